@@ -1,0 +1,11 @@
+"""cspace: exact 2-D geometry for configuration-space motion planning.
+
+The geometry layer: numpy + shapely only, never OMPL or matplotlib. Polygons are
+``(N, 2)`` float64 arrays, counter-clockwise. See ``docs/architecture.md``.
+"""
+from .predicates import orient2d, orient2d_many, cross_sign
+from .polygon import as_array, signed_area, normalize, is_convex, is_simple, lowest_first
+from .disk import disk_polygon, disk_sides, disk_error
+from .scenario import Scenario, Shape, Query, ScenarioError, load_scenario, scenario_from_dict
+
+__version__ = "0.1.0"

@@ -1,0 +1,196 @@
+"""Polygons as (N, 2) float64 arrays: conversion, orientation, clean-up, convexity.
+
+This module owns the polygon currency of the package. A polygon is an ``(N, 2)``
+float64 array of vertices, counter-clockwise, without the closing repeat. Every
+decision about turns is made with the exact predicate of :mod:`cspace.predicates`,
+so a cleaned polygon never keeps a collinear vertex and never loses a real one.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .predicates import orient2d_many, orient2d_xy
+
+
+def as_array(polygon) -> np.ndarray:
+    """Vertices of ``polygon`` as a fresh ``(N, 2)`` float64 array, closing repeat dropped.
+
+    Accepts an array-like of points or a shapely ``Polygon`` / ``LinearRing`` /
+    ``LineString`` / ``Point`` (a polygon's exterior is used).
+
+    >>> as_array([[0, 0], [1, 0], [0, 1], [0, 0]]).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
+    """
+    if hasattr(polygon, "geom_type"):
+        geom = polygon
+        if geom.geom_type == "Polygon":
+            geom = geom.exterior
+        pts = np.array(geom.coords, dtype=np.float64)[:, :2]
+    else:
+        pts = np.array(polygon, dtype=np.float64)
+    if pts.ndim == 1 and pts.size == 2:
+        pts = pts.reshape(1, 2)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise ValueError(f"expected an (N, 2) array of points, got shape {pts.shape}")
+    if len(pts) > 1 and pts[0, 0] == pts[-1, 0] and pts[0, 1] == pts[-1, 1]:
+        pts = pts[:-1]
+    return pts
+
+
+def signed_area(polygon) -> float:
+    """Signed area (shoelace, computed about the first vertex): > 0 for CCW.
+
+    >>> signed_area([[0, 0], [2, 0], [0, 2]])
+    2.0
+    """
+    p = as_array(polygon)
+    if len(p) < 3:
+        return 0.0
+    q = p - p[0]
+    x, y = q[:, 0], q[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def is_ccw(polygon) -> bool:
+    """True when the polygon's signed area is positive.
+
+    >>> is_ccw([[0, 0], [0, 1], [1, 0]])
+    False
+    """
+    return signed_area(polygon) > 0.0
+
+
+def drop_repeats(p: np.ndarray) -> np.ndarray:
+    """Remove consecutive duplicate vertices (cyclically).
+
+    >>> drop_repeats(np.array([[0., 0], [0, 0], [1, 0], [0, 1], [0, 0]])).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
+    """
+    if len(p) < 2:
+        return p
+    keep = np.any(p != np.roll(p, 1, axis=0), axis=1)
+    if not keep.any():  # all the same point
+        return p[:1]
+    return p[keep]
+
+
+def drop_collinear(p: np.ndarray) -> np.ndarray:
+    """Remove every vertex whose two neighbours are exactly collinear with it.
+
+    Repeats until stable, since removing one vertex can make its neighbour collinear
+    (a spike folding back on itself).
+
+    >>> drop_collinear(np.array([[0., 0], [1, 0], [2, 0], [2, 2]])).tolist()
+    [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]
+    """
+    while len(p) >= 3:
+        turn = orient2d_many(np.roll(p, 1, axis=0), p, np.roll(p, -1, axis=0))
+        keep = turn != 0
+        if keep.all():
+            break
+        if not keep.any():
+            return p[:0]
+        # Remove collinear vertices whose predecessor stays, so that both neighbours a
+        # removal was decided on are still there: every removal is then exact.
+        drop = np.zeros(len(p), dtype=bool)
+        for i in np.flatnonzero(~keep):
+            drop[i] = not drop[i - 1]
+        if drop[0] and drop[-1]:
+            drop[-1] = False
+        p = p[~drop]
+        p = drop_repeats(p)
+    return p
+
+
+def normalize(polygon, *, ccw: bool = True) -> np.ndarray:
+    """Clean a polygon: drop repeats and collinear vertices, orient CCW (or CW).
+
+    The result may have fewer than 3 vertices (a degenerate polygon); callers that
+    need a proper polygon check ``len``.
+
+    >>> normalize([[0, 0], [0, 2], [0, 1], [2, 0], [1, 0]]).tolist()
+    [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]]
+    """
+    p = drop_collinear(drop_repeats(as_array(polygon)))
+    if len(p) >= 3 and (signed_area(p) > 0.0) != ccw:
+        p = p[::-1].copy()
+    return p
+
+
+def lowest_first(p: np.ndarray) -> np.ndarray:
+    """Rotate the vertex cycle to start at the lowest vertex (then leftmost).
+
+    >>> lowest_first(np.array([[1., 1], [0, 0], [1, 0]])).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]
+    """
+    if len(p) == 0:
+        return p
+    i = int(np.lexsort((p[:, 0], p[:, 1]))[0])
+    return np.roll(p, -i, axis=0) if i else p
+
+
+def is_convex(polygon, *, strict: bool = False) -> bool:
+    """Exact convexity test of a closed polygon given in either orientation.
+
+    Convex means every turn has the same sign (or is straight) and the boundary
+    winds around exactly once. ``strict=True`` also rejects collinear vertices.
+
+    >>> is_convex([[0, 0], [2, 0], [2, 2], [0, 2]])
+    True
+    >>> is_convex([[0, 0], [2, 0], [1, 1], [2, 2], [0, 2]])
+    False
+    """
+    p = drop_repeats(as_array(polygon))
+    if len(p) < 3:
+        return not strict
+    turn = orient2d_many(np.roll(p, 1, axis=0), p, np.roll(p, -1, axis=0))
+    if strict and (turn == 0).any():
+        return False
+    if (turn > 0).any() and (turn < 0).any():
+        return False
+    if not turn.any():
+        return not strict  # all collinear: a segment, convex but degenerate
+    # Same-sign turns can still wind twice (a pentagram): total turning must be 2 pi.
+    e = np.roll(p, -1, axis=0) - p
+    ang = np.arctan2(e[:, 1], e[:, 0])
+    d = np.diff(np.append(ang, ang[0]))
+    d = (d + math.pi) % (2 * math.pi) - math.pi
+    return abs(abs(d.sum()) - 2 * math.pi) < 1.0
+
+
+def is_simple(polygon) -> bool:
+    """True when the closed polygon has non-zero area and does not cross itself.
+
+    >>> is_simple([[0, 0], [2, 2], [2, 0], [0, 2]])
+    False
+    """
+    import shapely
+
+    p = as_array(polygon)
+    if len(p) < 3:
+        return False
+    poly = shapely.Polygon(p)
+    return bool(poly.is_valid) and poly.area > 0.0
+
+
+def point_in_convex(p: np.ndarray, x: float, y: float) -> int:
+    """Locate point (x, y) against CCW convex polygon ``p`` exactly.
+
+    Returns +1 inside, 0 on the boundary, -1 outside.
+
+    >>> point_in_convex(np.array([[0., 0], [2, 0], [0, 2]]), 1.0, 1.0)
+    0
+    """
+    n = len(p)
+    res = 1
+    for i in range(n):
+        ax, ay = p[i]
+        bx, by = p[(i + 1) % n]
+        s = orient2d_xy(ax, ay, bx, by, x, y)
+        if s < 0:
+            return -1
+        if s == 0:
+            res = 0
+    return res

@@ -1,0 +1,407 @@
+"""Scenario files: the TOML schema, its loader and its validation.
+
+This module owns what a scenario *is* (:class:`Scenario`) and how a TOML file
+becomes one. Every fault in a file is reported as a :class:`ScenarioError` whose
+text is ``FILE: FIELD: what is wrong``, one line, so the command line can print it
+as it is. Loading never modifies the file.
+
+Schema (all lengths in one unit, angles in radians)::
+
+    name = "..."                       # optional, defaults to the file stem
+    expect = "solvable"                # optional: "solvable" (default) or "unsolvable"
+    disk_tolerance = 1e-3              # optional: largest disk-to-polygon error, relative to r
+    [bounds]   xmin, xmax, ymin, ymax  # bounds of the robot's reference point (the state)
+    [robot]    polygon = [[x, y], ...] # body frame, reference point = body origin
+               | [[robot.parts]] polygon = ...   (several parts)
+               | radius = r            # a disk centred on the reference point
+               (no [robot]: a point robot)
+    [[obstacles]] polygon = [[x, y], ...], holes = [[[x, y], ...], ...]  (holes optional)
+                | center = [x, y], radius = r
+    [start]    x, y, theta (optional; the fixed orientation while translating)
+    [goal]     x, y, theta (optional; must equal the start's)
+    [planner]  name, time, seed        # optional defaults
+    [[queries]] start = [x, y], goal = [x, y]   # optional extra queries
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
+from .polygon import is_convex, normalize
+
+try:  # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+
+class ScenarioError(ValueError):
+    """A fault in a scenario: ``str(err)`` is ``FILE: FIELD: message``."""
+
+    def __init__(self, file: str, field: str, message: str):
+        self.file, self.field, self.message = file, field, message
+        super().__init__(f"{file}: {field}: {message}")
+
+
+@dataclass
+class Shape:
+    """One robot part or obstacle: a simple polygon (CCW exterior, CW holes).
+
+    ``disk`` is ``(cx, cy, r)`` when the shape stands for a disk (then ``polygon``
+    is the circumscribed regular polygon).
+    """
+
+    polygon: np.ndarray
+    holes: list[np.ndarray] = field(default_factory=list)
+    disk: tuple[float, float, float] | None = None
+    convex: bool = False
+
+    def to_shapely(self):
+        """The shape as a shapely Polygon (imported lazily)."""
+        import shapely
+
+        return shapely.Polygon(self.polygon, [h for h in self.holes])
+
+
+@dataclass
+class Query:
+    """A start and goal of the reference point."""
+
+    start: tuple[float, float]
+    goal: tuple[float, float]
+
+
+@dataclass
+class Scenario:
+    """A planning problem: a translating robot, obstacles, bounds and queries.
+
+    ``robot`` holds the parts in the world orientation (already rotated by
+    ``theta``), relative to the reference point; an empty list is a point robot.
+    """
+
+    name: str
+    bounds: tuple[float, float, float, float]
+    robot: list[Shape]
+    obstacles: list[Shape]
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    theta: float = 0.0
+    planner: dict = field(default_factory=dict)
+    queries: list[Query] = field(default_factory=list)
+    expect: str = "solvable"
+    path: str | None = None
+    robot_kind: str = "point"  # "point", "polygon", "parts" or "disk"
+    disk_tolerance: float = DEFAULT_RELATIVE_ERROR
+
+    @property
+    def is_point_robot(self) -> bool:
+        return not self.robot
+
+    def all_queries(self) -> list[Query]:
+        """The main query first, then the ``[[queries]]`` (the main one not repeated)."""
+        main = Query(self.start, self.goal)
+        rest = [q for q in self.queries if (q.start, q.goal) != (main.start, main.goal)]
+        return [main] + rest
+
+    def robot_at(self, x: float, y: float) -> list[np.ndarray]:
+        """The robot's part polygons with the reference point at (x, y)."""
+        return [s.polygon + np.array([x, y]) for s in self.robot]
+
+
+# ---------------------------------------------------------------------------------
+# Loading
+
+
+def load_scenario(path) -> Scenario:
+    """Read and validate a TOML scenario file.
+
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp(); f = os.path.join(d, "s.toml")
+    >>> _ = open(f, "w").write('[bounds]\\nxmin=0\\nxmax=1\\nymin=0\\nymax=1\\n'
+    ...                        '[start]\\nx=0.1\\ny=0.1\\n[goal]\\nx=0.9\\ny=0.9\\n')
+    >>> load_scenario(f).goal
+    (0.9, 0.9)
+    """
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise ScenarioError(path, "file", f"cannot read ({exc.strerror or exc})") from None
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise ScenarioError(path, "file", "not UTF-8 text") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
+    return scenario_from_dict(data, path)
+
+
+def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
+    """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`."""
+    v = _Validator(path)
+    known = {"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal", "planner", "queries"}
+    for key in data:
+        if key not in known:
+            raise v.err(key, f"unknown field (expected one of: {', '.join(sorted(known))})")
+    name = data.get("name", os.path.splitext(os.path.basename(path))[0])
+    if not isinstance(name, str):
+        raise v.err("name", "must be a string")
+    expect = data.get("expect", "solvable")
+    if expect not in ("solvable", "unsolvable"):
+        raise v.err("expect", 'must be "solvable" or "unsolvable"')
+    tol = v.number(data.get("disk_tolerance", DEFAULT_RELATIVE_ERROR), "disk_tolerance", positive=True)
+
+    b = v.table(data, "bounds", required=True)
+    xmin, xmax = v.number(b.get("xmin"), "bounds.xmin"), v.number(b.get("xmax"), "bounds.xmax")
+    ymin, ymax = v.number(b.get("ymin"), "bounds.ymin"), v.number(b.get("ymax"), "bounds.ymax")
+    v.no_extra(b, "bounds", {"xmin", "xmax", "ymin", "ymax"})
+    if not xmin < xmax:
+        raise v.err("bounds", f"xmin ({xmin}) must be less than xmax ({xmax})")
+    if not ymin < ymax:
+        raise v.err("bounds", f"ymin ({ymin}) must be less than ymax ({ymax})")
+    bounds = (xmin, xmax, ymin, ymax)
+
+    start_t = v.table(data, "start", required=True)
+    goal_t = v.table(data, "goal", required=True)
+    start, theta = v.pose(start_t, "start")
+    goal, goal_theta = v.pose(goal_t, "goal")
+    if goal_theta is not None and theta is not None and goal_theta != theta:
+        raise v.err("goal.theta", "must equal start.theta (the robot translates at a fixed orientation)")
+    theta = theta if theta is not None else (goal_theta or 0.0)
+
+    robot, kind = v.robot(data.get("robot"), theta, tol)
+    obstacles = v.obstacles(data.get("obstacles", []), tol)
+    planner = v.planner(data.get("planner", {}))
+    queries = v.queries(data.get("queries", []))
+
+    sc = Scenario(
+        name=name, bounds=bounds, robot=robot, obstacles=obstacles, start=start, goal=goal,
+        theta=theta, planner=planner, queries=queries, expect=expect, path=path,
+        robot_kind=kind, disk_tolerance=tol,
+    )
+    probe = CollisionProbe(sc)
+    labelled = [(start, "start"), (goal, "goal")]
+    for i, q in enumerate(queries):
+        labelled += [(q.start, f"queries[{i}].start"), (q.goal, f"queries[{i}].goal")]
+    for pt, fld in labelled:
+        v.placement(sc, probe, pt, fld)
+    return sc
+
+
+class _Validator:
+    """Field-by-field checks; each failure names the file and the field."""
+
+    def __init__(self, path: str):
+        self.path = path
+
+    def err(self, field: str, message: str) -> ScenarioError:
+        return ScenarioError(self.path, field, message)
+
+    def table(self, data: dict, key: str, required: bool = False) -> dict:
+        t = data.get(key)
+        if t is None:
+            if required:
+                raise self.err(key, "missing (a table is required)")
+            return {}
+        if not isinstance(t, dict):
+            raise self.err(key, "must be a table")
+        return t
+
+    def no_extra(self, t: dict, where: str, allowed: set) -> None:
+        for k in t:
+            if k not in allowed:
+                raise self.err(f"{where}.{k}", f"unknown field (expected: {', '.join(sorted(allowed))})")
+
+    def number(self, x, field: str, positive: bool = False) -> float:
+        if x is None:
+            raise self.err(field, "missing (a number is required)")
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            raise self.err(field, f"must be a number, got {type(x).__name__} {x!r}")
+        try:
+            xf = float(x)
+        except OverflowError:
+            raise self.err(field, f"{x} is too large for a double") from None
+        if not math.isfinite(xf):
+            raise self.err(field, f"must be finite, got {x}")
+        if positive and not xf > 0.0:
+            raise self.err(field, f"must be positive, got {x}")
+        return xf
+
+    def point(self, p, field: str) -> tuple[float, float]:
+        if not isinstance(p, list) or len(p) != 2:
+            raise self.err(field, f"must be a point [x, y], got {p!r}")
+        return self.number(p[0], f"{field}[0]"), self.number(p[1], f"{field}[1]")
+
+    def pose(self, t: dict, field: str) -> tuple[tuple[float, float], float | None]:
+        self.no_extra(t, field, {"x", "y", "theta"})
+        xy = (self.number(t.get("x"), f"{field}.x"), self.number(t.get("y"), f"{field}.y"))
+        theta = self.number(t["theta"], f"{field}.theta") if "theta" in t else None
+        return xy, theta
+
+    def polygon(self, pts, field: str) -> np.ndarray:
+        if not isinstance(pts, list):
+            raise self.err(field, "must be a list of points [[x, y], ...]")
+        arr = np.array([self.point(p, f"{field}[{i}]") for i, p in enumerate(pts)], dtype=np.float64).reshape(-1, 2)
+        if len(np.unique(arr, axis=0)) < 3:
+            raise self.err(field, f"needs at least 3 distinct vertices, got {len(np.unique(arr, axis=0))}")
+        return arr
+
+    def shape(self, t: dict, field: str, tol: float, allow_holes: bool) -> Shape:
+        import shapely
+
+        if not isinstance(t, dict):
+            raise self.err(field, "must be a table")
+        allowed = {"polygon", "holes"} if allow_holes else {"polygon"}
+        if "polygon" in t:
+            self.no_extra(t, field, allowed)
+            ext = self.polygon(t["polygon"], f"{field}.polygon")
+            holes_raw = t.get("holes", [])
+            if not isinstance(holes_raw, list):
+                raise self.err(f"{field}.holes", "must be a list of polygons")
+            holes = [self.polygon(h, f"{field}.holes[{i}]") for i, h in enumerate(holes_raw)]
+            shell = shapely.Polygon(ext)
+            if not shell.is_valid:
+                raise self.err(f"{field}.polygon", f"not a simple polygon ({shapely.is_valid_reason(shell)})")
+            if not shell.area > 0.0:
+                raise self.err(f"{field}.polygon", "has zero area")
+            for i, h in enumerate(holes):
+                hp = shapely.Polygon(h)
+                if not hp.is_valid or not hp.area > 0.0:
+                    raise self.err(f"{field}.holes[{i}]", "not a simple polygon of non-zero area")
+            if holes:
+                whole = shapely.Polygon(ext, holes)
+                if not whole.is_valid:
+                    raise self.err(f"{field}.holes", f"holes do not fit the polygon ({shapely.is_valid_reason(whole)})")
+            ext_n = normalize(ext, ccw=True)
+            holes_n = [normalize(h, ccw=False) for h in holes]
+            if len(ext_n) < 3:
+                raise self.err(f"{field}.polygon", "has zero area")
+            return Shape(ext_n, holes_n, None, convex=not holes_n and is_convex(ext_n))
+        if "radius" in t:
+            self.no_extra(t, field, {"center", "radius"})
+            r = self.number(t.get("radius"), f"{field}.radius", positive=True)
+            c = self.point(t.get("center", [0.0, 0.0] if field == "robot" else None), f"{field}.center")
+            return Shape(disk_polygon(c, r, max_error=tol * r), [], (c[0], c[1], r), convex=True)
+        raise self.err(field, "needs polygon = [[x, y], ...] or center = [x, y] with radius = r")
+
+    def robot(self, t, theta: float, tol: float) -> tuple[list[Shape], str]:
+        if t is None:
+            return [], "point"
+        if not isinstance(t, dict):
+            raise self.err("robot", "must be a table")
+        if "parts" in t:
+            self.no_extra(t, "robot", {"parts"})
+            parts = t["parts"]
+            if not isinstance(parts, list) or not parts:
+                raise self.err("robot.parts", "must be a non-empty array of tables")
+            shapes = [self.shape(p, f"robot.parts[{i}]", tol, allow_holes=False) for i, p in enumerate(parts)]
+            kind = "parts"
+        elif "radius" in t:
+            if "center" in t:
+                raise self.err("robot.center", "a disk robot is centred on its reference point; give radius only")
+            shapes = [self.shape(t, "robot", tol, allow_holes=False)]
+            kind = "disk"
+        elif "polygon" in t:
+            shapes = [self.shape(t, "robot", tol, allow_holes=False)]
+            kind = "polygon"
+        else:
+            raise self.err("robot", "needs polygon, [[robot.parts]] or radius")
+        if theta:
+            c, s = math.cos(theta), math.sin(theta)
+            rot = np.array([[c, s], [-s, c]])  # row vectors: p @ rot rotates by +theta
+            for sh in shapes:
+                sh.polygon = sh.polygon @ rot
+                if sh.disk is not None:
+                    sh.disk = (0.0, 0.0, sh.disk[2])
+        return shapes, kind
+
+    def obstacles(self, lst, tol: float) -> list[Shape]:
+        if not isinstance(lst, list):
+            raise self.err("obstacles", "must be an array of tables [[obstacles]]")
+        return [self.shape(t, f"obstacles[{i}]", tol, allow_holes=True) for i, t in enumerate(lst)]
+
+    def planner(self, t) -> dict:
+        if not isinstance(t, dict):
+            raise self.err("planner", "must be a table")
+        self.no_extra(t, "planner", {"name", "time", "seed"})
+        out = {}
+        if "name" in t:
+            if not isinstance(t["name"], str) or not t["name"]:
+                raise self.err("planner.name", "must be a planner name")
+            out["name"] = t["name"]
+        if "time" in t:
+            out["time"] = self.number(t["time"], "planner.time", positive=True)
+        if "seed" in t:
+            if isinstance(t["seed"], bool) or not isinstance(t["seed"], int) or t["seed"] < 0:
+                raise self.err("planner.seed", "must be a non-negative integer")
+            out["seed"] = t["seed"]
+        return out
+
+    def queries(self, lst) -> list[Query]:
+        if not isinstance(lst, list):
+            raise self.err("queries", "must be an array of tables [[queries]]")
+        out = []
+        for i, q in enumerate(lst):
+            f = f"queries[{i}]"
+            if not isinstance(q, dict):
+                raise self.err(f, "must be a table")
+            self.no_extra(q, f, {"start", "goal"})
+            pts = []
+            for key in ("start", "goal"):
+                p = q.get(key)
+                if isinstance(p, dict):
+                    self.no_extra(p, f"{f}.{key}", {"x", "y"})
+                    pts.append((self.number(p.get("x"), f"{f}.{key}.x"), self.number(p.get("y"), f"{f}.{key}.y")))
+                elif p is None:
+                    raise self.err(f"{f}.{key}", "missing")
+                else:
+                    pts.append(self.point(p, f"{f}.{key}"))
+            out.append(Query(pts[0], pts[1]))
+        return out
+
+    def placement(self, sc: Scenario, probe: "CollisionProbe", pt: tuple[float, float], field: str) -> None:
+        """The reference point must be in bounds and the robot there must touch no obstacle."""
+        xmin, xmax, ymin, ymax = sc.bounds
+        x, y = pt
+        if not (xmin <= x <= xmax and ymin <= y <= ymax):
+            raise self.err(field, f"({x}, {y}) is outside the bounds [{xmin}, {xmax}] x [{ymin}, {ymax}]")
+        hit = probe.first_hit(x, y)
+        if hit is not None:
+            raise self.err(field, f"({x}, {y}) puts the robot in collision with obstacles[{hit}]")
+
+
+class CollisionProbe:
+    """Which obstacle does the robot at (x, y) touch? An independent shapely route.
+
+    Closed sets: touching counts, the same convention as the C-space. Used to
+    validate starts and goals, and as a test oracle.
+    """
+
+    def __init__(self, sc: Scenario):
+        import shapely
+
+        self._shapely = shapely
+        self._sc = sc
+        self._geoms = [ob.to_shapely() for ob in sc.obstacles]
+        self._tree = shapely.STRtree(self._geoms) if self._geoms else None
+
+    def first_hit(self, x: float, y: float) -> int | None:
+        shapely = self._shapely
+        if self._tree is None:
+            return None
+        if self._sc.robot:
+            body = shapely.union_all([shapely.Polygon(p) for p in self._sc.robot_at(x, y)])
+        else:
+            body = shapely.Point(x, y)
+        hits = self._tree.query(body, predicate="intersects")
+        return int(hits.min()) if len(hits) else None
+
+
+def first_collision(sc: Scenario, x: float, y: float) -> int | None:
+    """Index of the first obstacle the robot at (x, y) touches (closed sets), or None."""
+    return CollisionProbe(sc).first_hit(x, y)
