@@ -1,0 +1,77 @@
+"""The ``cspace`` command: a thin dispatcher over subcommand modules.
+
+Each subcommand lives in its own module, imported only when that subcommand runs,
+so ``cspace plan`` never pays for matplotlib or the benchmark code. A module exposes
+``register(subparsers)``, which adds its parser and sets ``run`` (``args -> exit code``).
+
+Exit codes: 0 success, 1 not solved (or a check failed), 2 bad input.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+
+from cspace.scenario import ScenarioError
+
+COMMANDS = {
+    "plan": "planners.cli_plan",
+    "show": "planners.cli_show",
+    "bench": "planners.bench",
+    "stability": "planners.stability",
+    "generate": "planners.generate",
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, like every other input fault
+        sys.stderr.write(f"error: {self.prog}: {message}\n")
+        sys.exit(2)
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    parser = _Parser(prog="cspace", description="2-D configuration-space motion planning")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name, module in COMMANDS.items():
+        if only is not None and name != only:
+            sub.add_parser(name, help=f"(see cspace {name} --help)", add_help=False)
+            continue
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name != module:
+                raise
+            continue
+        mod.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    first = next((a for a in argv if not a.startswith("-")), None)
+    parser = build_parser(first if first in COMMANDS else None)
+    args = parser.parse_args(argv)
+    try:
+        code = args.run(args)
+    except ScenarioError as exc:
+        sys.stderr.write(f"error: {exc}\n")
+        code = 2
+    except KeyboardInterrupt:
+        sys.stderr.write("interrupted\n")
+        code = 130
+    return _exit(code, verbose=getattr(args, "verbose", False))
+
+
+def _exit(code: int, verbose: bool = False) -> int:
+    """Leave without the nanobind leak report OMPL's bindings print at interpreter exit."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if "ompl" in sys.modules and not verbose:
+        os._exit(code)
+    return code
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
