@@ -61,17 +61,23 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("interrupted\n")
         code = 130
-    return _exit(code, verbose=getattr(args, "verbose", False))
-
-
-def _exit(code: int, verbose: bool = False) -> int:
-    """Leave without the nanobind leak report OMPL's bindings print at interpreter exit."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    if "ompl" in sys.modules and not verbose:
-        os._exit(code)
     return code
 
 
+def console() -> None:
+    """Entry point of the installed ``cspace`` script.
+
+    OMPL's bindings print a ``nanobind: leaked ...`` report at interpreter exit; a
+    command-line user should not see it, so the process ends with ``os._exit`` once
+    its output is flushed (unless ``--verbose`` asks to see everything).
+    """
+    code = main()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if "ompl" in sys.modules and "--verbose" not in sys.argv and "-v" not in sys.argv:
+        os._exit(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    console()
