@@ -66,7 +66,7 @@ def drop_repeats(p: np.ndarray) -> np.ndarray:
     """Remove consecutive duplicate vertices (cyclically).
 
     >>> drop_repeats(np.array([[0., 0], [0, 0], [1, 0], [0, 1], [0, 0]])).tolist()
-    [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
+    [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]
     """
     if len(p) < 2:
         return p
@@ -105,18 +105,19 @@ def drop_collinear(p: np.ndarray) -> np.ndarray:
 
 
 def normalize(polygon, *, ccw: bool = True) -> np.ndarray:
-    """Clean a polygon: drop repeats and collinear vertices, orient CCW (or CW).
+    """Clean a polygon: drop repeats, spikes and collinear vertices, orient CCW (or CW).
 
-    The result may have fewer than 3 vertices (a degenerate polygon); callers that
-    need a proper polygon check ``len``.
+    The cycle starts at the lowest (then leftmost) vertex. The result may have
+    fewer than 3 vertices (a degenerate polygon); callers that need a proper
+    polygon check ``len``.
 
     >>> normalize([[0, 0], [0, 2], [0, 1], [2, 0], [1, 0]]).tolist()
-    [[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]]
+    [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]]
     """
     p = drop_collinear(drop_repeats(as_array(polygon)))
     if len(p) >= 3 and (signed_area(p) > 0.0) != ccw:
         p = p[::-1].copy()
-    return p
+    return lowest_first(p)
 
 
 def lowest_first(p: np.ndarray) -> np.ndarray:
@@ -157,7 +158,7 @@ def is_convex(polygon, *, strict: bool = False) -> bool:
     ang = np.arctan2(e[:, 1], e[:, 0])
     d = np.diff(np.append(ang, ang[0]))
     d = (d + math.pi) % (2 * math.pi) - math.pi
-    return abs(abs(d.sum()) - 2 * math.pi) < 1.0
+    return bool(abs(abs(d.sum()) - 2 * math.pi) < 1.0)
 
 
 def is_simple(polygon) -> bool:

@@ -91,23 +91,33 @@ def orient2d_many(a, b, c) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     c = np.asarray(c, dtype=np.float64)
-    a, b, c = np.broadcast_arrays(a, b, c)
+    return orient2d_cols(a[..., 0], a[..., 1], b[..., 0], b[..., 1], c[..., 0], c[..., 1])
+
+
+def orient2d_cols(ax, ay, bx, by, cx, cy) -> np.ndarray:
+    """:func:`orient2d_many` on coordinate columns (arrays or scalars that broadcast).
+
+    >>> orient2d_cols(np.zeros(2), np.zeros(2), 1.0, 0.0, np.array([0.5, 0.5]), np.array([1.0, -1.0])).tolist()
+    [1, -1]
+    """
     with np.errstate(over="ignore", invalid="ignore", under="ignore"):
-        detleft = (a[..., 0] - c[..., 0]) * (b[..., 1] - c[..., 1])
-        detright = (a[..., 1] - c[..., 1]) * (b[..., 0] - c[..., 0])
+        acx, bcy = ax - cx, by - cy
+        acy, bcx = ay - cy, bx - cx
+        detleft = acx * bcy
+        detright = acy * bcx
         det = detleft - detright
         detsum = np.abs(detleft) + np.abs(detright)
         errbound = CCW_ERRBOUND_A * detsum
         ok = (detsum > _UNDERFLOW_GUARD) & (detsum < _INF)
-        sign = np.where(ok & (det > errbound), 1, np.where(ok & (-det > errbound), -1, 0)).astype(np.int8)
-        certain = ok & (np.abs(det) > errbound)
-        zero = (detsum == 0.0) & ((a[..., 0] == c[..., 0]) | (b[..., 1] == c[..., 1])) & (
-            (a[..., 1] == c[..., 1]) | (b[..., 0] == c[..., 0])
-        )
-        certain |= zero
+        sign = (ok & (det > errbound)).astype(np.int8) - (ok & (-det > errbound)).astype(np.int8)
+        certain = sign != 0
+        # Both products exact zeros (a zero factor, not an underflow): collinear.
+        certain |= (detsum == 0.0) & ((acx == 0.0) | (bcy == 0.0)) & ((acy == 0.0) | (bcx == 0.0))
     if not certain.all():
-        for idx in zip(*np.nonzero(~certain)):
-            sign[idx] = orient2d_exact(a[idx][0], a[idx][1], b[idx][0], b[idx][1], c[idx][0], c[idx][1])
+        cols = np.broadcast_arrays(ax, ay, bx, by, cx, cy, sign)
+        sign = np.array(cols[-1], dtype=np.int8)
+        for idx in zip(*np.nonzero(~np.broadcast_to(certain, sign.shape))):
+            sign[idx] = orient2d_exact(*(float(col[idx]) for col in cols[:6]))
     return sign
 
 

@@ -1,0 +1,199 @@
+"""Broad phase for point and segment queries: a uniform grid with a precomputed occupancy.
+
+This module owns the question "which convex pieces can a query near (x, y) touch?".
+The grid covers the bounds; each cell is classified once, at build time:
+
+- ``FREE``: no piece meets the closed cell, so every state in it is free;
+- ``BLOCKED``: the closed cell lies inside one (closed, convex) piece, so every
+  state in it collides;
+- ``MIXED``: otherwise; the cell keeps the list of pieces that may meet it.
+
+The classification is conservative: a cell is called FREE or BLOCKED only when the
+float test is certified with a margin far larger than its rounding error; anything
+in doubt is MIXED and goes to the exact narrow phase. A point query in a FREE or
+BLOCKED cell therefore costs a few arithmetic operations, which is what makes a
+Python validity checker affordable inside OMPL.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+FREE, MIXED, BLOCKED = 0, 1, 2
+
+# Relative margin for the certified cell classification: far above the rounding
+# error of the few float operations used (about 1e-15 of the scene's scale).
+_MARGIN = 1e-9
+
+
+class GridIndex:
+    """Uniform grid over ``bounds`` classifying cells against convex ``pieces``.
+
+    >>> g = GridIndex([np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])], (0, 4, 0, 4), cells=16)
+    >>> int(g.state_at(3.5, 3.5)), int(g.state_at(0.5, 0.5))
+    (0, 2)
+    """
+
+    def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None):
+        xmin, xmax, ymin, ymax = map(float, bounds)
+        self.bounds = (xmin, xmax, ymin, ymax)
+        n = len(pieces)
+        if cells is None:
+            cells = int(min(max(1024 * n, 1 << 16), 1 << 20))
+        w, h = xmax - xmin, ymax - ymin
+        nx = max(1, min(4096, int(round(math.sqrt(cells * w / h)))))
+        ny = max(1, min(4096, int(round(cells / nx))))
+        self.nx, self.ny = nx, ny
+        self.x0, self.y0 = xmin, ymin
+        self.cw, self.ch = w / nx, h / ny
+        self.inv_w, self.inv_h = nx / w, ny / h
+        # Classification runs in a local frame centred on the bounds, so its rounding
+        # error scales with the scene's extent; the shift itself may round by up to
+        # an ulp of the largest coordinate, which the margin also covers.
+        self.ox, self.oy = 0.5 * (xmin + xmax), 0.5 * (ymin + ymax)
+        big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] + [float(np.abs(p).max()) for p in pieces])
+        self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
+        state = np.zeros(nx * ny, dtype=np.int8)
+        blocker = np.full(nx * ny, -1, dtype=np.int64)
+        cand_cells: list[np.ndarray] = []
+        cand_piece: list[np.ndarray] = []
+        for k, p in enumerate(pieces):
+            cells_k, inside = self._classify(p)
+            if cells_k.size == 0:
+                continue
+            blk = cells_k[inside]
+            state[blk] = BLOCKED
+            blocker[blk] = k
+            mixed = cells_k[~inside]
+            cand_cells.append(mixed)
+            cand_piece.append(np.full(mixed.size, k, dtype=np.int64))
+        # A cell touched by any piece but not wholly inside one is MIXED.
+        if cand_cells:
+            cc = np.concatenate(cand_cells)
+            cp = np.concatenate(cand_piece)
+            order = np.argsort(cc, kind="stable")
+            cc, cp = cc[order], cp[order]
+            touched = np.zeros(nx * ny, dtype=bool)
+            touched[cc] = True
+            state[touched & (state != BLOCKED)] = MIXED
+            starts = np.searchsorted(cc, np.arange(nx * ny + 1))
+        else:
+            cp = np.zeros(0, dtype=np.int64)
+            starts = np.zeros(nx * ny + 1, dtype=np.int64)
+        self.state = state
+        self.blocker = blocker
+        self._cand = cp
+        self._starts = starts
+        # Plain Python copies for the scalar hot path (list indexing beats numpy scalars).
+        self.state_list = state.tolist()
+        self.blocker_list = blocker.tolist()
+
+    # -- build -------------------------------------------------------------------
+
+    def _classify(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Cells that closed convex ``p`` may meet, and which of them lie inside ``p``."""
+        m = self.margin
+        i0 = int(math.floor((p[:, 0].min() - m - self.x0) * self.inv_w))
+        i1 = int(math.floor((p[:, 0].max() + m - self.x0) * self.inv_w))
+        j0 = int(math.floor((p[:, 1].min() - m - self.y0) * self.inv_h))
+        j1 = int(math.floor((p[:, 1].max() + m - self.y0) * self.inv_h))
+        i0, j0 = max(i0, 0), max(j0, 0)
+        i1, j1 = min(i1, self.nx - 1), min(j1, self.ny - 1)
+        if i0 > i1 or j0 > j1:
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool)
+        ii, jj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
+        ii, jj = ii.ravel(), jj.ravel()
+        q = p - (self.ox, self.oy)
+        # Edge half-planes of p: n . x <= c, n the outward unit normal.
+        e = np.roll(q, -1, axis=0) - q
+        nrm = np.column_stack([e[:, 1], -e[:, 0]])
+        nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
+        c = np.einsum("ij,ij->i", nrm, q)
+        inside = np.empty(ii.size, dtype=bool)
+        separated = np.empty(ii.size, dtype=bool)
+        step = max(1, (1 << 21) // (4 * len(q)))  # bound the (cells, 4, edges) block
+        for s in range(0, ii.size, step):
+            cx0 = (self.x0 - self.ox) + ii[s : s + step] * self.cw
+            cy0 = (self.y0 - self.oy) + jj[s : s + step] * self.ch
+            xs = np.stack([cx0, cx0 + self.cw, cx0 + self.cw, cx0], axis=1)
+            ys = np.stack([cy0, cy0, cy0 + self.ch, cy0 + self.ch], axis=1)
+            # signed distance of each corner beyond each edge line
+            d = xs[:, :, None] * nrm[:, 0] + ys[:, :, None] * nrm[:, 1] - c
+            inside[s : s + step] = (d <= -m).all(axis=(1, 2))
+            # Separated when all four corners lie beyond one edge; the cell's own
+            # axes are covered by the bounding-box range above.
+            separated[s : s + step] = (d >= m).all(axis=1).any(axis=1)
+        keep = ~separated
+        return (jj * self.nx + ii)[keep], inside[keep]
+
+    # -- queries -----------------------------------------------------------------
+
+    def cell_of(self, x: float, y: float) -> int:
+        """Flat index of the cell holding (x, y) (clamped to the grid)."""
+        i = int((x - self.x0) * self.inv_w)
+        j = int((y - self.y0) * self.inv_h)
+        i = 0 if i < 0 else (self.nx - 1 if i >= self.nx else i)
+        j = 0 if j < 0 else (self.ny - 1 if j >= self.ny else j)
+        return j * self.nx + i
+
+    def state_at(self, x: float, y: float) -> int:
+        """FREE, MIXED or BLOCKED for the cell holding (x, y)."""
+        return self.state_list[self.cell_of(x, y)]
+
+    def candidates(self, cell: int) -> np.ndarray:
+        """Pieces that may meet a MIXED cell."""
+        return self._cand[self._starts[cell] : self._starts[cell + 1]]
+
+    def candidates_of(self, cells: np.ndarray) -> np.ndarray:
+        """Distinct pieces that may meet any of ``cells`` (one vectorised gather)."""
+        s, e = self._starts[cells], self._starts[cells + 1]
+        counts = e - s
+        total = int(counts.sum())
+        if total == 0:
+            return np.zeros(0, dtype=np.int64)
+        idx = np.repeat(s - (np.cumsum(counts) - counts), counts) + np.arange(total)
+        return np.unique(self._cand[idx])
+
+    def cells_on_segment(self, ax: float, ay: float, bx: float, by: float) -> np.ndarray:
+        """Every cell the closed segment a-b may meet (a conservative supercover).
+
+        For each grid column the segment crosses, the rows spanned by the segment's
+        y-range inside that column, widened by the margin, are taken.
+        """
+        m = self.margin
+        xlo, xhi = min(ax, bx), max(ax, bx)
+        i0 = max(int(math.floor((xlo - m - self.x0) * self.inv_w)), 0)
+        i1 = min(int(math.floor((xhi + m - self.x0) * self.inv_w)), self.nx - 1)
+        if i1 < i0:
+            return np.zeros(0, dtype=np.int64)
+        cols = np.arange(i0, i1 + 1)
+        # x-interval of each column intersected with the segment's x-range
+        lo = np.maximum(self.x0 + cols * self.cw, xlo)
+        hi = np.minimum(self.x0 + (cols + 1) * self.cw, xhi)
+        if bx != ax:
+            t = (ay - by) / (ax - bx)
+            ylo_x, yhi_x = ay + (lo - ax) * t, ay + (hi - ax) * t
+            y_lo = np.minimum(ylo_x, yhi_x)
+            y_hi = np.maximum(ylo_x, yhi_x)
+        else:
+            y_lo = np.full(cols.size, min(ay, by))
+            y_hi = np.full(cols.size, max(ay, by))
+        r0 = np.clip(np.floor((y_lo - m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
+        r1 = np.clip(np.floor((y_hi + m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
+        counts = r1 - r0 + 1
+        total = int(counts.sum())
+        col_rep = np.repeat(cols, counts)
+        offs = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+        rows = np.repeat(r0, counts) + offs
+        return rows * self.nx + col_rep
+
+    def stats(self) -> dict:
+        """Cell counts by class, for reports."""
+        return {
+            "cells": int(self.nx * self.ny),
+            "grid": [int(self.nx), int(self.ny)],
+            "free": int((self.state == FREE).sum()),
+            "blocked": int((self.state == BLOCKED).sum()),
+            "mixed": int((self.state == MIXED).sum()),
+        }

@@ -1,0 +1,313 @@
+"""The configuration space of a translating robot, kept as convex pieces.
+
+This module owns the C-space: C_obs = union over obstacles O and robot parts R of
+O ⊕ (−R), stored as convex pieces (convex obstacle piece ⊕ reflected convex robot
+piece), pruned, and indexed by a grid broad phase. Obstacles are closed sets: a
+state whose robot touches an obstacle is not free (so a passage exactly as wide as
+the robot is closed, consistently, by every query).
+
+Only the stages a scene needs run, and each is recorded with its cost:
+
+- ``decompose_obstacles`` / ``decompose_robot``: convex shapes are kept as they are;
+- ``minkowski``: skipped for a point robot (C_obs is the obstacles themselves);
+  a disk robot is its circumscribed polygon, convex, so never decomposed;
+- ``prune``: pieces that cannot meet the bounds are dropped, and pieces inside
+  another piece (exact test) are removed;
+- ``index``: the grid broad phase of :mod:`cspace.broadphase`.
+"""
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .broadphase import BLOCKED, FREE, MIXED, GridIndex
+from .pieces import PieceSet
+from .predicates import orient2d_many
+from .scenario import Scenario, load_scenario
+
+
+@dataclass
+class Stage:
+    """One build stage: whether it ran, what it counted and what it cost."""
+
+    name: str
+    ran: bool
+    seconds: float = 0.0
+    counts: dict = field(default_factory=dict)
+    note: str = ""
+
+    def as_dict(self) -> dict:
+        return {"stage": self.name, "ran": self.ran, "seconds": self.seconds, **self.counts, "note": self.note}
+
+
+class CSpace:
+    """Convex C-obstacle pieces of a scenario behind a broad phase.
+
+    >>> import numpy as np
+    >>> cs = CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])])
+    >>> cs.is_free((1, 1)), cs.is_free((5, 5)), cs.segment_free((1, 5), (9, 5))
+    (True, False, False)
+    """
+
+    def __init__(
+        self,
+        bounds,
+        obstacles: list[np.ndarray] | None = None,
+        robot: list[np.ndarray] | None = None,
+        *,
+        obstacle_holes: list[list[np.ndarray]] | None = None,
+        robot_is_disk: bool = False,
+        grid_cells: int | None = None,
+    ):
+        self.bounds = tuple(float(v) for v in bounds)
+        self.stages: list[Stage] = []
+        obstacles = obstacles or []
+        holes = obstacle_holes or [[] for _ in obstacles]
+        self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes)
+        self.robot_pieces = self._decompose_robot(robot or [], robot_is_disk)
+        raw, raw_owner = self._sum()
+        self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
+        t = time.perf_counter()
+        self.packed = PieceSet(self.pieces)
+        self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells)
+        self.stages.append(Stage("index", True, time.perf_counter() - t, self.index.stats()))
+        self._state = self.index.state_list
+        self._blocker = self.index.blocker_list
+        self.checks = {"points": 0, "segments": 0, "exact_points": 0, "exact_segments": 0}
+
+    # -- construction --------------------------------------------------------------
+
+    @classmethod
+    def from_scenario(cls, scenario, grid_cells: int | None = None) -> "CSpace":
+        """Build the C-space of a :class:`Scenario` (or of a scenario file path).
+
+        >>> import os, tempfile
+        >>> f = os.path.join(tempfile.mkdtemp(), "s.toml")
+        >>> _ = open(f, "w").write("[bounds]\\nxmin=0\\nxmax=4\\nymin=0\\nymax=4\\n[start]\\nx=0.5\\ny=0.5\\n"
+        ...     "[goal]\\nx=3.5\\ny=3.5\\n[[obstacles]]\\npolygon=[[1,1],[3,1],[3,3],[1,3]]\\n")
+        >>> CSpace.from_scenario(f).is_free((2, 2))
+        False
+        """
+        t0 = time.perf_counter()
+        sc = scenario if isinstance(scenario, Scenario) else load_scenario(os.fspath(scenario))
+        load_s = time.perf_counter() - t0
+        cs = cls(
+            sc.bounds,
+            [o.polygon for o in sc.obstacles],
+            [r.polygon for r in sc.robot],
+            obstacle_holes=[o.holes for o in sc.obstacles],
+            robot_is_disk=sc.robot_kind == "disk",
+            grid_cells=grid_cells,
+        )
+        cs.scenario = sc
+        if not isinstance(scenario, Scenario):
+            cs.stages.insert(0, Stage("load", True, load_s, {"obstacles": len(sc.obstacles)}))
+        return cs
+
+    def _decompose_obstacles(self, obstacles, holes):
+        from .polygon import is_convex
+
+        t = time.perf_counter()
+        pieces, owner, split = [], [], 0
+        for i, (poly, hs) in enumerate(zip(obstacles, holes)):
+            if not hs and is_convex(poly):
+                parts = [np.asarray(poly, dtype=np.float64)]
+            else:
+                from .decompose import convex_decompose
+
+                parts = convex_decompose(poly, hs)
+                split += 1
+            pieces += parts
+            owner += [i] * len(parts)
+        self.stages.append(
+            Stage("decompose_obstacles", split > 0, time.perf_counter() - t,
+                  {"obstacles": len(obstacles), "decomposed": split, "pieces": len(pieces)},
+                  "" if split else "all obstacles convex: nothing to decompose")
+        )
+        return pieces, np.array(owner, dtype=np.int64)
+
+    def _decompose_robot(self, robot, is_disk):
+        from .polygon import is_convex
+
+        t = time.perf_counter()
+        if not robot:
+            self.stages.append(Stage("decompose_robot", False, 0.0, {"parts": 0}, "point robot"))
+            return []
+        pieces, split = [], 0
+        for part in robot:
+            if is_disk or is_convex(part):
+                pieces.append(np.asarray(part, dtype=np.float64))
+            else:
+                from .decompose import convex_decompose
+
+                pieces += convex_decompose(part)
+                split += 1
+        note = "disk robot: its polygon is convex" if is_disk else ("" if split else "robot parts convex")
+        self.stages.append(Stage("decompose_robot", split > 0, time.perf_counter() - t,
+                                 {"parts": len(robot), "pieces": len(pieces)}, note))
+        return pieces
+
+    def _sum(self):
+        t = time.perf_counter()
+        if not self.robot_pieces:
+            self.stages.append(Stage("minkowski", False, 0.0, {"pieces": len(self.obstacle_pieces)},
+                                     "point robot: C-obstacles are the obstacles"))
+            return list(self.obstacle_pieces), self.obstacle_of
+        from .minkowski import minkowski_sum, reflect
+
+        neg = [reflect(r) for r in self.robot_pieces]
+        out, owner = [], []
+        for p, o in zip(self.obstacle_pieces, self.obstacle_of):
+            for r in neg:
+                out.append(minkowski_sum(p, r))
+                owner.append(o)
+        self.stages.append(Stage("minkowski", True, time.perf_counter() - t,
+                                 {"pairs": len(out), "robot_pieces": len(neg)}))
+        return out, np.array(owner, dtype=np.int64)
+
+    def _prune(self, pieces, owner):
+        """Drop pieces that cannot meet the bounds, and pieces inside another piece."""
+        t = time.perf_counter()
+        xmin, xmax, ymin, ymax = self.bounds
+        before = len(pieces)
+        keep = [
+            k for k, p in enumerate(pieces)
+            if len(p) and p[:, 0].min() <= xmax and p[:, 0].max() >= xmin and p[:, 1].min() <= ymax and p[:, 1].max() >= ymin
+        ]
+        outside = before - len(keep)
+        pieces = [pieces[k] for k in keep]
+        owner = owner[keep] if len(owner) else owner
+        contained = _contained_pieces(pieces)
+        if contained:
+            mask = np.ones(len(pieces), dtype=bool)
+            mask[list(contained)] = False
+            pieces = [p for p, m in zip(pieces, mask) if m]
+            owner = owner[mask]
+        self.stages.append(Stage("prune", True, time.perf_counter() - t,
+                                 {"pieces_before": before, "outside_bounds": outside,
+                                  "inside_another": len(contained), "pieces_after": len(pieces)}))
+        return pieces, owner
+
+    # -- queries ---------------------------------------------------------------------
+
+    def in_bounds(self, x: float, y: float) -> bool:
+        xmin, xmax, ymin, ymax = self.bounds
+        return xmin <= x <= xmax and ymin <= y <= ymax
+
+    def is_free(self, q) -> bool:
+        """Is the reference point at q a valid state (in bounds, robot touching nothing)?"""
+        return self.is_free_xy(float(q[0]), float(q[1]))
+
+    def is_free_xy(self, x: float, y: float) -> bool:
+        """:meth:`is_free` on two floats: the validity checker's hot path."""
+        self.checks["points"] += 1
+        xmin, xmax, ymin, ymax = self.bounds
+        if not (xmin <= x <= xmax and ymin <= y <= ymax):
+            return False
+        cell = self.index.cell_of(x, y)
+        s = self._state[cell]
+        if s == FREE:
+            return True
+        if s == BLOCKED:
+            return False
+        self.checks["exact_points"] += 1
+        hits = self.packed.point_hits
+        for k in self.index.candidates(cell).tolist():
+            if hits(k, x, y):
+                return False
+        return True
+
+    def segment_free(self, a, b) -> bool:
+        """Is every state on the closed segment a-b valid? Exact: no sampling along it."""
+        ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+        self.checks["segments"] += 1
+        if not (self.in_bounds(ax, ay) and self.in_bounds(bx, by)):
+            return False  # the bounds box is convex: both ends inside => whole segment inside
+        cells = self.index.cells_on_segment(ax, ay, bx, by)
+        st = self.index.state[cells]
+        if not st.any():
+            return True
+        pa, pb = np.array([ax, ay]), np.array([bx, by])
+        blocked = cells[st == BLOCKED]
+        if blocked.size:
+            # A segment through a blocked cell almost always hits its blocker: test those first.
+            ks = np.unique(self.index.blocker[blocked])
+            if self.packed.segment_hits_many(ks, pa, pb).any():
+                return False
+        ks = self.index.candidates_of(cells[st == MIXED])
+        self.checks["exact_segments"] += 1
+        return not self.packed.segment_hits_many(ks, pa, pb).any()
+
+    def clearance(self, q) -> float:
+        """Distance from q to the nearest C-obstacle piece (0 when not free), via GJK.
+
+        Pieces are visited in order of their bounding-box distance, a lower bound,
+        and the search stops once that bound exceeds the best distance found.
+        """
+        x, y = float(q[0]), float(q[1])
+        if not self.is_free_xy(x, y) or not len(self.pieces):
+            return 0.0 if len(self.pieces) or not self.in_bounds(x, y) else float("inf")
+        from .gjk import gjk_distance
+
+        lb = self.packed.box_distance(x, y)
+        order = np.argsort(lb, kind="stable")
+        best = float("inf")
+        point = np.array([[x, y]])
+        for k in order.tolist():
+            if lb[k] >= best:
+                break
+            best = min(best, gjk_distance(self.pieces[k], point).distance)
+        return best
+
+    def report(self) -> dict:
+        """The stages that ran, with counts and times, and the query counters."""
+        return {
+            "stages": [s.as_dict() for s in self.stages],
+            "pieces": len(self.pieces),
+            "robot_pieces": len(self.robot_pieces),
+            "obstacle_pieces": len(self.obstacle_pieces),
+            "build_seconds": sum(s.seconds for s in self.stages),
+            "checks": dict(self.checks),
+        }
+
+
+def _contained_pieces(pieces: list[np.ndarray]) -> set[int]:
+    """Indices of convex pieces lying inside another piece (exact containment test).
+
+    Candidate pairs come from bounding-box containment; a convex piece P lies in a
+    convex piece Q iff every vertex of P is on or left of every edge of Q. Of two
+    identical pieces only the later one is removed.
+    """
+    n = len(pieces)
+    if n < 2:
+        return set()
+    lo = np.array([p.min(axis=0) for p in pieces])
+    hi = np.array([p.max(axis=0) for p in pieces])
+    order = np.argsort(lo[:, 0], kind="stable")
+    removed: set[int] = set()
+    lo_sorted = lo[order, 0]
+    for q in range(n):
+        if q in removed:
+            continue
+        # pieces whose box lies inside q's box
+        j0 = np.searchsorted(lo_sorted, lo[q, 0], side="left")
+        j1 = np.searchsorted(lo_sorted, hi[q, 0], side="right")
+        cand = order[j0:j1]
+        cand = cand[(cand != q) & (hi[cand, 0] <= hi[q, 0]) & (lo[cand, 1] >= lo[q, 1]) & (hi[cand, 1] <= hi[q, 1])]
+        if not cand.size:
+            continue
+        Q = pieces[q]
+        s, e = Q, np.roll(Q, -1, axis=0)
+        for p in cand.tolist():
+            if p in removed:
+                continue
+            P = pieces[p]
+            if P.shape == Q.shape and p < q and np.array_equal(P, Q):
+                continue  # identical: keep the earlier one, drop q when it is visited as p
+            sides = orient2d_many(s[None, :, :], e[None, :, :], P[:, None, :])
+            if (sides >= 0).all():
+                removed.add(p)
+    return removed
