@@ -1,0 +1,184 @@
+"""OMPL glue: the state space, the validity checker and motion validator over a C-space.
+
+This module owns everything that touches OMPL's objects. OMPL never sees geometry:
+the validity checker asks :meth:`cspace.CSpace.is_free_xy`, the motion validator asks
+the exact :meth:`cspace.CSpace.segment_free` (no sampling along the segment, so a thin
+obstacle cannot be tunnelled through), and the clearance goes through GJK.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+
+from cspace.scenario import ScenarioError
+
+_ompl = None
+
+
+def ompl():
+    """Import OMPL once, silence its logging, and return ``(base, geometric, util)``."""
+    global _ompl
+    if _ompl is None:
+        with _quiet_fd(2):
+            from ompl import base as ob
+            from ompl import geometric as og
+            from ompl import util as ou
+        ou.setLogLevel(ou.LOG_NONE)
+        _ompl = (ob, og, ou)
+    return _ompl
+
+
+@contextlib.contextmanager
+def _quiet_fd(fd: int):
+    """Send a file descriptor to /dev/null for the duration (C++ code writes to it directly)."""
+    try:
+        saved = os.dup(fd)
+    except OSError:  # pragma: no cover - no such descriptor
+        yield
+        return
+    try:
+        sys.stderr.flush()
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, fd)
+        os.close(devnull)
+        yield
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
+
+
+# Planners of ompl.geometric, by lower-case name. Anytime (optimising) planners keep
+# improving until their budget ends; the others stop at their first solution.
+PLANNERS = (
+    "RRT", "RRTConnect", "RRTstar", "InformedRRTstar", "SORRTstar", "BITstar", "AORRTC",
+    "PRM", "PRMstar", "FMT", "BFMT", "KPIECE1", "BKPIECE1", "LBKPIECE1",
+)
+ANYTIME = {"rrtstar", "informedrrtstar", "sorrtstar", "bitstar", "aorrtc", "prm", "prmstar"}
+DEFAULT_PLANNER = "RRTConnect"
+
+
+def planner_name(name: str | None, source: str = "<options>", field: str = "planner") -> str:
+    """Canonical spelling of a planner name (case-insensitive), or a ScenarioError.
+
+    >>> planner_name("rrtconnect")
+    'RRTConnect'
+    """
+    if name is None:
+        return DEFAULT_PLANNER
+    table = {p.lower(): p for p in PLANNERS}
+    table["exact"] = "exact"
+    canon = table.get(str(name).lower())
+    if canon is None:
+        raise ScenarioError(source, field, f"unknown planner {name!r} (choose from: exact, {', '.join(PLANNERS)})")
+    return canon
+
+
+def make_setup(cspace, planner: str, seed: int):
+    """A configured ``SimpleSetup`` over ``cspace`` with the named planner, seeded.
+
+    Returns ``(setup, space, checker, validator)``; keep the last two alive as long
+    as the setup is used (OMPL holds them by reference).
+    """
+    ob, og, ou = ompl()
+    # OMPL ignores seed 0, so user seeds map to seed + 1. Re-seeding before any
+    # RNG is created makes every plan with the same seed draw the same samples.
+    with _quiet_fd(2):
+        ou.RNG.setSeed(int(seed) + 1)
+    space = ob.RealVectorStateSpace(2)
+    xmin, xmax, ymin, ymax = cspace.bounds
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0, xmin)
+    bounds.setHigh(0, xmax)
+    bounds.setLow(1, ymin)
+    bounds.setHigh(1, ymax)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    checker = _checker_class()(si, cspace)
+    ss.setStateValidityChecker(checker)
+    validator = _validator_class()(si, cspace)
+    si.setMotionValidator(validator)
+    ss.setPlanner(getattr(og, planner)(si))
+    return ss, space, checker, validator
+
+
+_classes: dict = {}
+
+
+def _checker_class():
+    if "checker" not in _classes:
+        ob = ompl()[0]
+
+        class CSpaceValidityChecker(ob.StateValidityChecker):
+            """Validity = the reference point is a free state of the C-space."""
+
+            def __init__(self, si, cspace):
+                super().__init__(si)
+                self.is_free_xy = cspace.is_free_xy
+                self.cspace = cspace
+
+            def isValid(self, state):
+                return self.is_free_xy(state[0], state[1])
+
+            def clearance(self, state):
+                return self.cspace.clearance((state[0], state[1]))
+
+        _classes["checker"] = CSpaceValidityChecker
+    return _classes["checker"]
+
+
+def _validator_class():
+    if "validator" not in _classes:
+        ob = ompl()[0]
+
+        class ExactMotionValidator(ob.MotionValidator):
+            """A motion is valid iff the closed segment lies in the free C-space (exact)."""
+
+            def __init__(self, si, cspace):
+                super().__init__(si)
+                self.segment_free = cspace.segment_free
+
+            def checkMotion(self, s1, s2, *rest):
+                ok = self.segment_free((s1[0], s1[1]), (s2[0], s2[1]))
+                if rest and not ok:  # the (s1, s2, lastValid) form: report no progress
+                    with contextlib.suppress(Exception):
+                        rest[0].second = 0.0
+                return ok
+
+        _classes["validator"] = ExactMotionValidator
+    return _classes["validator"]
+
+
+def set_query(ss, space, start, goal) -> None:
+    """Set the start and goal states (goal reached only exactly: threshold 0)."""
+    s = space.allocState()
+    s[0], s[1] = float(start[0]), float(start[1])
+    g = space.allocState()
+    g[0], g[1] = float(goal[0]), float(goal[1])
+    ss.setStartAndGoalStates(s, g, 0.0)
+
+
+def termination(time_limit: float, iterations: int | None = None):
+    """Stop at the time limit, or after ``iterations`` planner iterations if given.
+
+    OMPL evaluates the condition once per planner iteration, so an iteration budget
+    is deterministic where a time budget is not (for anytime planners).
+    """
+    ob = ompl()[0]
+    timed = ob.timedPlannerTerminationCondition(float(time_limit))
+    if not iterations:
+        return timed, None
+    count = [0]
+
+    def spent() -> bool:
+        count[0] += 1
+        return count[0] > iterations
+
+    it = ob.PlannerTerminationCondition(spent)
+    return ob.plannerOrTerminationCondition(timed, it), it
+
+
+def path_states(path) -> list[tuple[float, float]]:
+    """States of an OMPL PathGeometric as (x, y) tuples."""
+    return [(s[0], s[1]) for s in path.getStates()]
