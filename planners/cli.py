@@ -4,7 +4,7 @@ Each subcommand lives in its own module, imported only when that subcommand runs
 so ``cspace plan`` never pays for matplotlib or the benchmark code. A module exposes
 ``register(subparsers)``, which adds its parser and sets ``run`` (``args -> exit code``).
 
-Exit codes: 0 success, 1 not solved (or a check failed), 2 bad input.
+Exit codes: 0 success, 1 not solved (or a check failed), 2 bad input, 3 internal error.
 """
 from __future__ import annotations
 
@@ -61,6 +61,11 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("interrupted\n")
         code = 130
+    except Exception as exc:  # a bug, not bad input: still one line unless --verbose
+        if getattr(args, "verbose", False):
+            raise
+        sys.stderr.write(f"internal error: {type(exc).__name__}: {exc} (run with --verbose for the traceback)\n")
+        code = 3
     return code
 
 

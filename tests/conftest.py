@@ -1,0 +1,23 @@
+"""Shared fixtures: scenario files written from TOML text, paths to bundled data."""
+from __future__ import annotations
+
+import os
+import textwrap
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PEER = os.path.join(os.path.dirname(ROOT), "shared", "peer-scenarios", "ompl")
+SCENARIOS = os.path.join(ROOT, "scenarios")
+
+
+@pytest.fixture
+def write_toml(tmp_path):
+    """write_toml(text, name="s.toml") -> path of a scenario file with that text."""
+
+    def _write(text: str, name: str = "s.toml") -> str:
+        p = tmp_path / name
+        p.write_text(textwrap.dedent(text))
+        return str(p)
+
+    return _write

@@ -1,0 +1,143 @@
+"""The scenario loader: what it accepts, and a one-line error naming file and field for each fault."""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+from cspace import ScenarioError, load_scenario
+from cspace.disk import disk_error
+from cspace.polygon import signed_area
+
+BASE = """
+name = "t"
+[bounds]
+xmin = 0
+xmax = 10
+ymin = 0
+ymax = 10
+[start]
+x = 1
+y = 1
+[goal]
+x = 9
+y = 9
+"""
+
+
+def test_minimal_scenario_is_a_point_robot(write_toml):
+    sc = load_scenario(write_toml(BASE))
+    assert sc.is_point_robot and sc.robot_kind == "point"
+    assert sc.bounds == (0.0, 10.0, 0.0, 10.0)
+    assert sc.start == (1.0, 1.0) and sc.goal == (9.0, 9.0)
+
+
+def test_polygons_are_normalised_to_ccw_with_collinear_vertices_dropped(write_toml):
+    sc = load_scenario(write_toml(BASE + """
+[[obstacles]]
+polygon = [[4, 4], [4, 6], [5, 6], [6, 6], [6, 4]]
+"""))
+    p = sc.obstacles[0].polygon
+    assert signed_area(p) > 0 and len(p) == 4 and sc.obstacles[0].convex
+
+
+def test_disks_become_containing_polygons_within_the_tolerance(write_toml):
+    sc = load_scenario(write_toml("disk_tolerance = 1e-4\n" + BASE + """
+[[obstacles]]
+center = [5, 5]
+radius = 2
+"""))
+    ob = sc.obstacles[0]
+    d = np.hypot(ob.polygon[:, 0] - 5, ob.polygon[:, 1] - 5)
+    n = len(ob.polygon)
+    # every vertex at the circumradius, so the polygon contains the disk; error within tolerance
+    assert np.all(d >= 2 / math.cos(math.pi / n) * (1 - 1e-15))
+    assert disk_error(2, n) <= 1e-4 * 2
+    assert ob.disk == (5.0, 5.0, 2.0)
+
+
+def test_theta_rotates_the_robot_and_goal_theta_must_match(write_toml):
+    text = BASE.replace("y = 1\n[goal]", "y = 1\ntheta = 1.5707963267948966\n[goal]") + """
+[robot]
+polygon = [[0, 0], [2, 0], [2, 0.5], [0, 0.5]]
+"""
+    sc = load_scenario(write_toml(text))
+    p = sc.robot[0].polygon
+    # a quarter turn CCW maps the long x-extent onto y
+    assert np.ptp(p[:, 1]) == pytest.approx(2.0) and np.ptp(p[:, 0]) == pytest.approx(0.5)
+    bad = text.replace("y = 9\n", "y = 9\ntheta = 0.5\n", 1)
+    with pytest.raises(ScenarioError, match="goal.theta"):
+        load_scenario(write_toml(bad, "bad.toml"))
+
+
+def test_queries_are_read(write_toml):
+    sc = load_scenario(write_toml(BASE + """
+[[queries]]
+start = [2, 2]
+goal = [8, 8]
+[[queries]]
+start = {x = 3, y = 3}
+goal = {x = 7, y = 7}
+"""))
+    assert [q.start for q in sc.queries] == [(2.0, 2.0), (3.0, 3.0)]
+    assert len(sc.all_queries()) == 3
+
+
+def test_peer_scenarios_load():
+    from conftest import PEER
+
+    for f in sorted(os.listdir(PEER)):
+        if f.endswith(".toml"):
+            sc = load_scenario(os.path.join(PEER, f))
+            assert sc.is_point_robot
+
+
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda t: t.replace("xmax = 10", 'xmax = "10"'), "bounds.xmax"),
+        (lambda t: t.replace("xmax = 10\n", ""), "bounds.xmax"),
+        (lambda t: t.replace("xmax = 10", "xmax = nan"), "bounds.xmax"),
+        (lambda t: t.replace("ymax = 10", "ymax = inf"), "bounds.ymax"),
+        (lambda t: t.replace("xmax = 10", "xmax = 0"), "bounds"),
+        (lambda t: t.replace("x = 1\n", "x = -1\n", 1), "start"),
+        (lambda t: t.replace("y = 9", "y = 11"), "goal"),
+        (lambda t: t.replace("[goal]\nx = 9\ny = 9\n", ""), "goal"),
+        (lambda t: t.replace("x = 1\n", "x = true\n", 1), "start.x"),
+        (lambda t: t + "[[obstacles]]\npolygon = [[1, 1], [2, 2], [1, 1]]\n", "obstacles[0].polygon"),
+        (lambda t: t + "[[obstacles]]\npolygon = [[3, 3], [5, 5], [5, 3], [3, 5]]\n", "obstacles[0].polygon"),
+        (lambda t: t + "[[obstacles]]\npolygon = [[3, 3], [4, 4], [5, 5]]\n", "obstacles[0].polygon"),
+        (lambda t: t + "[[obstacles]]\npolygon = [[0, 0], [2, 0], [2, 2], [0, 2]]\n", "start"),
+        (lambda t: t + "[[obstacles]]\ncenter = [9, 9]\nradius = 0.5\n", "goal"),
+        (lambda t: t + "[[obstacles]]\ncenter = [5, 5]\nradius = -1\n", "obstacles[0].radius"),
+        (lambda t: t + "[robot]\npolygon = [[0, 0], [1, 0]]\n", "robot.polygon"),
+        (lambda t: t + "[planner]\ntime = 0\n", "planner.time"),
+        (lambda t: t + "[planner]\nseed = -3\n", "planner.seed"),
+        (lambda t: "colour = 3\n" + t, "colour"),
+        (lambda t: t + "[[obstacles]]\npolygon = [[2, 2], [8, 2], [8, 8], [2, 8]]\n"
+                       "holes = [[[1, 1], [3, 1], [3, 3], [1, 3]]]\n", "obstacles[0].holes"),
+        (lambda t: t.replace("[bounds]", "[bounds\n"), "toml"),
+    ],
+)
+def test_each_fault_names_the_file_and_the_field(write_toml, edit, field):
+    path = write_toml(edit(BASE))
+    with pytest.raises(ScenarioError) as exc:
+        load_scenario(path)
+    err = exc.value
+    assert err.field == field
+    assert str(err).startswith(f"{path}: {field}: ")
+    assert "\n" not in str(err)
+
+
+def test_unreadable_file(tmp_path):
+    with pytest.raises(ScenarioError, match="file: cannot read"):
+        load_scenario(tmp_path / "missing.toml")
+
+
+def test_loading_does_not_modify_the_file(write_toml):
+    path = write_toml(BASE + "[[obstacles]]\npolygon = [[6, 6], [4, 6], [4, 4], [6, 4]]\n")
+    before = open(path, "rb").read()
+    load_scenario(path)
+    assert open(path, "rb").read() == before
