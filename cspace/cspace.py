@@ -17,6 +17,7 @@ Only the stages a scene needs run, and each is recorded with its cost:
 """
 from __future__ import annotations
 
+import itertools
 import os
 import time
 from dataclasses import dataclass, field
@@ -74,9 +75,9 @@ class CSpace:
         self.packed = PieceSet(self.pieces)
         self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells)
         self.stages.append(Stage("index", True, time.perf_counter() - t, self.index.stats()))
-        self._state = self.index.state_list
-        self._blocker = self.index.blocker_list
         self.checks = {"points": 0, "segments": 0, "exact_points": 0, "exact_segments": 0}
+        self._points = itertools.count()
+        self.is_free_xy = self.point_test(self._points.__next__)
 
     # -- construction --------------------------------------------------------------
 
@@ -201,14 +202,55 @@ class CSpace:
         """Is the reference point at q a valid state (in bounds, robot touching nothing)?"""
         return self.is_free_xy(float(q[0]), float(q[1]))
 
-    def is_free_xy(self, x: float, y: float) -> bool:
-        """:meth:`is_free` on two floats: the validity checker's hot path."""
-        self.checks["points"] += 1
+    def point_test(self, tick=None):
+        """A fast ``(x, y) -> bool`` free-state test: the validity checker's hot path.
+
+        The grid answers FREE and BLOCKED cells with a few float operations; MIXED
+        cells, the bounds' edges and anything outside go to :meth:`_is_free_exact`.
+        The cell index is computed as ``x * (1 / cell width) - offset``: its rounding
+        error (a few ulps of |x|) is far below the classification margin, so a
+        point is never answered from a cell it is not within the margin of.
+        ``tick``, if given, is called once per query (a counter).
+        """
+        idx = self.index
+        iw, ih = idx.inv_w, idx.inv_h
+        a0, b0 = idx.x0 * iw, idx.y0 * ih
+        nx = idx.nx
+        # Rows padded with a MIXED sentinel column and row, so an index one past the
+        # end falls back to the exact path instead of raising.
+        rows = [idx.state[r * nx:(r + 1) * nx].tolist() + [1] for r in range(idx.ny)] + [[1] * (nx + 1)]
+        exact = self._is_free_exact
+
+        def is_free_xy(x: float, y: float) -> bool:
+            if tick is not None:
+                tick()
+            i = x * iw - a0
+            j = y * ih - b0
+            if i >= 0.0 and j >= 0.0:
+                try:
+                    c = rows[int(j)][int(i)]
+                except IndexError:
+                    return exact(x, y)
+                if c == 0:
+                    return True
+                if c == 2:
+                    return False
+            return exact(x, y)
+
+        return is_free_xy
+
+    def point_count(self) -> int:
+        """Point queries answered so far."""
+        n = self._points.__reduce__()[1][0]
+        return int(n)
+
+    def _is_free_exact(self, x: float, y: float) -> bool:
+        """Bounds check, then the exact test against the cell's candidate pieces."""
         xmin, xmax, ymin, ymax = self.bounds
         if not (xmin <= x <= xmax and ymin <= y <= ymax):
             return False
         cell = self.index.cell_of(x, y)
-        s = self._state[cell]
+        s = self.index.state_list[cell]
         if s == FREE:
             return True
         if s == BLOCKED:
@@ -264,6 +306,7 @@ class CSpace:
 
     def report(self) -> dict:
         """The stages that ran, with counts and times, and the query counters."""
+        self.checks["points"] = self.point_count()
         return {
             "stages": [s.as_dict() for s in self.stages],
             "pieces": len(self.pieces),

@@ -138,8 +138,8 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         r.cspace_report = report
     first = results[0]
     first.timings["total"] = load_s + (_now() - wall0)
-    first.checks = {**first.checks, **{f"cspace_{k}": v for k, v in cspace.checks.items()}}
     first.cspace_report = cspace.report()
+    first.checks = {**first.checks, **{f"cspace_{k}": v for k, v in cspace.checks.items()}}
     if all_queries:
         first.queries = results
     first.scenario_data, first.cspace = sc, cspace
@@ -166,7 +166,7 @@ def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> l
             else:
                 ss.clear()
         set_query(ss, space, q.start, q.goal)
-        before = dict(cspace.checks)
+        before = {"points": cspace.point_count(), "segments": cspace.checks["segments"]}
         t1 = _now()
         ptc, _keep = termination(tlim, iterations)
         status = ss.solve(ptc)
@@ -182,7 +182,7 @@ def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> l
         t3 = _now()
         verified, message = _verify(cspace, path, q) if exact_sol else (False, str(status))
         verify_s = _now() - t3
-        after = cspace.checks
+        after = {"points": cspace.point_count(), "segments": cspace.checks["segments"]}
         out.append(PlanResult(
             scenario=sc.name, solved=verified, exact=verified, path=path if verified else np.zeros((0, 2)),
             length=path_length(path) if verified else math.inf, planner=name, seed=seed,
