@@ -42,8 +42,12 @@ class PlanResult:
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
 
-    def as_dict(self) -> dict:
-        """The JSON form (the ``--json`` output of ``cspace plan``)."""
+    def as_dict(self, nested: bool = True) -> dict:
+        """The JSON form (the ``--json`` output of ``cspace plan``).
+
+        With ``queries``, the top level describes the first query and ``queries``
+        holds one entry per query with the fields of a single plan.
+        """
         d = {
             "scenario": self.scenario,
             "solved": self.solved,
@@ -60,10 +64,10 @@ class PlanResult:
             "stages": self.stages,
             "message": self.message,
         }
-        if self.cspace_report is not None:
+        if nested and self.cspace_report is not None:
             d["cspace"] = self.cspace_report
-        if self.queries is not None:
-            d["queries"] = [q.as_dict() for q in self.queries]
+        if nested and self.queries is not None:
+            d["queries"] = [q.as_dict(nested=False) for q in self.queries]
         return d
 
 
