@@ -168,17 +168,21 @@ class GridIndex:
         if i1 < i0:
             return np.zeros(0, dtype=np.int64)
         cols = np.arange(i0, i1 + 1)
-        # x-interval of each column intersected with the segment's x-range
-        lo = np.maximum(self.x0 + cols * self.cw, xlo)
-        hi = np.minimum(self.x0 + (cols + 1) * self.cw, xhi)
+        # x-interval of each column, widened by the margin, intersected with the
+        # segment's x-range. Widening makes the y-range below grow by m |slope|,
+        # which dominates the rounding of the column boundary times the slope, so
+        # even near-vertical segments keep a conservative row range.
+        lo = np.maximum(self.x0 + cols * self.cw - m, xlo)
+        hi = np.minimum(self.x0 + (cols + 1) * self.cw + m, xhi)
+        ylo_seg, yhi_seg = min(ay, by), max(ay, by)
         if bx != ax:
             t = (ay - by) / (ax - bx)
             ylo_x, yhi_x = ay + (lo - ax) * t, ay + (hi - ax) * t
-            y_lo = np.minimum(ylo_x, yhi_x)
-            y_hi = np.maximum(ylo_x, yhi_x)
+            y_lo = np.maximum(np.minimum(ylo_x, yhi_x), ylo_seg)
+            y_hi = np.minimum(np.maximum(ylo_x, yhi_x), yhi_seg)
         else:
-            y_lo = np.full(cols.size, min(ay, by))
-            y_hi = np.full(cols.size, max(ay, by))
+            y_lo = np.full(cols.size, ylo_seg)
+            y_hi = np.full(cols.size, yhi_seg)
         r0 = np.clip(np.floor((y_lo - m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
         r1 = np.clip(np.floor((y_hi + m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
         counts = r1 - r0 + 1
