@@ -88,6 +88,13 @@ class GridIndex:
         # Plain Python copies for the scalar hot path (list indexing beats numpy scalars).
         self.state_list = state.tolist()
         self.blocker_list = blocker.tolist()
+        self._cand_list = cp.tolist()
+        self._starts_list = starts.tolist()
+        # Summed-area table of non-FREE cells: the count in any block of cells in O(1).
+        busy = (state != FREE).reshape(ny, nx).astype(np.int64)
+        sat = np.zeros((ny + 1, nx + 1), dtype=np.int64)
+        sat[1:, 1:] = busy.cumsum(axis=0).cumsum(axis=1)
+        self._sat = sat.tolist()
 
     # -- build -------------------------------------------------------------------
 
@@ -154,6 +161,58 @@ class GridIndex:
             return np.zeros(0, dtype=np.int64)
         idx = np.repeat(s - (np.cumsum(counts) - counts), counts) + np.arange(total)
         return np.unique(self._cand[idx])
+
+    def segment_candidates(self, ax: float, ay: float, bx: float, by: float, on_blocker=None):
+        """Pieces the closed segment a-b may meet: ``(blockers, candidates)`` as sets.
+
+        The segment is halved recursively; a piece of it whose cell bounding box
+        (widened by the margin) holds no non-FREE cell is free and dropped, in O(1)
+        through the summed-area table. Pieces of at most 2 x 2 cells are leaves:
+        their BLOCKED cells contribute their blocking piece, their MIXED cells their
+        candidate pieces. The caller tests the original segment exactly against
+        both sets, so the halving only has to be conservative, never exact.
+        ``on_blocker(k)``, if given, is called on each new blocking piece as soon as
+        it is found (nearest ``a`` first); when it returns True the walk stops and
+        ``None`` is returned (the caller found a hit).
+        """
+        m, x0, y0, iw, ih = self.margin, self.x0, self.y0, self.inv_w, self.inv_h
+        nx1, ny1 = self.nx - 1, self.ny - 1
+        sat, state, nx = self._sat, self.state_list, self.nx
+        blockers: set[int] = set()
+        cands: set[int] = set()
+        stack = [(ax, ay, bx, by)]
+        while stack:
+            px, py, qx, qy = stack.pop()
+            i0 = int(math.floor(((px if px < qx else qx) - m - x0) * iw))
+            i1 = int(math.floor(((qx if px < qx else px) + m - x0) * iw))
+            j0 = int(math.floor(((py if py < qy else qy) - m - y0) * ih))
+            j1 = int(math.floor(((qy if py < qy else py) + m - y0) * ih))
+            i0 = 0 if i0 < 0 else i0
+            j0 = 0 if j0 < 0 else j0
+            i1 = nx1 if i1 > nx1 else i1
+            j1 = ny1 if j1 > ny1 else j1
+            if i1 < i0 or j1 < j0:
+                continue
+            if sat[j1 + 1][i1 + 1] - sat[j0][i1 + 1] - sat[j1 + 1][i0] + sat[j0][i0] == 0:
+                continue  # every cell near this piece of the segment is FREE
+            if (i1 - i0) < 2 and (j1 - j0) < 2:
+                for j in range(j0, j1 + 1):
+                    for i in range(i0, i1 + 1):
+                        c = j * nx + i
+                        st = state[c]
+                        if st == BLOCKED:
+                            k = self.blocker_list[c]
+                            if k not in blockers:
+                                blockers.add(k)
+                                if on_blocker is not None and on_blocker(k):
+                                    return None
+                        elif st == MIXED:
+                            cands.update(self._cand_list[self._starts_list[c]:self._starts_list[c + 1]])
+                continue
+            mx, my = 0.5 * (px + qx), 0.5 * (py + qy)
+            stack.append((mx, my, qx, qy))
+            stack.append((px, py, mx, my))
+        return blockers, cands
 
     def cells_on_segment(self, ax: float, ay: float, bx: float, by: float) -> np.ndarray:
         """Every cell the closed segment a-b may meet (a conservative supercover).

@@ -69,25 +69,16 @@ class PieceSet:
         idx = first + (np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts))
         s, e = self.start[idx], self.end[idx]
         ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
-        n = idx.size
-        # One exact call decides three families of sides:
-        #   rows [0, n):   a against each edge line of the piece
-        #   rows [n, 2n):  b against each edge line
-        #   rows [2n, 3n): each vertex of the piece against the segment's line
         sx, sy, ex, ey = s[:, 0], s[:, 1], e[:, 0], e[:, 1]
-        sides = orient2d_cols(
-            np.concatenate([sx, sx, np.full(n, ax)]), np.concatenate([sy, sy, np.full(n, ay)]),
-            np.concatenate([ex, ex, np.full(n, bx)]), np.concatenate([ey, ey, np.full(n, by)]),
-            np.concatenate([np.full(n, ax), np.full(n, bx), sx]),
-            np.concatenate([np.full(n, ay), np.full(n, by), sy]),
-        )
-        oa, ob, side = sides[:n], sides[n : 2 * n], sides[2 * n :]
         seg_start = np.cumsum(counts) - counts
-        # Axis 1: an edge of the piece with both endpoints strictly outside it.
+        # Axis 1: an edge of the piece with both segment ends strictly outside it.
+        oa = orient2d_cols(sx, sy, ex, ey, ax, ay)
+        ob = orient2d_cols(sx, sy, ex, ey, bx, by)
         edge_sep = np.logical_or.reduceat((oa < 0) & (ob < 0), seg_start)
         if ax == bx and ay == by:
             return ~edge_sep  # a point: the piece's edges are the only axes
         # Axis 2: the segment's own line with every vertex of the piece strictly on one side.
+        side = orient2d_cols(ax, ay, bx, by, sx, sy)
         line_sep = np.logical_and.reduceat(side > 0, seg_start) | np.logical_and.reduceat(side < 0, seg_start)
         return ~(edge_sep | line_sep)
 
