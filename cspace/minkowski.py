@@ -1,0 +1,503 @@
+"""Minkowski sums of convex polygons by the angular merge, and reflection.
+
+The sum of convex polygons P_1 ⊕ ... ⊕ P_k is the convex polygon whose edge
+sequence is the merge of the operands' edge sequences by polar angle (foundations
+note, section on the merge). Start at the sum of the operands' lowest-then-leftmost
+vertices, which is the sum's lowest-then-leftmost vertex; then walk the edges in
+angle order. Each vertex of the sum is the sum of one vertex per operand.
+
+Angles are compared exactly: first by half-plane (the upper half [0, pi) versus the
+lower half [pi, 2 pi), decided by the signs of the edge's coordinates, which float
+subtraction preserves), then by the exact sign of the cross product of the two
+edge vectors (:func:`cspace.predicates.cross_diff_sign`). Parallel edges of equal
+direction are fused, so the sum has no collinear vertex and at most sum(n_i)
+vertices. Integer input (|x| < 2^52) gives the exact integer sum. Float input gives
+each vertex as a sum of input vertices rounded once per addition; if that rounding
+makes a turn non-convex, the exact hull of the rounded vertices is returned, so the
+output is always strictly convex by the exact test.
+
+Two code paths, one semantics: a scalar merge for the small polygons of C-space
+pieces, and a vectorised one for large inputs (a stable sort of pseudo-angle keys,
+whose order is then certified pair by pair with the exact comparison; any doubt
+falls back to the scalar merge).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
+from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign
+
+# Up to this many vertices in total the scalar merge is faster than numpy's overhead.
+_SCALAR_MAX = 96
+
+
+def reflect(polygon) -> np.ndarray:
+    """The reflection −P = {−p : p ∈ P}, CCW and lowest-first like its input.
+
+    Reflection through the origin is a rotation by pi, so orientation is kept.
+
+    >>> reflect([[0, 0], [2, 0], [0, 1]]).tolist()
+    [[0.0, -1.0], [0.0, 0.0], [-2.0, 0.0]]
+    """
+    p = as_array(polygon)
+    return lowest_first(-p + 0.0)  # + 0.0 turns -0.0 into 0.0
+
+
+def minkowski_sum(P, Q, *more) -> np.ndarray:
+    """P ⊕ Q (⊕ more...) of convex polygons, by one angular merge of all their edges.
+
+    Operands may be in either orientation and may be degenerate (a point, a segment);
+    they may carry repeated or collinear vertices. A non-convex operand raises
+    ``ValueError``. The result is CCW from its lowest-then-leftmost vertex, with no
+    collinear vertices.
+
+    >>> minkowski_sum([[0, 0], [2, 0], [0, 2]], [[0, 0], [1, 0], [1, 1], [0, 1]]).tolist()
+    [[0.0, 0.0], [3.0, 0.0], [3.0, 1.0], [1.0, 3.0], [0.0, 3.0]]
+    """
+    ops = [as_array(x) for x in (P, Q) + more]
+    if sum(len(o) for o in ops) <= _SCALAR_MAX:
+        polys = [_clean_small(o.tolist()) for o in ops]
+        if len(polys) == 2:
+            out, exact = _merge2_small(polys[0], polys[1])
+            if exact:  # the exact sum, strictly convex by the exact merge
+                return np.array(out, dtype=np.float64)
+        else:
+            out = _merge_small(polys)
+        return np.array(_certify_small(out), dtype=np.float64)
+    polys = [_clean_convex(o) for o in ops]
+    out = _merge_vectorised(polys)
+    if out is None:  # the float pre-sort could not be certified: exact scalar merge
+        out = np.array(_certify_small(_merge_small([_clean_small(p.tolist()) for p in polys])))
+    return out
+
+
+# ---------------------------------------------------------------- exact turn of two edge vectors
+
+
+def _turn(ux: float, uy: float, vx: float, vy: float, a, b, c, d) -> int:
+    """Sign of (b - a) x (d - c), given the float edges u = b - a and v = d - c.
+
+    The stage-A filter on the already-rounded differences; the exact product of the
+    endpoints' rationals when it cannot decide.
+    """
+    left = ux * vy
+    right = uy * vx
+    det = left - right
+    bound = CCW_ERRBOUND_A * (abs(left) + abs(right))
+    if det > bound and bound > 1e-280:
+        return 1
+    if -det > bound and bound > 1e-280:
+        return -1
+    return cross_diff_sign(a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1])
+
+
+# ---------------------------------------------------------------- operands
+
+
+def _clean_small(pts: list) -> list:
+    """CCW, lowest-first, no repeated or collinear vertex; checks convexity (scalar).
+
+    One pass computes each vertex's turn as the cross product of its two edges (the
+    stage-A filter inline, rationals only in doubt) and the lowest vertex.
+    """
+    out = [(p[0], p[1]) for i, p in enumerate(pts) if p != pts[i - 1]] or [tuple(pts[0])]
+    n = len(out)
+    if n <= 2:
+        return _extremes(out)
+    pos = neg = 0
+    px, py = out[-1]
+    qx, qy = out[0]
+    ux, uy = qx - px, qy - py
+    low = 0
+    for i in range(n):
+        rx, ry = out[i + 1] if i + 1 < n else out[0]
+        vx, vy = rx - qx, ry - qy
+        left, right = ux * vy, uy * vx
+        det = left - right
+        bound = CCW_ERRBOUND_A * (abs(left) + abs(right))
+        if bound > 1e-280 and det > bound:
+            pos += 1
+        elif bound > 1e-280 and -det > bound:
+            neg += 1
+        else:
+            t = cross_diff_sign(px, py, qx, qy, qx, qy, rx, ry)
+            if t == 0:  # a collinear vertex: drop it exactly (rare), then start again
+                p = drop_collinear(np.array(out, dtype=np.float64))
+                return _clean_small(p.tolist()) if len(p) >= 3 else _extremes(out)
+            pos += t > 0
+            neg += t < 0
+        if qy < out[low][1] or (qy == out[low][1] and qx < out[low][0]):
+            low = i
+        px, py, qx, qy, ux, uy = qx, qy, rx, ry, vx, vy
+    if pos and neg:
+        raise ValueError("minkowski_sum: operand is not convex")
+    if neg:
+        out.reverse()
+        low = n - 1 - low
+    out = out[low:] + out[:low]
+    # All turns left: convex iff the edges sweep the angle once, i.e. from the lowest
+    # vertex their half-planes read upper...upper then lower...lower (a pentagram
+    # returns to the upper half).
+    seen_lower = False
+    for i in range(n):
+        (ax, ay), (bx, by) = out[i], out[(i + 1) % n]
+        lower = by < ay or (by == ay and bx <= ax)
+        if seen_lower and not lower:
+            raise ValueError("minkowski_sum: operand is not convex (winds more than once)")
+        seen_lower = lower
+    return out
+
+
+def _extremes(pts: list) -> list:
+    """A point or a segment, as its one or two extreme points, lowest (then leftmost) first."""
+    lo = min(pts, key=lambda v: (v[1], v[0]))
+    hi = max(pts, key=lambda v: (v[1], v[0]))
+    return [lo] if lo == hi else [lo, hi]
+
+
+def _lowest_index(p: np.ndarray) -> int:
+    """Index of the lowest-then-leftmost vertex (no full lexsort)."""
+    y = p[:, 1]
+    cand = np.flatnonzero(y == y.min())
+    return int(cand[np.argmin(p[cand, 0])]) if len(cand) > 1 else int(cand[0])
+
+
+def _clean_convex(p: np.ndarray) -> np.ndarray:
+    """Vectorised :func:`_clean_small` for large operands."""
+    if len(p) >= 2:
+        nxt = np.roll(p, -1, axis=0)
+        if ((nxt[:, 0] == p[:, 0]) & (nxt[:, 1] == p[:, 1])).any():
+            p = drop_repeats(p)
+            nxt = np.roll(p, -1, axis=0)
+    if len(p) < 3:
+        return np.array(_extremes([tuple(v) for v in p.tolist()]), dtype=np.float64)
+    e = nxt - p
+    ep = np.roll(e, 1, axis=0)
+    turn = _turns_cols(ep[:, 0], ep[:, 1], e[:, 0], e[:, 1], np.roll(p, 1, axis=0), p, p, nxt)
+    if not turn.all():
+        q = drop_collinear(p)
+        if len(q) < 3:
+            return np.array(_extremes([tuple(v) for v in p.tolist()]), dtype=np.float64)
+        return _clean_convex(q)
+    pos = turn[0] > 0
+    if (turn < 0).any() if pos else (turn > 0).any():
+        raise ValueError("minkowski_sum: operand is not convex")
+    if not pos:
+        p = p[::-1]
+    k = _lowest_index(p)
+    if k:
+        p = np.roll(p, -k, axis=0)
+    return np.ascontiguousarray(p)
+
+
+def _turns_cols(ux, uy, vx, vy, a, b, c, d) -> np.ndarray:
+    """Vectorised :func:`_turn`: exact signs of u x v for float edges u = b - a, v = d - c."""
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+        left = ux * vy
+        right = uy * vx
+        det = left - right
+        bound = CCW_ERRBOUND_A * (np.abs(left) + np.abs(right))
+        ok = (bound > 1e-280) & (bound < np.inf)
+        sign = (ok & (det > bound)).astype(np.int8) - (ok & (-det > bound)).astype(np.int8)
+    doubt = np.flatnonzero(sign == 0)
+    if len(doubt):
+        sign[doubt] = cross_diff_cols(a[doubt, 0], a[doubt, 1], b[doubt, 0], b[doubt, 1],
+                                      c[doubt, 0], c[doubt, 1], d[doubt, 0], d[doubt, 1])
+    return sign
+
+
+def _half(dx: float, dy: float) -> int:
+    """0 for directions in [0, pi) (upper half-plane), 1 for [pi, 2 pi)."""
+    return 0 if dy > 0.0 or (dy == 0.0 and dx > 0.0) else 1
+
+
+def _halves(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    return ((dy < 0.0) | ((dy == 0.0) & (dx <= 0.0))).view(np.int8)
+
+
+# ---------------------------------------------------------------- merges
+
+
+def _merge2_small(P: list, Q: list) -> list:
+    """The two-operand merge: two pointers, exact comparison, parallel edges fused.
+
+    Returns the vertices and whether every vertex sum was exact (Fast2Sum test:
+    fl(s - a) == b and fl(s - b) == a hold together only for an exact sum).
+    """
+    n, m = len(P), len(Q)
+    ne = n if n > 1 else 0
+    me = m if m > 1 else 0
+    i = j = 0
+    (ax, ay), (cx, cy) = P[0], Q[0]
+    sx, sy = ax + cx, ay + cy
+    exact = sx - ax == cx and sx - cx == ax and sy - ay == cy and sy - cy == ay
+    out = [(sx, sy)]
+    while i < ne or j < me:
+        if i < ne and j < me:
+            a, b = P[i], P[(i + 1) % n]
+            c, d = Q[j], Q[(j + 1) % m]
+            ux, uy, vx, vy = b[0] - a[0], b[1] - a[1], d[0] - c[0], d[1] - c[1]
+            hu = 0 if uy > 0.0 or (uy == 0.0 and ux > 0.0) else 1
+            hv = 0 if vy > 0.0 or (vy == 0.0 and vx > 0.0) else 1
+            s = hv - hu if hu != hv else _turn(ux, uy, vx, vy, a, b, c, d)
+            # s > 0: Q's edge comes later (P's first); s < 0: Q's first; 0: parallel.
+            if s >= 0:
+                i += 1
+            if s <= 0:
+                j += 1
+        elif i < ne:
+            i += 1
+        else:
+            j += 1
+        if i < ne or j < me:
+            (ax, ay), (cx, cy) = P[i % n], Q[j % m]
+            sx, sy = ax + cx, ay + cy
+            if exact:
+                exact = sx - ax == cx and sx - cx == ax and sy - ay == cy and sy - cy == ay
+            out.append((sx, sy))
+    return out, exact
+
+
+def _merge_small(polys: list) -> list:
+    """The k-way angular merge, one vertex of the sum per distinct edge direction.
+
+    ``idx[i]`` is the current vertex of operand i; the current vertex of the sum is
+    the sum of those. At each step the operands whose next edge has the smallest
+    angle (exactly equal angles tie) all advance together, which fuses parallel edges.
+    """
+    k = len(polys)
+    sizes = [len(p) for p in polys]
+    idx = [0] * k
+    out = [(sum(p[0][0] for p in polys), sum(p[0][1] for p in polys))]
+    total = sum(s if s > 1 else 0 for s in sizes)
+    taken = 0
+    while taken < total:
+        best: list = []
+        bh = 2
+        for i in range(k):
+            n = sizes[i]
+            if n < 2 or idx[i] == n:
+                continue
+            p = polys[i]
+            a, b = p[idx[i]], p[(idx[i] + 1) % n]
+            h = _half(b[0] - a[0], b[1] - a[1])
+            if h < bh:
+                bh, best = h, [(i, a, b)]
+            elif h == bh:
+                _, c, d = best[0]
+                s = cross_diff_sign(c[0], c[1], d[0], d[1], a[0], a[1], b[0], b[1])
+                if s < 0:      # edge a->b is clockwise of the current best: smaller angle
+                    best = [(i, a, b)]
+                elif s == 0:   # parallel, same half: the same direction
+                    best.append((i, a, b))
+        for i, _, _ in best:
+            idx[i] += 1
+            taken += 1
+        if taken < total:
+            out.append((sum(polys[i][idx[i] % sizes[i]][0] for i in range(k)),
+                        sum(polys[i][idx[i] % sizes[i]][1] for i in range(k))))
+    return out
+
+
+def _pseudo_angle(dx: np.ndarray, dy: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """A monotone stand-in for the polar angle in [0, 4), no trigonometry.
+
+    t = dx / (|dx| + |dy|) falls from 1 to -1 over the upper half and rises back over
+    the lower half; the key is only a pre-sort, certified afterwards exactly.
+    """
+    t = dx / (np.abs(dx) + np.abs(dy))
+    return np.where(half, 3.0 + t, 1.0 - t)
+
+
+def _merge_vectorised(polys: list) -> np.ndarray | None:
+    """Merge by a stable sort of pseudo-angles, then certify the order exactly.
+
+    Returns None if some adjacent pair is out of exact angular order (a pre-sort
+    misled by rounding): the caller then runs the exact scalar merge.
+    """
+    edged = [p for p in polys if len(p) >= 2]
+    start = np.sum([p[0] for p in polys], axis=0)
+    if not edged:
+        return start.reshape(1, 2)
+    xs = [np.ascontiguousarray(p[:, 0]) for p in edged]
+    ys = [np.ascontiguousarray(p[:, 1]) for p in edged]
+    ex = np.concatenate([_cyclic_diff(x) for x in xs])
+    ey = np.concatenate([_cyclic_diff(y) for y in ys])
+    half = _halves(ex, ey)
+    order = np.argsort(_pseudo_angle(ex, ey, half), kind="stable")
+    half = half[order]
+    if (half[:-1] > half[1:]).any():
+        return None
+    ux, uy = ex[order], ey[order]
+    # Certify each consecutive pair: u x v >= 0 exactly within a half.
+    left = ux[:-1] * uy[1:]
+    right = uy[:-1] * ux[1:]
+    det = left - right
+    bound = CCW_ERRBOUND_A * (np.abs(left) + np.abs(right))
+    same = half[:-1] == half[1:]
+    sure = (bound > 1e-280) & (bound < np.inf) & (np.abs(det) > bound)
+    if (same & sure & (det < 0)).any():
+        return None
+    fused = same & ~sure  # zero, or in doubt: decide exactly below
+    doubt = np.flatnonzero(fused)
+    if len(doubt):
+        sign = _error_free_signs(ux, uy, doubt)
+        exact_edge = np.concatenate([_diff_is_exact(x) & _diff_is_exact(y) for x, y in zip(xs, ys)])
+        sign[~(exact_edge[order[doubt]] & exact_edge[order[doubt + 1]])] = 2
+        rest = np.flatnonzero(sign == 2)
+        if len(rest):
+            ends = np.cumsum([0] + [len(p) for p in edged])
+            sign[rest] = [_exact_pair(edged, ends, order[doubt[r]], order[doubt[r] + 1]) for r in rest]
+        if (sign < 0).any():
+            return None
+        fused[doubt] = sign == 0  # parallel, same direction: no vertex between them
+    keep = np.flatnonzero(~fused)  # vertex after merged edge t (the last edge closes the cycle)
+    # Vertex after merged edge t: the sum over operands of the vertex each has reached.
+    vx = np.full(len(keep), start[0]) if len(edged) < len(polys) else np.zeros(len(keep))
+    vy = np.full(len(keep), start[1]) if len(edged) < len(polys) else np.zeros(len(keep))
+    if len(edged) < len(polys):  # point operands: their vertex is in every sum
+        vx -= sum(p[0, 0] for p in edged)
+        vy -= sum(p[0, 1] for p in edged)
+    lo = 0
+    for x, y in zip(xs, ys):
+        mine = (order >= lo) & (order < lo + len(x))
+        cnt = np.cumsum(mine)[keep] % len(x)
+        vx += x[cnt]
+        vy += y[cnt]
+        lo += len(x)
+    out = np.empty((len(keep) + 1, 2))
+    out[0] = start
+    out[1:, 0] = vx
+    out[1:, 1] = vy
+    return _certify_cols(out, exact=_sums_exact(polys))
+
+
+_SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitter
+
+
+def _error_free_signs(ux: np.ndarray, uy: np.ndarray, doubt: np.ndarray) -> np.ndarray:
+    """Exact signs of ux[t]*uy[t+1] - uy[t]*ux[t+1] where both products are exact.
+
+    Dekker's TwoProduct tells whether a float product was exact (its error term is
+    zero). When both products are exact, the one rounded subtraction keeps the true
+    sign. Returns 2 where this cannot certify (the caller goes to rationals). The
+    edges themselves must be exact differences, which holds for integer coordinates
+    below 2^52 and is checked by the caller's choice of route.
+    """
+    a, b = ux[doubt], uy[doubt + 1]
+    c, d = uy[doubt], ux[doubt + 1]
+    with np.errstate(over="ignore", invalid="ignore"):
+        left, right = a * b, c * d
+        ok = (_product_error(a, b, left) == 0) & (_product_error(c, d, right) == 0)
+        ok &= (np.abs(left) < 2.0**1000) & (np.abs(right) < 2.0**1000)
+        det = left - right
+    return np.where(ok, np.sign(det), 2).astype(np.int8)
+
+
+def _diff_is_exact(x: np.ndarray) -> np.ndarray:
+    """Whether each cyclic difference fl(x[i+1] - x[i]) is exact (Knuth's TwoSum error 0)."""
+    b = np.roll(x, -1)
+    na = -x
+    s = b + na
+    bv = s - b
+    av = s - bv
+    return ((b - av) + (na - bv)) == 0.0
+
+
+def _product_error(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Dekker's TwoProduct error term: a*b - fl(a*b), exactly (barring over/underflow)."""
+    t = _SPLIT * a
+    ah = t - (t - a)
+    al = a - ah
+    t = _SPLIT * b
+    bh = t - (t - b)
+    bl = b - bh
+    return ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+def _cyclic_diff(x: np.ndarray) -> np.ndarray:
+    d = np.empty_like(x)
+    np.subtract(x[1:], x[:-1], out=d[:-1])
+    d[-1] = x[0] - x[-1]
+    return d
+
+
+def _exact_pair(edged: list, ends: np.ndarray, s: int, t: int) -> int:
+    """Exact sign of edge s x edge t, edges numbered across the concatenated operands."""
+    def ends_of(g):
+        i = int(np.searchsorted(ends, g, side="right")) - 1
+        p = edged[i]
+        j = g - ends[i]
+        return p[j], p[(j + 1) % len(p)]
+    a, b = ends_of(int(s))
+    c, d = ends_of(int(t))
+    return cross_diff_sign(a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1])
+
+
+def _sums_exact(polys: list) -> bool:
+    """True when every vertex sum is exact: all coordinates integers below 2^52 / k."""
+    lim = 2.0**52 / max(len(polys), 1)
+    for p in polys:
+        if not (np.abs(p) < lim).all() or not (np.floor(p) == p).all():
+            return False
+    return True
+
+
+# ---------------------------------------------------------------- certification
+
+
+def _certify_small(out: list) -> list:
+    """Exact strict-convexity check of the rounded sum; repair by exact hull if needed."""
+    n = len(out)
+    if n < 3:  # a point or a segment, already lowest first
+        return out
+    for i in range(n):
+        a, b, c = out[i - 1], out[i], out[(i + 1) % n]
+        if _turn(b[0] - a[0], b[1] - a[1], c[0] - b[0], c[1] - b[1], a, b, b, c) <= 0:
+            from .hull import convex_hull
+
+            return convex_hull(out).tolist()
+    return out
+
+
+def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
+    """Vectorised :func:`_certify_small`; skipped when the sums were exact integers.
+
+    Rounded sums of a strictly convex polygon are still in angular order around its
+    interior, so a vertex whose exact turn is not left lies inside its neighbours'
+    chord and is removed (never two neighbours in one round, so each removal is
+    decided on vertices that stay); rounds repeat until every turn is left, which is
+    the hull of the rounded vertices (as a Graham scan of angularly sorted points).
+    """
+    if exact or len(out) < 3:
+        return out
+    for _ in range(len(out)):
+        nxt = np.roll(out, -1, axis=0)
+        e = nxt - out
+        ep = np.roll(e, 1, axis=0)
+        prev = np.roll(out, 1, axis=0)
+        turn = _turns_cols(ep[:, 0], ep[:, 1], e[:, 0], e[:, 1], prev, out, out, nxt)
+        bad = turn <= 0
+        if not bad.any():
+            break
+        drop = bad.copy()
+        drop[1:] &= ~bad[:-1]  # keep a bad vertex whose predecessor is being removed
+        if drop[0] and drop[-1]:
+            drop[-1] = False
+        out = out[~drop]
+        if len(out) < 3:
+            break
+    from .hull import convex_hull
+
+    if len(out) < 3 or _winds_more_than_once(out):
+        return convex_hull(out)
+    k = _lowest_index(out)
+    return np.roll(out, -k, axis=0) if k else out
+
+
+def _winds_more_than_once(p: np.ndarray) -> bool:
+    p = np.roll(p, -_lowest_index(p), axis=0)
+    e = np.roll(p, -1, axis=0) - p
+    h = _halves(e[:, 0], e[:, 1])
+    return bool((h[:-1] > h[1:]).any())
