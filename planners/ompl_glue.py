@@ -166,13 +166,16 @@ def _validator_class():
     return _classes["validator"]
 
 
+GOAL_THRESHOLD = 1e-9
+
+
 def set_query(ss, space, start, goal) -> None:
     """Set the start and goal states (goal reached only exactly: threshold 0)."""
     s = space.allocState()
     s[0], s[1] = float(start[0]), float(start[1])
     g = space.allocState()
     g[0], g[1] = float(goal[0]), float(goal[1])
-    ss.setStartAndGoalStates(s, g, 0.0)
+    ss.setStartAndGoalStates(s, g, GOAL_THRESHOLD)
 
 
 def termination(time_limit: float, iterations: int | None = None):

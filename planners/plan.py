@@ -176,13 +176,13 @@ def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> l
         status = ss.solve(ptc)
         solve_s = _now() - t1
         exact_sol = bool(status) and ss.haveExactSolutionPath()
-        raw = np.array(path_states(ss.getSolutionPath()), dtype=np.float64) if exact_sol else np.zeros((0, 2))
+        raw = _snap(path_states(ss.getSolutionPath()), q) if exact_sol else np.zeros((0, 2))
         length_raw = path_length(raw) if exact_sol else None
         t2 = _now()
         if exact_sol and simplify:
             ss.simplifySolution()
         simp_s = _now() - t2 if exact_sol and simplify else 0.0
-        path = np.array(path_states(ss.getSolutionPath()), dtype=np.float64) if exact_sol else np.zeros((0, 2))
+        path = _snap(path_states(ss.getSolutionPath()), q) if exact_sol else np.zeros((0, 2))
         t3 = _now()
         verified, message = _verify(cspace, path, q) if exact_sol else (False, str(status))
         verify_s = _now() - t3
@@ -199,6 +199,20 @@ def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> l
         if name.lower() in ANYTIME and iterations is None:
             out[-1].message += " (anytime planner: ran to its time limit)"
     return out
+
+
+def _snap(states, q) -> np.ndarray:
+    """The planner's path, ending exactly at the goal.
+
+    OMPL reports the goal reached within ``GOAL_THRESHOLD`` (1e-9; a threshold of 0
+    makes RRT miss a goal it has sampled); the last little step to the exact goal is
+    appended and, like every segment, verified exactly afterwards.
+    """
+    path = np.array(states, dtype=np.float64).reshape(-1, 2)
+    goal = np.array(q.goal, dtype=np.float64)
+    if len(path) and not (path[-1] == goal).all():
+        path = np.vstack([path, goal])
+    return path
 
 
 def _verify(cspace: CSpace, path: np.ndarray, q) -> tuple[bool, str]:

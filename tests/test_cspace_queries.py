@@ -1,0 +1,125 @@
+"""C-space point and segment queries against shapely on the workspace (an independent route).
+
+Oracle: the robot translated to q, as shapely polygons, intersects a closed obstacle.
+Random float states never land exactly on a boundary, so closed/open conventions
+do not matter for these samples.
+"""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+import shapely
+
+from cspace import load_scenario
+from cspace.cspace import CSpace
+from cspace.scenario import CollisionProbe
+
+from conftest import PEER, SCENARIOS
+
+
+def _robot_swept(sc, a, b):
+    """Workspace region swept by the robot translating from a to b (convex hull per part)."""
+    parts = []
+    for part in sc.robot:
+        pts = np.vstack([part.polygon + a, part.polygon + b])
+        parts.append(shapely.MultiPoint(pts).convex_hull)
+    return shapely.union_all(parts) if parts else shapely.LineString([a, b])
+
+
+def _scenes():
+    names = [os.path.join(PEER, f) for f in ("circles.toml", "env1.toml", "normal.toml")]
+    if os.path.isdir(SCENARIOS):
+        names += sorted(os.path.join(SCENARIOS, f) for f in os.listdir(SCENARIOS) if f.endswith(".toml"))
+    return names
+
+
+@pytest.mark.parametrize("path", _scenes(), ids=os.path.basename)
+def test_point_queries_agree_with_shapely(path):
+    sc = load_scenario(path)
+    if len(sc.obstacles) > 300:
+        pytest.skip("large scene: covered by the dedicated test")
+    cs = CSpace.from_scenario(sc)
+    probe = CollisionProbe(sc)
+    rng = np.random.default_rng(1)
+    xmin, xmax, ymin, ymax = sc.bounds
+    pts = rng.uniform([xmin, ymin], [xmax, ymax], size=(1500, 2))
+    ours = [cs.is_free_xy(x, y) for x, y in pts.tolist()]
+    ref = [probe.first_hit(x, y) is None for x, y in pts.tolist()]
+    assert ours == ref
+
+
+@pytest.mark.parametrize("path", _scenes(), ids=os.path.basename)
+def test_segment_queries_agree_with_shapely(path):
+    sc = load_scenario(path)
+    if len(sc.obstacles) > 300:
+        pytest.skip("large scene: covered by the dedicated test")
+    cs = CSpace.from_scenario(sc)
+    obstacles = shapely.union_all([o.to_shapely() for o in sc.obstacles])
+    shapely.prepare(obstacles)
+    rng = np.random.default_rng(2)
+    xmin, xmax, ymin, ymax = sc.bounds
+    a = rng.uniform([xmin, ymin], [xmax, ymax], size=(300, 2))
+    b = a + (rng.uniform([xmin, ymin], [xmax, ymax], size=(300, 2)) - a) * rng.uniform(0, 0.4, size=(300, 1))
+    for p, q in zip(a, b):
+        ref = not obstacles.intersects(_robot_swept(sc, p, q))
+        assert cs.segment_free(p, q) == ref, (p, q)
+
+
+def test_thin_obstacle_is_not_tunnelled():
+    # a wall 1e-9 thick: any sampling-based motion check at resolution 1e-3 would miss it
+    wall = np.array([[5.0, 0.0], [5.0 + 1e-9, 0.0], [5.0 + 1e-9, 10.0], [5.0, 10.0]])
+    cs = CSpace((0, 10, 0, 10), [wall])
+    assert cs.is_free((1, 5)) and cs.is_free((9, 5))
+    assert not cs.segment_free((1, 5), (9, 5))
+    assert cs.segment_free((1, 5), (4.9, 9))
+
+
+def test_touching_counts_as_collision_consistently():
+    sq = np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]])
+    cs = CSpace((0, 10, 0, 10), [sq])
+    assert not cs.is_free((6.0, 5.0))  # on the edge
+    assert not cs.is_free((4.0, 4.0))  # on a vertex
+    assert cs.is_free((6.0 + 2 ** -40, 5.0))
+    assert not cs.segment_free((6.0, 0.0), (6.0, 10.0))  # grazing along an edge
+    assert cs.segment_free((6.0 + 2 ** -40, 0.0), (6.0 + 2 ** -40, 10.0))
+
+
+def test_offset_scene_keeps_exact_answers():
+    # the same geometry shifted by 1e8: the answers must not change
+    sq = np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]])
+    off = 1e8
+    cs = CSpace((off, off + 10, off, off + 10), [sq + off])
+    assert not cs.is_free((off + 6.0, off + 5.0))
+    assert cs.is_free((off + 6.0 + 2e-8, off + 5.0))
+    assert not cs.segment_free((off + 1, off + 5), (off + 9, off + 5))
+
+
+def test_pruning_drops_outside_and_contained_pieces():
+    inside = np.array([[4.5, 4.5], [5.5, 4.5], [5.5, 5.5], [4.5, 5.5]])
+    big = np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]])
+    far = np.array([[40.0, 40.0], [41.0, 40.0], [41.0, 41.0]])
+    cs = CSpace((0, 10, 0, 10), [inside, big, far])
+    rep = {s["stage"]: s for s in cs.report()["stages"]}
+    assert rep["prune"]["outside_bounds"] == 1
+    assert rep["prune"]["inside_another"] == 1
+    assert len(cs.pieces) == 1
+    assert rep["minkowski"]["ran"] is False  # a point robot is not summed
+
+
+def test_clearance_matches_shapely_distance():
+    pytest.importorskip("cspace.gjk")
+    sc = load_scenario(os.path.join(PEER, "circles.toml"))
+    cs = CSpace.from_scenario(sc)
+    union = shapely.union_all([shapely.Polygon(p) for p in cs.pieces])
+    rng = np.random.default_rng(3)
+    xmin, xmax, ymin, ymax = sc.bounds
+    n = 0
+    for x, y in rng.uniform([xmin, ymin], [xmax, ymax], size=(200, 2)):
+        if cs.is_free((x, y)):
+            assert cs.clearance((x, y)) == pytest.approx(union.distance(shapely.Point(x, y)), rel=1e-9, abs=1e-12)
+            n += 1
+    assert n > 50
+    assert math.isinf(CSpace((0, 1, 0, 1), []).clearance((0.5, 0.5)))
