@@ -19,19 +19,19 @@ import numpy as np
 from .plan import PlanResult
 
 
-def exact_plan(sc, cspace, query) -> PlanResult:
-    """Shortest path for one query on a built C-space."""
+def exact_plan(sc, cspace, query, time_limit: float | None = None) -> PlanResult:
+    """Shortest path for one query on a built C-space (search bounded by ``time_limit``)."""
     from cspace.shortest import shortest_path as geometric_shortest
 
     t = time.perf_counter()
-    sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal)
+    sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit)
     dt = time.perf_counter() - t
     if sp.solved:
         message = "exact shortest path (touches C-obstacle boundaries where it bends)"
     elif sp.proven_unsolvable:
         message = "proven unsolvable: start and goal lie in different free components"
     else:
-        message = "no path found"
+        message = f"no path found ({sp.stats.get('reason', 'search exhausted')})"
     return PlanResult(
         scenario=sc.name, solved=bool(sp.solved), exact=bool(sp.solved),
         path=np.asarray(sp.path, dtype=np.float64) if sp.solved else np.zeros((0, 2)),

@@ -133,7 +133,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     if name == "exact":
         from .exact import exact_plan
 
-        results = [exact_plan(sc, cspace, q) for q in queries]
+        results = [exact_plan(sc, cspace, q, time_limit=tlim) for q in queries]
     else:
         results = _plan_ompl(sc, cspace, queries, name, tlim, sd, simplify, iterations)
     for r in results:
