@@ -1,0 +1,99 @@
+"""Convex decomposition and non-convex sums against shapely and an independent reference."""
+import numpy as np
+import pytest
+import shapely
+
+from cspace.decompose import convex_decompose
+from cspace.minkowski import minkowski_sum
+from cspace.nonconvex import minkowski_pieces, minkowski_sum_nonconvex
+from cspace.polygon import is_convex
+from cspace.predicates import orient2d
+
+
+def comb(teeth, w=1.0, gap=1.0, h=4.0, spine=1.0):
+    pts = [[0.0, 0.0], [teeth * w + (teeth - 1) * gap, 0.0]]
+    x = teeth * w + (teeth - 1) * gap
+    for t in range(teeth):
+        xr = x - t * (w + gap)
+        pts += [[xr, spine + h], [xr - w, spine + h]]
+        if t < teeth - 1:
+            pts += [[xr - w, spine], [xr - w - gap, spine]]
+    return np.array(pts)
+
+
+def reflex_count(p):
+    n = len(p)
+    return sum(orient2d(p[i - 1], p[i], p[(i + 1) % n]) < 0 for i in range(n))
+
+
+def star(k, seed):
+    rng = np.random.default_rng(seed)
+    a = np.sort(rng.uniform(0, 2 * np.pi, k))
+    r = rng.uniform(0.3, 1.0, k)
+    return np.c_[r * np.cos(a), r * np.sin(a)]
+
+
+SHAPES = [comb(5), comb(12), np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2.0]])] + [star(k, s) for k, s in
+                                                                                             [(8, 1), (20, 2), (40, 3)]]
+
+
+@pytest.mark.parametrize("poly", SHAPES, ids=lambda p: f"{len(p)}v")
+def test_pieces_convex_cover_exactly_and_respect_the_bound(poly):
+    pieces = convex_decompose(poly)
+    assert all(is_convex(p, strict=True) for p in pieces)
+    ref = shapely.Polygon(poly)
+    union = shapely.union_all([shapely.Polygon(p) for p in pieces])
+    assert abs(sum(shapely.Polygon(p).area for p in pieces) - ref.area) <= 1e-12 * ref.area  # disjoint interiors
+    assert union.symmetric_difference(ref).area <= 1e-12 * ref.area
+    assert len(pieces) <= 2 * reflex_count(poly) + 1
+
+
+def test_convex_input_is_returned_untouched():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    (only,) = convex_decompose(sq)
+    assert only.tolist() == sq.tolist()
+
+
+def test_comb_is_optimal_and_holes_are_covered():
+    assert len(convex_decompose(comb(6))) == 7  # spine + 6 teeth: the optimum
+    shell = np.array([[0.0, 0], [10, 0], [10, 10], [0, 10]])
+    hole = np.array([[3.0, 3], [7, 3], [5, 7]])
+    pieces = convex_decompose(shell, [hole])
+    ref = shapely.Polygon(shell, [hole])
+    union = shapely.union_all([shapely.Polygon(p) for p in pieces])
+    assert union.symmetric_difference(ref).area <= 1e-12 * ref.area
+    assert sum(shapely.Polygon(p).area for p in pieces) == pytest.approx(ref.area, rel=1e-12)
+
+
+def reference_sum(A, B):
+    """Independent: the union of all triangle-pair sums (GEOS triangulation, hull of the 9 vertex sums)."""
+    def tris(P):
+        return [np.asarray(t.exterior.coords)[:3] for t in shapely.get_parts(shapely.constrained_delaunay_triangles(P))]
+    A = A if hasattr(A, "geom_type") else shapely.Polygon(A)
+    B = B if hasattr(B, "geom_type") else shapely.Polygon(B)
+    return shapely.union_all([shapely.MultiPoint((ta[:, None] + tb[None]).reshape(-1, 2)).convex_hull
+                              for ta in tris(A) for tb in tris(B)])
+
+
+@pytest.mark.parametrize("A,B", [(comb(5), comb(3)), (comb(20), comb(10)), (star(20, 5), comb(4)), (star(12, 6), star(9, 7))])
+def test_nonconvex_sum_matches_reference(A, B):
+    got = minkowski_sum_nonconvex(A, B)
+    ref = reference_sum(A, B)
+    assert got.symmetric_difference(ref).area <= 1e-9 * ref.area
+
+
+def test_small_hole_of_the_sum_survives():
+    # A square ring with a hole 4 wide, plus a 3.9-wide square: the sum keeps a 0.1-wide hole.
+    ring = shapely.Polygon([[0, 0], [10, 0], [10, 10], [0, 10]], [[[3, 3], [3, 7], [7, 7], [7, 3]]])
+    sq = np.array([[0.0, 0.0], [3.9, 0.0], [3.9, 3.9], [0.0, 3.9]]) - 1.95
+    got = minkowski_sum_nonconvex(ring, sq)
+    assert got.geom_type == "Polygon" and len(got.interiors) == 1
+    assert shapely.Polygon(got.interiors[0]).area == pytest.approx(0.01, rel=1e-9)
+
+
+def test_pieces_are_pairwise_sums():
+    L = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2.0]])
+    tri = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    pieces = minkowski_pieces(L, tri)
+    assert len(pieces) == 2
+    assert sorted(map(len, pieces)) == sorted(len(minkowski_sum(p, tri)) for p in convex_decompose(L))
