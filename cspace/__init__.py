@@ -7,5 +7,14 @@ from .predicates import orient2d, orient2d_many, cross_sign
 from .polygon import as_array, signed_area, normalize, is_convex, is_simple, lowest_first
 from .disk import disk_polygon, disk_sides, disk_error
 from .scenario import Scenario, Shape, Query, ScenarioError, load_scenario, scenario_from_dict
+from .hull import convex_hull
+from .minkowski import minkowski_sum, reflect
+from .halfplane import halfplanes, support, support_point, erode
+from .gjk import Distance, gjk_distance, gjk_intersects
+from .epa import Penetration, epa_penetration
+from .decompose import convex_decompose
+from .nonconvex import minkowski_pieces, minkowski_sum_nonconvex
+from .cspace import CSpace
+from .shortest import ShortestPath, shortest_path
 
 __version__ = "0.1.0"
