@@ -60,23 +60,9 @@ def orient2d_xy(ax: float, ay: float, bx: float, by: float, cx: float, cy: float
     >>> orient2d_xy(0.0, 0.0, 1.0, 0.0, 2.0, -1.0)
     -1
     """
-    # Shewchuk's form: translate so c is the origin, then one 2x2 determinant.
-    # Each difference is correctly rounded and keeps its sign (zero only when equal).
-    detleft = (ax - cx) * (by - cy)
-    detright = (ay - cy) * (bx - cx)
-    det = detleft - detright
-    detsum = abs(detleft) + abs(detright)
-    if _UNDERFLOW_GUARD < detsum < _INF:
-        errbound = CCW_ERRBOUND_A * detsum
-        if det > errbound:
-            return 1
-        if -det > errbound:
-            return -1
-    elif detsum == 0.0 and (ax == cx or by == cy) and (ay == cy or bx == cx):
-        # Both products are exact zeros (a zero factor), not underflowed ones.
-        return 0
-    # The filter cannot certify the sign (near-degenerate, overflow or underflow).
-    return orient2d_exact(ax, ay, bx, by, cx, cy)
+    # Shewchuk's form: translate so c is the origin, then one 2x2 determinant, i.e. the
+    # cross product of the edge vectors c->a and c->b (filter and fallback live there).
+    return cross_diff_sign(cx, cy, ax, ay, cx, cy, bx, by)
 
 
 def orient2d_many(a, b, c) -> np.ndarray:
@@ -100,25 +86,8 @@ def orient2d_cols(ax, ay, bx, by, cx, cy) -> np.ndarray:
     >>> orient2d_cols(np.zeros(2), np.zeros(2), 1.0, 0.0, np.array([0.5, 0.5]), np.array([1.0, -1.0])).tolist()
     [1, -1]
     """
-    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
-        acx, bcy = ax - cx, by - cy
-        acy, bcx = ay - cy, bx - cx
-        detleft = acx * bcy
-        detright = acy * bcx
-        det = detleft - detright
-        detsum = np.abs(detleft) + np.abs(detright)
-        errbound = CCW_ERRBOUND_A * detsum
-        ok = (detsum > _UNDERFLOW_GUARD) & (detsum < _INF)
-        sign = (ok & (det > errbound)).astype(np.int8) - (ok & (-det > errbound)).astype(np.int8)
-        certain = sign != 0
-        # Both products exact zeros (a zero factor, not an underflow): collinear.
-        certain |= (detsum == 0.0) & ((acx == 0.0) | (bcy == 0.0)) & ((acy == 0.0) | (bcx == 0.0))
-    if not certain.all():
-        cols = np.broadcast_arrays(ax, ay, bx, by, cx, cy, sign)
-        sign = np.array(cols[-1], dtype=np.int8)
-        for idx in zip(*np.nonzero(~np.broadcast_to(certain, sign.shape))):
-            sign[idx] = orient2d_exact(*(float(col[idx]) for col in cols[:6]))
-    return sign
+    # orient2d(a, b, c) = (a - c) x (b - c): the edge-vector cross product from c.
+    return cross_diff_cols(cx, cy, ax, ay, cx, cy, bx, by)
 
 
 def cross_sign(u, v) -> int:
