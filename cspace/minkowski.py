@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
-from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign
+from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, orient2d_xy
 
 # Up to this many vertices in total the scalar merge is faster than numpy's overhead.
 _SCALAR_MAX = 96
@@ -57,16 +57,23 @@ def minkowski_sum(P, Q, *more) -> np.ndarray:
     """
     ops = [as_array(x) for x in (P, Q) + more]
     if sum(len(o) for o in ops) <= _SCALAR_MAX:
-        polys = [_clean_small(o.tolist()) for o in ops]
-        if len(polys) == 2:
-            out, exact = _merge2_small(polys[0], polys[1])
+        if len(ops) == 2:
+            (P, EP), (Q, EQ) = _clean_edges_small(ops[0].tolist()), _clean_edges_small(ops[1].tolist())
+            flat, exact = _merge2_small(P, Q, EP, EQ)
             if exact:  # the exact sum, strictly convex by the exact merge
-                return np.array(out, dtype=np.float64)
+                return np.array(flat, dtype=np.float64).reshape(-1, 2)
+            out = list(zip(flat[::2], flat[1::2]))
         else:
-            out = _merge_small(polys)
+            out = _merge_small([_clean_small(o.tolist()) for o in ops])
         return np.array(_certify_small(out), dtype=np.float64)
-    polys = [_clean_convex(o) for o in ops]
-    out = _merge_vectorised(polys)
+    out = None
+    if all(len(o) >= 3 for o in ops):  # the common case: certify while merging
+        fast = [_prep_fast(o) for o in ops]
+        if all(f is not None for f in fast):
+            out = _merge_vectorised(fast)
+    if out is None:  # repeats, collinear or degenerate operands: clean them first
+        polys = [_clean_convex(o) for o in ops]
+        out = _merge_vectorised(polys)
     if out is None:  # the float pre-sort could not be certified: exact scalar merge
         out = np.array(_certify_small(_merge_small([_clean_small(p.tolist()) for p in polys])))
     return out
@@ -96,7 +103,12 @@ def _turn(ux: float, uy: float, vx: float, vy: float, a, b, c, d) -> int:
 
 
 def _clean_small(pts: list) -> list:
-    """CCW, lowest-first, no repeated or collinear vertex; checks convexity (scalar).
+    """CCW, lowest-first, no repeated or collinear vertex; checks convexity (scalar)."""
+    return _clean_edges_small(pts)[0]
+
+
+def _clean_edges_small(pts: list) -> tuple[list, list]:
+    """:func:`_clean_small`, and the cleaned operand's edges from :func:`_edges_small`.
 
     One pass computes each vertex's turn as the cross product of its two edges (the
     stage-A filter inline, rationals only in doubt) and the lowest vertex.
@@ -104,7 +116,8 @@ def _clean_small(pts: list) -> list:
     out = [(p[0], p[1]) for i, p in enumerate(pts) if p != pts[i - 1]] or [tuple(pts[0])]
     n = len(out)
     if n <= 2:
-        return _extremes(out)
+        out = _extremes(out)
+        return out, _edges_small(out)
     pos = neg = 0
     px, py = out[-1]
     qx, qy = out[0]
@@ -124,7 +137,10 @@ def _clean_small(pts: list) -> list:
             t = cross_diff_sign(px, py, qx, qy, qx, qy, rx, ry)
             if t == 0:  # a collinear vertex: drop it exactly (rare), then start again
                 p = drop_collinear(np.array(out, dtype=np.float64))
-                return _clean_small(p.tolist()) if len(p) >= 3 else _extremes(out)
+                if len(p) >= 3:
+                    return _clean_edges_small(p.tolist())
+                out = _extremes(out)
+                return out, _edges_small(out)
             pos += t > 0
             neg += t < 0
         if qy < out[low][1] or (qy == out[low][1] and qx < out[low][0]):
@@ -136,17 +152,7 @@ def _clean_small(pts: list) -> list:
         out.reverse()
         low = n - 1 - low
     out = out[low:] + out[:low]
-    # All turns left: convex iff the edges sweep the angle once, i.e. from the lowest
-    # vertex their half-planes read upper...upper then lower...lower (a pentagram
-    # returns to the upper half).
-    seen_lower = False
-    for i in range(n):
-        (ax, ay), (bx, by) = out[i], out[(i + 1) % n]
-        lower = by < ay or (by == ay and bx <= ax)
-        if seen_lower and not lower:
-            raise ValueError("minkowski_sum: operand is not convex (winds more than once)")
-        seen_lower = lower
-    return out
+    return out, _edges_small(out)  # raises unless the edges sweep the angle once
 
 
 def _extremes(pts: list) -> list:
@@ -219,44 +225,72 @@ def _halves(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
 # ---------------------------------------------------------------- merges
 
 
-def _merge2_small(P: list, Q: list) -> list:
+def _merge2_small(P: list, Q: list, EP: list | None = None, EQ: list | None = None) -> tuple[list, bool]:
     """The two-operand merge: two pointers, exact comparison, parallel edges fused.
 
-    Returns the vertices and whether every vertex sum was exact (Fast2Sum test:
-    fl(s - a) == b and fl(s - b) == a hold together only for an exact sum).
+    Returns the vertices as a flat list [x0, y0, x1, y1, ...] (cheap to hand to numpy)
+    and whether every vertex sum was exact (the test of Fast2Sum: fl(s - a) == c
+    and fl(s - c) == a hold together only for an exact sum).
     """
     n, m = len(P), len(Q)
-    ne = n if n > 1 else 0
-    me = m if m > 1 else 0
+    EP = _edges_small(P) if EP is None else EP
+    EQ = _edges_small(Q) if EQ is None else EQ
+    ne, me = len(EP), len(EQ)
     i = j = 0
     (ax, ay), (cx, cy) = P[0], Q[0]
     sx, sy = ax + cx, ay + cy
     exact = sx - ax == cx and sx - cx == ax and sy - ay == cy and sy - cy == ay
-    out = [(sx, sy)]
-    while i < ne or j < me:
+    out = [sx, sy]
+    while True:
         if i < ne and j < me:
-            a, b = P[i], P[(i + 1) % n]
-            c, d = Q[j], Q[(j + 1) % m]
-            ux, uy, vx, vy = b[0] - a[0], b[1] - a[1], d[0] - c[0], d[1] - c[1]
-            hu = 0 if uy > 0.0 or (uy == 0.0 and ux > 0.0) else 1
-            hv = 0 if vy > 0.0 or (vy == 0.0 and vx > 0.0) else 1
-            s = hv - hu if hu != hv else _turn(ux, uy, vx, vy, a, b, c, d)
-            # s > 0: Q's edge comes later (P's first); s < 0: Q's first; 0: parallel.
+            ux, uy, hu = EP[i]
+            vx, vy, hv = EQ[j]
+            if hu != hv:
+                s = hv - hu  # the edge in the upper half comes first
+            else:  # exact sign of u x v: the stage-A filter, rationals in doubt
+                left, right = ux * vy, uy * vx
+                det = left - right
+                bound = CCW_ERRBOUND_A * (abs(left) + abs(right))
+                if bound > 1e-280 and abs(det) > bound:
+                    s = 1 if det > 0 else -1
+                else:
+                    a, b, c, d = P[i], P[(i + 1) % n], Q[j], Q[(j + 1) % m]
+                    s = cross_diff_sign(a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1])
+            # s > 0: P's edge comes first; s < 0: Q's; 0: parallel, fused.
             if s >= 0:
                 i += 1
             if s <= 0:
                 j += 1
         elif i < ne:
             i += 1
-        else:
+        elif j < me:
             j += 1
-        if i < ne or j < me:
-            (ax, ay), (cx, cy) = P[i % n], Q[j % m]
-            sx, sy = ax + cx, ay + cy
-            if exact:
-                exact = sx - ax == cx and sx - cx == ax and sy - ay == cy and sy - cy == ay
-            out.append((sx, sy))
-    return out, exact
+        if i == ne and j == me:
+            return out, exact
+        (ax, ay), (cx, cy) = P[i % n], Q[j % m]
+        sx, sy = ax + cx, ay + cy
+        if exact:
+            exact = sx - ax == cx and sx - cx == ax and sy - ay == cy and sy - cy == ay
+        out += (sx, sy)
+
+
+def _edges_small(P: list) -> list:
+    """Edge vectors of a cleaned operand with their half-plane (0 upper, 1 lower).
+
+    From the lowest vertex of a convex polygon, the edges read upper...upper then
+    lower...lower; a polygon with all turns left that returns to the upper half
+    (a pentagram) winds more than once and is not convex. A point has no edge.
+    """
+    if len(P) < 2:
+        return []
+    edges = [(bx - ax, by - ay, 0 if by > ay or (by == ay and bx > ax) else 1)
+             for (ax, ay), (bx, by) in zip(P, P[1:] + P[:1])]
+    seen_lower = 0
+    for e in edges:
+        if e[2] < seen_lower:
+            raise ValueError("minkowski_sum: operand is not convex (winds more than once)")
+        seen_lower = e[2]
+    return edges
 
 
 def _merge_small(polys: list) -> list:
@@ -300,77 +334,172 @@ def _merge_small(polys: list) -> list:
     return out
 
 
-def _pseudo_angle(dx: np.ndarray, dy: np.ndarray, half: np.ndarray) -> np.ndarray:
+def _pseudo_angle(dx: np.ndarray, dy: np.ndarray, half: np.ndarray, scratch: np.ndarray) -> np.ndarray:
     """A monotone stand-in for the polar angle in [0, 4), no trigonometry.
 
     t = dx / (|dx| + |dy|) falls from 1 to -1 over the upper half and rises back over
-    the lower half; the key is only a pre-sort, certified afterwards exactly.
+    the lower half, so the key is 1 - t there and 3 + t here, i.e. 1 - s t + 2 half
+    with s = 1 - 2 half. The key is only a pre-sort, certified afterwards exactly.
+    In place where it can be: these arrays are large, and each fresh one costs.
     """
-    t = dx / (np.abs(dx) + np.abs(dy))
-    return np.where(half, 3.0 + t, 1.0 - t)
+    key = np.abs(dx)
+    key += np.abs(dy, out=scratch)
+    np.divide(dx, key, out=key)  # t
+    np.multiply(half, -2.0, out=scratch)
+    scratch += 1.0  # s
+    key *= scratch
+    np.subtract(1.0, key, out=key)
+    np.multiply(half, 2.0, out=scratch)
+    key += scratch
+    return key
+
+
+def _prep_fast(p: np.ndarray) -> np.ndarray | None:
+    """CCW, lowest-first copy of a large operand without the full clean, or None.
+
+    The lowest-then-leftmost vertex is a strict extreme point, so the exact turn
+    there gives the orientation of a convex polygon. Nothing else is checked here:
+    convexity, repeats and collinear vertices are certified by the merge itself
+    (an operand whose edges do not sweep the angle once in order fails there, and
+    the caller then takes the full clean, which raises for non-convex input).
+    """
+    n = len(p)
+    k = _lowest_index(p)
+    a, b, c = p[k - 1], p[k], p[(k + 1) % n]
+    t = orient2d_xy(a[0], a[1], b[0], b[1], c[0], c[1])
+    if t == 0:
+        return None
+    if t < 0:
+        p, k = p[::-1], n - 1 - k
+    return np.concatenate([p[k:], p[:k]]) if k else p
+
+
+def _sort_keys(key: np.ndarray, runs: int) -> np.ndarray:
+    """Stable permutation sorting ``key`` (pseudo-angles in [0, 4)), made of ``runs`` sorted runs.
+
+    Below 2^21 keys, each key is quantised to 40 bits and packed with its index
+    into one int64, so an integer sort moves no index array beside it; equal quanta
+    keep index order, which the exact certification that follows checks anyway.
+    A merge sort (timsort finds the runs) costs O(N log runs), so it serves few
+    runs; the SIMD quicksort is faster from a handful of runs on.
+    """
+    n = len(key)
+    if n >= 1 << 21:
+        return np.argsort(key, kind="stable")
+    packed = (key * 2.0**40).astype(np.int64)
+    packed <<= 21
+    packed |= np.arange(n, dtype=np.int64)
+    packed.sort(kind="stable" if runs <= 4 else None)
+    packed &= (1 << 21) - 1
+    return packed
 
 
 def _merge_vectorised(polys: list) -> np.ndarray | None:
-    """Merge by a stable sort of pseudo-angles, then certify the order exactly.
+    """Merge by a sort of pseudo-angle keys, then certify the order exactly.
 
-    Returns None if some adjacent pair is out of exact angular order (a pre-sort
-    misled by rounding): the caller then runs the exact scalar merge.
+    Each operand is CCW and lowest-first. Returns None when the result cannot be
+    certified: an operand whose keys do not increase along it, or some adjacent
+    pair of the merged sequence out of exact angular order (a pre-sort misled by
+    rounding, or a non-convex operand); the caller then takes a slower exact route.
     """
     edged = [p for p in polys if len(p) >= 2]
     start = np.sum([p[0] for p in polys], axis=0)
     if not edged:
         return start.reshape(1, 2)
-    xs = [np.ascontiguousarray(p[:, 0]) for p in edged]
-    ys = [np.ascontiguousarray(p[:, 1]) for p in edged]
-    ex = np.concatenate([_cyclic_diff(x) for x in xs])
-    ey = np.concatenate([_cyclic_diff(y) for y in ys])
+    sizes = np.array([len(p) for p in edged])
+    ends = np.cumsum(sizes)
+    first = ends - sizes
+    X = np.concatenate([p[:, 0] for p in edged])
+    Y = np.concatenate([p[:, 1] for p in edged])
+    ex, ey = np.empty_like(X), np.empty_like(Y)
+    np.subtract(X[1:], X[:-1], out=ex[:-1])
+    np.subtract(Y[1:], Y[:-1], out=ey[:-1])
+    ex[ends - 1] = X[first] - X[ends - 1]  # each operand's closing edge
+    ey[ends - 1] = Y[first] - Y[ends - 1]
+    if ((ex == 0.0) & (ey == 0.0)).any():  # a repeated vertex: no direction
+        return None
     half = _halves(ex, ey)
-    order = np.argsort(_pseudo_angle(ex, ey, half), kind="stable")
+    scratch = np.empty_like(X)
+    key = _pseudo_angle(ex, ey, half, scratch)
+    down = np.flatnonzero(key[1:] < key[:-1])  # allowed only where one operand ends
+    if len(down) and not np.isin(down, ends[:-1] - 1).all():
+        return None
+    order = _sort_keys(key, len(edged))
     half = half[order]
     if (half[:-1] > half[1:]).any():
         return None
-    ux, uy = ex[order], ey[order]
-    # Certify each consecutive pair: u x v >= 0 exactly within a half.
-    left = ux[:-1] * uy[1:]
-    right = uy[:-1] * ux[1:]
-    det = left - right
-    bound = CCW_ERRBOUND_A * (np.abs(left) + np.abs(right))
+    ux, uy = np.take(ex, order, out=key), np.take(ey, order, out=scratch)
+    integral = _integral(X, Y, len(polys), ex)
+    fused = _parallel_pairs(ux, uy, half, integral, X, Y, order, first, ends, edged, ex, ey)
+    if fused is None:
+        return None
+    keep = np.flatnonzero(~fused)  # the vertex after merged edge t, t < last
+    out = np.empty((len(keep) + 1, 2))
+    out[0] = start
+    if integral:  # exact: vertex after edge t = start + the sum of the edges up to t
+        out[1:, 0] = np.cumsum(ux, out=ux)[keep]
+        out[1:, 1] = np.cumsum(uy, out=uy)[keep]
+        out[1:] += start
+        return out
+    # Float input: each vertex is the sum of one input vertex per operand, rounded
+    # once per addition; the count of an operand's edges taken so far is its index.
+    vx = np.full(len(keep), start[0] - X[first].sum())
+    vy = np.full(len(keep), start[1] - Y[first].sum())
+    owner = np.repeat(np.arange(len(edged)), sizes)[order]
+    for i, lo in enumerate(first):
+        cnt = np.cumsum(owner == i)[keep] % sizes[i] + lo
+        vx += X[cnt]
+        vy += Y[cnt]
+    out[1:, 0] = vx
+    out[1:, 1] = vy
+    return _certify_cols(out, exact=False)
+
+
+def _integral(X: np.ndarray, Y: np.ndarray, k: int, scratch: np.ndarray) -> bool:
+    """Every coordinate an integer small enough that all sums of k of them are exact."""
+    lim = 2.0**51 / max(k, 1)
+    if not max(X.max(), Y.max(), -X.min(), -Y.min()) < lim:
+        return False
+    return bool((np.floor(X, out=scratch) == X).all() and (np.floor(Y, out=scratch) == Y).all())
+
+
+def _parallel_pairs(ux, uy, half, integral, X, Y, order, first, ends, edged, w1, w2) -> np.ndarray | None:
+    """Which consecutive merged edges are parallel (to be fused); None if out of order.
+
+    Within a half-plane, edge t+1 must not turn clockwise of edge t: u x v >= 0,
+    decided exactly. For integer input, products below 2^53 are exact; for floats the
+    stage-A filter decides; in doubt, Dekker's error-free products, rationals last.
+    """
     same = half[:-1] == half[1:]
-    sure = (bound > 1e-280) & (bound < np.inf) & (np.abs(det) > bound)
+    left = np.multiply(ux[:-1], uy[1:], out=w1[:-1])  # w1, w2: scratch
+    right = np.multiply(uy[:-1], ux[1:], out=w2[:-1])
+    if integral:
+        # Integer products below 2^53 are exact (a true product of 2^53 + 1 or more
+        # cannot round below 2^53), and the one rounding of their difference keeps
+        # its sign; pairs with a larger product go to the exact tests below.
+        big = 2.0**53
+        sure = (left < big) & (left > -big) & (right < big) & (right > -big)
+        det = np.subtract(left, right, out=left)
+    else:
+        det = left - right
+        bound = CCW_ERRBOUND_A * (np.abs(left) + np.abs(right))
+        sure = (bound > 1e-280) & (bound < np.inf) & (np.abs(det) > bound)
     if (same & sure & (det < 0)).any():
         return None
-    fused = same & ~sure  # zero, or in doubt: decide exactly below
-    doubt = np.flatnonzero(fused)
+    fused = same & (~sure | (det == 0))  # parallel, or in doubt: decided exactly below
+    doubt = np.flatnonzero(same & ~sure)
     if len(doubt):
         sign = _error_free_signs(ux, uy, doubt)
-        exact_edge = np.concatenate([_diff_is_exact(x) & _diff_is_exact(y) for x, y in zip(xs, ys)])
+        exact_edge = _diff_is_exact_cols(X, first, ends) & _diff_is_exact_cols(Y, first, ends)
         sign[~(exact_edge[order[doubt]] & exact_edge[order[doubt + 1]])] = 2
         rest = np.flatnonzero(sign == 2)
         if len(rest):
-            ends = np.cumsum([0] + [len(p) for p in edged])
-            sign[rest] = [_exact_pair(edged, ends, order[doubt[r]], order[doubt[r] + 1]) for r in rest]
+            sign[rest] = [_exact_pair(edged, first, order[doubt[r]], order[doubt[r] + 1])
+                          for r in rest]
         if (sign < 0).any():
             return None
         fused[doubt] = sign == 0  # parallel, same direction: no vertex between them
-    keep = np.flatnonzero(~fused)  # vertex after merged edge t (the last edge closes the cycle)
-    # Vertex after merged edge t: the sum over operands of the vertex each has reached.
-    vx = np.full(len(keep), start[0]) if len(edged) < len(polys) else np.zeros(len(keep))
-    vy = np.full(len(keep), start[1]) if len(edged) < len(polys) else np.zeros(len(keep))
-    if len(edged) < len(polys):  # point operands: their vertex is in every sum
-        vx -= sum(p[0, 0] for p in edged)
-        vy -= sum(p[0, 1] for p in edged)
-    lo = 0
-    for x, y in zip(xs, ys):
-        mine = (order >= lo) & (order < lo + len(x))
-        cnt = np.cumsum(mine)[keep] % len(x)
-        vx += x[cnt]
-        vy += y[cnt]
-        lo += len(x)
-    out = np.empty((len(keep) + 1, 2))
-    out[0] = start
-    out[1:, 0] = vx
-    out[1:, 1] = vy
-    return _certify_cols(out, exact=_sums_exact(polys))
+    return fused
 
 
 _SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitter
@@ -395,9 +524,14 @@ def _error_free_signs(ux: np.ndarray, uy: np.ndarray, doubt: np.ndarray) -> np.n
     return np.where(ok, np.sign(det), 2).astype(np.int8)
 
 
-def _diff_is_exact(x: np.ndarray) -> np.ndarray:
-    """Whether each cyclic difference fl(x[i+1] - x[i]) is exact (Knuth's TwoSum error 0)."""
-    b = np.roll(x, -1)
+def _diff_is_exact_cols(x: np.ndarray, first: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Whether each cyclic difference fl(x[i+1] - x[i]) within each operand is exact.
+
+    Knuth's TwoSum: the rounding error of b + (-a) is computed exactly; zero means exact.
+    """
+    b = np.empty_like(x)
+    b[:-1] = x[1:]
+    b[ends - 1] = x[first]
     na = -x
     s = b + na
     bv = s - b
@@ -416,13 +550,6 @@ def _product_error(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
     return ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
-def _cyclic_diff(x: np.ndarray) -> np.ndarray:
-    d = np.empty_like(x)
-    np.subtract(x[1:], x[:-1], out=d[:-1])
-    d[-1] = x[0] - x[-1]
-    return d
-
-
 def _exact_pair(edged: list, ends: np.ndarray, s: int, t: int) -> int:
     """Exact sign of edge s x edge t, edges numbered across the concatenated operands."""
     def ends_of(g):
@@ -433,15 +560,6 @@ def _exact_pair(edged: list, ends: np.ndarray, s: int, t: int) -> int:
     a, b = ends_of(int(s))
     c, d = ends_of(int(t))
     return cross_diff_sign(a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1])
-
-
-def _sums_exact(polys: list) -> bool:
-    """True when every vertex sum is exact: all coordinates integers below 2^52 / k."""
-    lim = 2.0**52 / max(len(polys), 1)
-    for p in polys:
-        if not (np.abs(p) < lim).all() or not (np.floor(p) == p).all():
-            return False
-    return True
 
 
 # ---------------------------------------------------------------- certification

@@ -143,7 +143,7 @@ def test_large_vectorised_path_matches_exact():
     # The exact reference without the quadratic blow-up: the scalar exact merge on the same input.
     from cspace.minkowski import _clean_small, _merge2_small
     ref, exact = _merge2_small(_clean_small(P.tolist()), _clean_small(Q.tolist()))
-    assert exact and S.tolist() == [list(v) for v in ref]
+    assert exact and S.ravel().tolist() == ref
 
 
 def test_degenerate_operands():
@@ -196,3 +196,71 @@ def test_erosion_is_not_the_sum_with_the_reflection():
     assert erode(A, B).tolist() == [[0, 0], [3, 0], [3, 2], [0, 2]]
     assert minkowski_sum(A, reflect(B)).tolist() != erode(A, B).tolist()
     assert erode([[0, 0], [1, 0], [1, 1], [0, 1]], [[0, 0], [1, 0], [1, 1], [0, 1]]).tolist() == [[0, 0]]
+
+
+# ---------------------------------------------------------------- the vectorised route (> 96 vertices)
+
+
+def _scalar_reference(*polys):
+    """The scalar exact merge on the same operands: same rounding semantics, other code path."""
+    from cspace.minkowski import _certify_small, _clean_small, _merge_small
+
+    return _certify_small(_merge_small([_clean_small(np.asarray(p, float).tolist()) for p in polys]))
+
+
+def _random_convex(rng, n, scale=1.0, offset=0.0, integer=False):
+    """n random points on an ellipse-ish curve, hulled exactly: a convex polygon of about n vertices."""
+    a = np.sort(rng.uniform(0, 2 * np.pi, n))
+    r = rng.uniform(0.5, 2.0)
+    p = np.c_[r * np.cos(a), np.sin(a)] * scale + offset
+    return convex_hull(np.round(p) if integer else p)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1e-9, 1.0, 1e9]), st.sampled_from([0.0, 1e8]),
+       st.integers(2, 3))
+def test_vectorised_route_equals_scalar_route_on_floats(seed, scale, offset, k):
+    rng = np.random.default_rng(seed)
+    polys = [_random_convex(rng, int(rng.integers(60, 300)), scale, offset * scale) for _ in range(k)]
+    S = minkowski_sum(*polys)
+    assert strictly_convex(S)
+    assert S.tolist() == [list(v) for v in _scalar_reference(*polys)]
+
+
+@settings(max_examples=10, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_vectorised_route_exact_on_integers(seed):
+    rng = np.random.default_rng(seed)
+    P = _random_convex(rng, 70, 2.0**20, integer=True)
+    Q = _random_convex(rng, 60, 2.0**18, 5.0, integer=True)
+    assert len(P) + len(Q) > 96
+    S = minkowski_sum(P, Q)
+    assert as_fr(S) == exact_sum(P, Q)
+
+
+def test_vectorised_route_cleans_cw_collinear_and_repeated_operands():
+    rng = np.random.default_rng(7)
+    P = _random_convex(rng, 150, 2.0**20, integer=True)
+    Q = _random_convex(rng, 150, 2.0**20, integer=True)
+    # Clockwise, with exact midpoints of edges inserted (collinear) and repeated vertices.
+    mid = (P + np.roll(P, -1, axis=0)) / 2
+    messy = np.empty((2 * len(P), 2))
+    messy[0::2], messy[1::2] = P, mid
+    messy = np.repeat(messy, 2, axis=0)[::-1]
+    S = minkowski_sum(messy, Q)
+    assert S.tolist() == minkowski_sum(P, Q).tolist()
+    assert strictly_convex(S) and len(S) <= len(P) + len(Q)
+
+
+def test_vectorised_route_rejects_non_convex_operands():
+    rng = np.random.default_rng(3)
+    P = _random_convex(rng, 200)
+    Q = _random_convex(rng, 200)
+    dented = P.copy()
+    dented[50] = 0.9 * dented[50] + 0.1 * P.mean(axis=0)  # a reflex vertex
+    with pytest.raises(ValueError):
+        minkowski_sum(dented, Q)
+    # All turns left but winding twice around (a {101/2} star polygon).
+    a = 4 * np.pi * np.arange(101) / 101
+    with pytest.raises(ValueError):
+        minkowski_sum(np.c_[np.cos(a), np.sin(a)], Q)
