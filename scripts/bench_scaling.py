@@ -10,35 +10,41 @@ Three sweeps, each on scenes built through the public API (a scenario dict ->
     teeth: build time, convex pieces kept, and the vertex count of the union of the
     pieces (shapely), i.e. the C-obstacle's boundary.
 
-Build time and query times are medians over repetitions (``time.perf_counter``);
+Build time (and each build stage's time, from ``CSpace.stages``) and query times are
+medians over repetitions (``time.perf_counter``);
 per-query time is the median over batches of the batch mean. Peak memory is
 tracemalloc's peak during one separate build (tracemalloc slows code down, so it
 never wraps a timed build).
 
-Reading the slopes (exponent of the fitted power law y ~ x^k, least squares on
-log-log) against the theory:
-- a convex sum costs O(n + m) (an angular merge), each obstacle meets each robot
-  piece once, pruning and indexing are near-linear: build time and memory against
-  the number of obstacles (a) should have slope ~1; against vertices per obstacle
-  (b) slope <= 1 -- below 1 at small sizes, where the per-piece Python overhead,
-  not the vertex count, dominates.
-- queries go through a grid broad phase sized to the number of pieces: a state or
-  a fixed-length motion meets O(1) cells and O(1) pieces at constant density, so
-  is_free / segment_free against obstacles (a) should have slope ~0 (a small
-  positive slope is cache and hash effects). Against vertices (b) the exact narrow
-  phase tests every edge of a candidate piece, vectorised: slope between 0 and 1,
-  and near 0 while numpy's per-call overhead dominates.
-- non-convex pairs (c): n-teeth and m-teeth combs decompose into O(n) and O(m)
-  convex pieces, so there are O(nm) pairwise sums: pieces and build time slope ~2
-  in n (= m). The union of those pieces -- the C-obstacle's boundary, which the
-  C-space never computes -- can have Θ(n²m²) vertices in the worst case (slope 4).
-  These combs do NOT reach it: with the obstacle's pitch n times the robot's, the
-  teeth of the sum give nm distinct vertical strips and the boundary has Θ(nm)
-  vertices (slope ~2; crossed or tilted combs measured lower, 0.9 and 1.85). A
-  Θ(n²m²) boundary needs Θ(nm) strips in each of two directions crossing without
-  being filled in, which two long teeth in different directions always fill (their
-  sum is a parallelogram); we did not build such a layout. The point stands either
-  way: the C-space's own cost follows the pieces, O(nm), never the union.
+Reading the slopes (exponent k of the fitted power law y ~ x^k, least squares on
+log-log) against the theory, with the full run's figures (2-core machine, shared):
+- (a) obstacles. A convex sum is an O(n + m) angular merge, one per obstacle: the
+  sum stage fits k = 0.97 (theory 1). The whole build fits ~0.7, not 1, because
+  it is dominated (60-85 %) by the grid index, whose cell count is 1024 per piece
+  clamped to [2^16, 2^20]: constant below 64 pieces, linear up to 1024, then only
+  the per-piece classification grows. Peak memory (~0.6) is the grid too: linear
+  from 100 to 1000 obstacles (13 -> 136 MiB), nearly flat after (172 MiB at 10^4).
+  Queries: theory O(1) at constant density (a state or a fixed-length motion meets
+  O(1) cells). is_free fits 0.17 and segment_free 0.20: flat to 1000 obstacles, then
+  the clamped grid's cells each hold more pieces (more MIXED cells, more exact
+  tests), so the cost creeps up; still ~1 us and ~35 us at 10 000 obstacles.
+- (b) vertices per obstacle. Theory O(n + m) per sum: the measured k ~0.5 is below
+  1 because 20 sums of <= 1000 vertices each are dominated by numpy's per-call
+  overhead (scripts/bench_minkowski.py shows the linear regime at 10^3..10^4). The
+  index classifies every edge against its cells and grows ~linearly from 128
+  vertices on. Queries rise mildly (k ~0.3-0.4): FREE/BLOCKED cells are O(1), only
+  MIXED cells run the vectorised O(n) exact test.
+- (c) non-convex pairs. A comb with n teeth decomposes into n + 1 convex pieces,
+  so there are (n+1)(m+1) pairwise sums: pairs fit ~1.7 and approach 2 (theory
+  O(nm), n = m); build time ~1.4 (fixed costs at small n). The union of the pieces,
+  the C-obstacle's boundary that the C-space never computes, can have Θ(n²m²)
+  vertices in the worst case (k = 4). These combs do NOT reach it: with the
+  obstacle's pitch n times the robot's, the teeth of the sum fall on nm distinct
+  vertical strips and the boundary has exactly 4(nm + 1) vertices (k ~1.9 -> 2;
+  crossed and tilted combs measured lower). A Θ(n²m²) boundary needs Θ(nm) strips
+  in each of two directions crossing without being filled in, and two long teeth
+  in different directions always sum to a filled parallelogram; no such layout is
+  built here. Either way the C-space's own cost follows the pieces, O(nm).
 Usage: python scripts/bench_scaling.py [--quick] [--plot scaling.png] [--out-json rows.json]
 """
 from __future__ import annotations
@@ -145,14 +151,17 @@ def comb_scene(n: int, m: int) -> dict:
 # ------------------------------------------------------------------ measuring
 
 
-def median_time(fn, reps: int) -> float:
-    """Median wall time of ``fn()`` over ``reps`` calls, in seconds."""
-    out = []
+def median_build(sc, reps: int) -> tuple[float, dict[str, float], CSpace]:
+    """Median wall time of ``CSpace.from_scenario(sc)`` over ``reps`` builds, the median
+    seconds of each build stage the C-space records, and the last C-space built."""
+    total, stages = [], {}
     for _ in range(reps):
         t = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t)
-    return statistics.median(out)
+        cs = CSpace.from_scenario(sc)
+        total.append(time.perf_counter() - t)
+        for st in cs.stages:
+            stages.setdefault(st.name, []).append(st.seconds)
+    return statistics.median(total), {k: statistics.median(v) for k, v in stages.items()}, cs
 
 
 def peak_memory(fn) -> float:
@@ -196,12 +205,11 @@ def measure_scene(scene: dict, reps: int, queries: int, batches: int, seed: int)
     """Build time (median), peak memory, pieces and query times of one scene."""
     sc = scenario_from_dict(scene)
     CSpace.from_scenario(sc)  # warm-up: first-call imports and caches stay out of the median
-    build = median_time(lambda: CSpace.from_scenario(sc), reps)
+    build, stages, cs = median_build(sc, reps)
     mem = peak_memory(lambda: CSpace.from_scenario(sc))
-    cs = CSpace.from_scenario(sc)
     point_s, seg_s = query_times(cs, np.random.default_rng(seed), queries, batches)
     return {
-        "build_s": build, "peak_mib": mem, "pieces": len(cs.pieces),
+        "build_s": build, "sum_s": stages["minkowski"], "index_s": stages["index"], "peak_mib": mem, "pieces": len(cs.pieces),
         "is_free_us": point_s * 1e6, "segment_free_us": seg_s * 1e6,
     }
 
@@ -243,15 +251,15 @@ def sweep_combs(sizes, budget_s: float = 60.0) -> list[dict]:
             print(f"# combs: n={n} skipped (time budget)", file=sys.stderr)
             break
         sc = scenario_from_dict(comb_scene(n, n))
-        build = median_time(lambda: CSpace.from_scenario(sc), _reps(n * n * 50))
-        cs = CSpace.from_scenario(sc)
+        CSpace.from_scenario(sc)  # warm-up
+        build, stages, cs = median_build(sc, _reps(n * n * 50))
         raw = next(s.counts["pairs"] for s in cs.stages if s.name == "minkowski")
         t = time.perf_counter()
         union = shapely.union_all(shapely.polygons(cs.pieces) if len({len(p) for p in cs.pieces}) == 1
                                   else [shapely.Polygon(p) for p in cs.pieces])
         union_s = time.perf_counter() - t
         rows.append({"sweep": "combs", "x": n, "teeth_robot": n, "teeth_obstacle": n,
-                     "build_s": build, "pairs": raw, "pieces": len(cs.pieces),
+                     "build_s": build, "sum_s": stages["minkowski"], "pairs": raw, "pieces": len(cs.pieces),
                      "union_vertices": boundary_vertices(union), "union_holes": holes(union),
                      "union_s": union_s})
     return rows
@@ -286,15 +294,20 @@ def fit_exponent(xs, ys) -> float:
 # (sweep, measured field, theory slope, theory text)
 THEORY = [
     ("obstacles", "build_s", 1.0, "O(N (n+m)) convex sums + near-linear prune/index"),
+    ("obstacles", "sum_s", 1.0, "one O(n + m) convex sum per obstacle"),
+    ("obstacles", "index_s", 1.0, "grid cells ~ pieces (capped at 1024²)"),
     ("obstacles", "peak_mib", 1.0, "pieces stored once, grid ~ pieces"),
     ("obstacles", "is_free_us", 0.0, "grid broad phase: O(1) cells at constant density"),
     ("obstacles", "segment_free_us", 0.0, "fixed-length motion: O(1) cells"),
-    ("vertices", "build_s", 1.0, "O(n + m) angular merge per pair"),
+    ("vertices", "build_s", 1.0, "O(n + m) merge per pair + O(n) normalisation"),
+    ("vertices", "sum_s", 1.0, "O(n + m) angular merge, 20 pairs"),
     ("vertices", "peak_mib", 1.0, "O(n + m) vertices per piece"),
     ("vertices", "is_free_us", 0.0, "O(1) FREE/BLOCKED cells; O(n) vectorised in MIXED ones"),
     ("vertices", "segment_free_us", 1.0, "exact SAT over the candidate's O(n) edges"),
-    ("combs", "pairs", 2.0, "O(n) x O(m) convex pieces, n = m"),
+    ("combs", "pairs", 2.0, "O(n) x O(m) convex pairs, n = m"),
+    ("combs", "pieces", 2.0, "pairs kept after pruning"),
     ("combs", "build_s", 2.0, "O(nm) pairwise sums, n = m"),
+    ("combs", "sum_s", 2.0, "O(nm) sums of O(1)-vertex pieces"),
     ("combs", "union_vertices", 4.0, "worst case Θ(n²m²), n = m"),
 ]
 
@@ -317,16 +330,19 @@ def print_rows(rows: list[dict]) -> None:
         if not sel:
             continue
         print(f"\n({'a' if sweep == 'obstacles' else 'b'}) {label}")
-        print(f"{label:>17} {'pieces':>7} {'build':>10} {'peak MiB':>9} {'is_free':>9} {'segment_free':>12}")
+        print(f"{label:>17} {'pieces':>7} {'build':>10} {'sums':>9} {'index':>9} {'peak MiB':>9} "
+              f"{'is_free':>9} {'segment_free':>12}")
         for r in sel:
-            print(f"{r['x']:>17} {r['pieces']:>7} {r['build_s'] * 1e3:>8.1f}ms {r['peak_mib']:>9.2f} "
+            print(f"{r['x']:>17} {r['pieces']:>7} {r['build_s'] * 1e3:>8.1f}ms {r['sum_s'] * 1e3:>7.2f}ms "
+                  f"{r['index_s'] * 1e3:>7.1f}ms {r['peak_mib']:>9.2f} "
                   f"{r['is_free_us']:>7.2f}us {r['segment_free_us']:>10.2f}us")
     sel = [r for r in rows if r["sweep"] == "combs"]
     if sel:
         print("\n(c) comb(n) robot vs comb(n) obstacle")
-        print(f"{'n=m':>5} {'pairs':>6} {'pieces':>7} {'build':>10} {'union verts':>12} {'holes':>6} {'union':>9}")
+        print(f"{'n=m':>5} {'pairs':>6} {'pieces':>7} {'build':>10} {'sums':>9} {'union verts':>12} {'holes':>6} "
+              f"{'union':>9}")
         for r in sel:
-            print(f"{r['x']:>5} {r['pairs']:>6} {r['pieces']:>7} {r['build_s'] * 1e3:>8.1f}ms "
+            print(f"{r['x']:>5} {r['pairs']:>6} {r['pieces']:>7} {r['build_s'] * 1e3:>8.1f}ms {r['sum_s'] * 1e3:>7.2f}ms "
                   f"{r['union_vertices']:>12} {r['union_holes']:>6} {r['union_s'] * 1e3:>7.1f}ms")
 
 
@@ -343,15 +359,16 @@ def plot(rows: list[dict], path: str) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
     panels = [
-        ("obstacles", "obstacles (8-gons)", [("build_s", "build s"), ("peak_mib", "peak MiB"),
-                                             ("is_free_us", "is_free µs"), ("segment_free_us", "segment_free µs")]),
-        ("vertices", "vertices per obstacle (20 obstacles)", [("build_s", "build s"), ("peak_mib", "peak MiB"),
-                                                              ("is_free_us", "is_free µs"),
+        ("obstacles", "obstacles (8-gons)", [("build_s", "build s"), ("sum_s", "sums s"),
+                                             ("peak_mib", "peak MiB"), ("is_free_us", "is_free µs"), ("segment_free_us", "segment_free µs")]),
+        ("vertices", "vertices per obstacle (20 obstacles)", [("build_s", "build s"), ("sum_s", "sums s"),
+                                                              ("peak_mib", "peak MiB"), ("is_free_us", "is_free µs"),
                                                               ("segment_free_us", "segment_free µs")]),
-        ("combs", "comb teeth n = m", [("build_s", "build s"), ("pieces", "pieces"),
+        ("combs", "comb teeth n = m", [("build_s", "build s"), ("sum_s", "sums s"), ("pieces", "pieces"),
                                        ("union_vertices", "union boundary vertices")]),
     ]
     table = {(f["sweep"], f["field"]): f["fitted"] for f in fits(rows)}
@@ -362,6 +379,14 @@ def plot(rows: list[dict], path: str) -> None:
             if pts:
                 k = table.get((sweep, field))
                 ax.loglog(*zip(*pts), "o-", label=f"{label} (k={k:.2f})" if k is not None else label)
+        if sweep == "combs" and sel:
+            # reference slopes: O(nm) = n² and the worst case O(n²m²) = n⁴, through the first union point
+            x0, y0 = sel[0]["x"], sel[0]["union_vertices"]
+            xs = np.array([r["x"] for r in sel], float)
+            ax.loglog(xs, y0 * (xs / x0) ** 2, "k:", lw=1, label="slope 2 (nm)")
+            ax.loglog(xs, y0 * (xs / x0) ** 4, "k--", lw=1, label="slope 4 (n²m² worst case)")
+            ax.set_xticks(xs, [str(int(x)) for x in xs])
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel(xlabel)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
