@@ -34,8 +34,9 @@ GUARANTEES = {
     "gjk": "relation (separated/touching/overlapping) exact; touching distance exactly 0; "
            "separated distance within 1e-9*scale (relative to the local extent)",
     "epa": "touching depth exactly 0; depth within EPA_TOL*scale + 64 eps*scale of the exact depth",
-    "cspace": "is_free/segment_free exact for closed obstacles (touching = collision), repeatable; "
-              "clearance within 1e-9*scale",
+    "cspace": "closed obstacles (touching = collision), repeatable; is_free/segment_free exact on the C-obstacle "
+              "pieces (vertices rounded once), so exact on the true geometry when obstacle-robot differences are "
+              "representable, else only within 2 eps*|coordinates| of contact; clearance within 1e-9*extent + that",
     "planning": "exact planner: solvable <=> found, unsolvable proven; OMPL paths re-verified exactly",
 }
 
@@ -524,7 +525,8 @@ def _epa_case(A, B, expect: str | None = None):
         err = abs(p.depth - ref)
         scale = _local_scale(a, b)
         bound = (EPA_TOL + 64 * EPS) * scale
-        unit = abs(math.hypot(*p.normal) - 1.0) <= 4 * EPS
+        # EPA's own normals are unit; a separated pair's comes from GJK's world points (not checked)
+        unit = p.status == "separated" or abs(math.hypot(*p.normal) - 1.0) <= 4 * EPS
         ok = (math.isfinite(p.depth) and unit and p.status == rel and (expect is None or rel == expect)
               and (p.depth == 0.0 if rel == "touching" else err <= bound))
         return f"{p.status} depth={p.depth:.6g} (exact {ref:.6g})", err, ok, dt
@@ -595,7 +597,59 @@ def exact_clearance(sc, q) -> float:
     return min(exact_distance(_placed(_fr(r.polygon), q), _fr(o.polygon)) for r in sc.robot for o in sc.obstacles)
 
 
+def _signed_margin(D: list, q) -> Fraction:
+    """Exact signed squared distance of point q to convex D: > 0 outside, <= 0 in the closed set
+    (minus the squared depth)."""
+    inward = []
+    for i in range(len(D)):
+        (px, py), (qx, qy) = D[i], D[(i + 1) % len(D)]
+        ex, ey = qx - px, qy - py
+        c = ex * (q[1] - py) - ey * (q[0] - px)  # |e| times q's inward distance from this edge
+        inward.append((c, ex * ex + ey * ey))
+    if all(c >= 0 for c, _ in inward):
+        return -min(Fraction(c * c) / n2 for c, n2 in inward)
+    return _dist_to_boundary2(q, D)
+
+
+def c_obstacles(sc) -> list:
+    """The true C-obstacles, exact: obstacle ⊕ (−robot part), for every pair."""
+    return [exact_sum(_fr(o.polygon), [(-x, -y) for x, y in _fr(r.polygon)]) for o in sc.obstacles for r in sc.robot]
+
+
+def sums_representable(sc) -> bool:
+    """Is every obstacle-minus-robot vertex difference exact in floats (integer or dyadic input)?"""
+    for o in sc.obstacles:
+        for r in sc.robot:
+            for a in _fr(o.polygon):
+                for b in _fr(r.polygon):
+                    for k in (0, 1):
+                        if Fraction(float(a[k] - b[k])) != a[k] - b[k]:
+                            return False
+    return True
+
+
+def _own_free(cs, q) -> bool:
+    """Exact answer on the C-space's own (float) pieces: q outside every closed piece."""
+    x, y = Fraction(q[0]), Fraction(q[1])
+    for piece in cs.pieces:
+        P = _fr(piece)
+        if all((P[(i + 1) % len(P)][0] - P[i][0]) * (y - P[i][1]) - (P[(i + 1) % len(P)][1] - P[i][1]) * (x - P[i][0])
+               >= 0 for i in range(len(P))):
+            return False
+    return True
+
+
+def _own_segment_free(cs, a, b) -> bool:
+    seg = exact_hull(_fr([a, b]))
+    return _own_free(cs, a) and _own_free(cs, b) and all(exact_relation(seg, _fr(p)) == "separated" for p in cs.pieces)
+
+
 def _cspace_case(robot_w: float, slack: float, offset: float = 0.0, repeats: int = 5):
+    """Passage queries. The C-space is exact on its C-obstacle pieces, whose vertices (obstacle
+    minus robot vertex) are rounded once. So: its answers must equal the exact answer on its own
+    pieces (always), and the exact answer on the true geometry whenever those differences are
+    representable; otherwise they may differ only for states within the rounding band of contact
+    (|true margin| <= 2 eps |coordinates|). Clearance within GJK's 1e-9 extent plus that band."""
     def run():
         from cspace import CSpace, scenario_from_dict
 
@@ -610,19 +664,28 @@ def _cspace_case(robot_w: float, slack: float, offset: float = 0.0, repeats: int
         seg = [cs.segment_free(left, right) for _ in range(repeats)]
         dt = time.perf_counter() - t
         consistent = all(len(set(f)) == 1 for f in free) and len(set(seg)) == 1
-        ref_free = [exact_free(sc, p) for p in probes]
-        ref_seg = exact_segment_free(sc, left, right)
-        wrong = sum(f[0] != r for f, r in zip(free, ref_free)) + (seg[0] != ref_seg)
-        err = float(wrong)
-        if ref_free[0]:
-            c = cs.clearance(centre)
-            err = max(err, abs(c - exact_clearance(sc, centre)))
-            bound = 1e-9 * 2 * robot_w
-        else:
-            c, bound = cs.clearance(centre), 0.0
-            err = max(err, abs(c))
-        ok = consistent and wrong == 0 and err <= bound
-        res = (f"free={free[0][0]} seg={seg[0]} clear={c:.3g} (exact free={ref_free[0]} seg={ref_seg})"
+        own_wrong = sum(f[0] != _own_free(cs, p) for f, p in zip(free, probes))
+        own_wrong += seg[0] != _own_segment_free(cs, left, right)
+        exact_sums = sums_representable(sc)
+        band = 2 * EPS * (abs(offset) + 10 * robot_w)
+        D = c_obstacles(sc)
+        truth_wrong, outside_band = 0, 0
+        margins = [min(_signed_margin(d, _fr([p])[0]) for d in D) for p in probes]
+        seg_truth = exact_segment_free(sc, left, right)
+        # The segment's answer hinges on its narrowest point, the passage centre (probe 0).
+        for got, truth, m2 in [(f[0], m > 0, m) for f, m in zip(free, margins)] + [(seg[0], seg_truth, margins[0])]:
+            if got != truth:
+                truth_wrong += 1
+                outside_band += exact_sums or abs(m2) > Fraction(band) ** 2
+        c = cs.clearance(centre)
+        ref_c = exact_clearance(sc, centre) if exact_free(sc, centre) else 0.0
+        c_err = abs(c - ref_c)
+        c_bound = 1e-9 * 20 * robot_w + band
+        err = max(float(own_wrong + outside_band), c_err)
+        ok = consistent and own_wrong == 0 and outside_band == 0 and c_err <= c_bound
+        res = (f"free={free[0][0]} seg={seg[0]} clear={c:.3g}; exact free={exact_free(sc, centre)} "
+               f"seg={exact_segment_free(sc, left, right)}"
+               + ("" if truth_wrong == 0 else f"; {truth_wrong} differ from true geometry within {band:.1g}")
                + ("" if consistent else " INCONSISTENT"))
         return res, err, ok, dt + t_build
     return run
@@ -753,6 +816,10 @@ def catalogue() -> list[Case]:
         for label, slack in (("exact", 0.0), ("wider", 1e-6 * w), ("narrower", -1e-6 * w)):
             add(f"cspace_{label}_w{w:g}_o{o:g}", "cspace", _cspace_case(w, slack, o),
                 "closed obstacles: touching is collision")
+    # non-dyadic widths far from the origin: the rounded C-obstacle closes a passage the true
+    # geometry leaves open by less than one ulp (decided consistently, within the rounding band)
+    for w, o in ((0.3, 1e8 + 0.1), (1 / 3, 1e8 / 3)):
+        add(f"cspace_exact_w{w:.3g}_o{o:.10g}", "cspace", _cspace_case(w, 0.0, o), "sums not representable")
 
     # planning (each <= 1 s)
     add("plan_exact_wider", "planning", _plan_case(1.0, 1e-6, 0.0, "exact", True))

@@ -130,6 +130,19 @@ def test_zero_clearance_is_collision_consistently():
         assert wider.is_free((o, o)) and wider.segment_free((o - 3 * w, o), (o + 3 * w, o))
 
 
+def test_non_representable_zero_clearance_is_decided_within_one_rounding():
+    """0.3-wide robot and passage at 1e8 + 0.1: the true float geometry leaves a gap below one ulp;
+    the C-space (its C-obstacle vertices rounded once) closes it, the same way every time."""
+    sc = cspace.scenario_from_dict(st.passage(0.3, 0.0, 1e8 + 0.1))
+    assert not st.sums_representable(sc)
+    q = (1e8 + 0.1, 1e8 + 0.1)
+    gap = st.exact_clearance(sc, q)
+    assert st.exact_free(sc, q) and 0 < gap <= 2 * st.EPS * 1e8
+    cs = cspace.CSpace.from_scenario(sc)
+    assert {cs.is_free(q) for _ in range(5)} == {False}
+    assert st._own_free(cs, q) is False  # exact on its own pieces
+
+
 # ---------------------------------------------------------------- the harness can fail
 
 
