@@ -19,21 +19,23 @@ never wraps a timed build).
 Reading the slopes (exponent k of the fitted power law y ~ x^k, least squares on
 log-log) against the theory, with the full run's figures (2-core machine, shared):
 - (a) obstacles. A convex sum is an O(n + m) angular merge, one per obstacle: the
-  sum stage fits k = 0.97 (theory 1). The whole build fits ~0.7, not 1, because
+  sum stage fits k = 0.97-1.05 (theory 1). The build fits 0.7-0.9, not 1, because
   it is dominated (60-85 %) by the grid index, whose cell count is 1024 per piece
   clamped to [2^16, 2^20]: constant below 64 pieces, linear up to 1024, then only
   the per-piece classification grows. Peak memory (~0.6) is the grid too: linear
   from 100 to 1000 obstacles (13 -> 136 MiB), nearly flat after (172 MiB at 10^4).
   Queries: theory O(1) at constant density (a state or a fixed-length motion meets
-  O(1) cells). is_free fits 0.17 and segment_free 0.20: flat to 1000 obstacles, then
+  O(1) cells). is_free fits ~0.18, segment_free 0.2-0.25: flat-ish to 1000, then
   the clamped grid's cells each hold more pieces (more MIXED cells, more exact
-  tests), so the cost creeps up; still ~1 us and ~35 us at 10 000 obstacles.
+  tests), so the cost creeps up; still ~1.5 us and ~40 us at 10 000 obstacles.
 - (b) vertices per obstacle. Theory O(n + m) per sum: the measured k ~0.5 is below
   1 because 20 sums of <= 1000 vertices each are dominated by numpy's per-call
   overhead (scripts/bench_minkowski.py shows the linear regime at 10^3..10^4). The
   index classifies every edge against its cells and grows ~linearly from 128
-  vertices on. Queries rise mildly (k ~0.3-0.4): FREE/BLOCKED cells are O(1), only
-  MIXED cells run the vectorised O(n) exact test.
+  vertices on. is_free rises mildly (k ~0.4): FREE/BLOCKED cells are O(1), only
+  MIXED cells run the vectorised O(n) exact test; segment_free stays within noise
+  (k between -0.05 and 0.3 across runs: ~10-40 us, mostly per-call overhead).
+  The machine is shared: slopes below ~0.3 move by +-0.2 from run to run.
 - (c) non-convex pairs. A comb with n teeth decomposes into n + 1 convex pieces,
   so there are (n+1)(m+1) pairwise sums: pairs fit ~1.7 and approach 2 (theory
   O(nm), n = m); build time ~1.4 (fixed costs at small n). The union of the pieces,
