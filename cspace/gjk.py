@@ -22,11 +22,13 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
+from itertools import chain
 from typing import NamedTuple
 
 import numpy as np
 
 from .polygon import as_array
+from .predicates import orient2d_cols
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -45,8 +47,11 @@ class Distance(NamedTuple):
     status: str
 
 
-def gjk_distance(A, B) -> Distance:
+def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
     """Distance and closest points of convex sets A and B (vertex arrays; points and segments too).
+
+    ``max_iterations`` caps the loop (the default is never reached on separated or
+    overlapping pairs; a capped answer is an upper bound on the distance).
 
     >>> d = gjk_distance([[0, 0], [1, 0], [1, 1], [0, 1]], [[3, 0], [4, 0], [4, 1], [3, 1]])
     >>> d.distance, d.status
@@ -59,19 +64,20 @@ def gjk_distance(A, B) -> Distance:
     origin = a[0].copy()
     al = (a - origin).tolist()
     bl = (b - origin).tolist()
-    dist, pa, pb, it, inside = _gjk(al, bl)
-    scale = _scale(al, bl)
+    dist, pa, pb, it, inside = _gjk(al, bl, max_iterations)
+    ox, oy = origin.tolist()
     if inside == "deep":
-        p = np.array(pa) + origin
+        p = np.array((pa[0] + ox, pa[1] + oy))
         return Distance(0.0, p, p.copy(), it, "overlapping")
-    if inside or dist <= EXACT_BAND * scale:
+    if inside or dist <= EXACT_BAND * _scale(al, bl):
         status = exact_relation(a, b)
         if status != "separated":
-            p = np.array(pa) + origin
+            p = np.array((pa[0] + ox, pa[1] + oy))
             return Distance(0.0, p, p.copy(), it, status)
         if inside:  # float said overlap but exact says apart: a sliver gap, measure it exactly
             dist, pa, pb = _exact_distance(a, b, origin)
-    return Distance(float(dist), np.array(pa) + origin, np.array(pb) + origin, it, "separated")
+    return Distance(float(dist), np.array((pa[0] + ox, pa[1] + oy)), np.array((pb[0] + ox, pb[1] + oy)),
+                    it, "separated")
 
 
 def gjk_intersects(A, B) -> bool:
@@ -84,11 +90,8 @@ def gjk_intersects(A, B) -> bool:
 
 
 def _scale(al: list, bl: list) -> float:
-    m = 0.0
-    for x, y in al:
-        m = max(m, abs(x), abs(y))
-    for x, y in bl:
-        m = max(m, abs(x), abs(y))
+    """Largest coordinate magnitude in the local frame (1 for two points at the origin)."""
+    m = max(map(abs, chain.from_iterable(al + bl)))
     return m if m > 0.0 else 1.0
 
 
@@ -102,45 +105,55 @@ def _support(pts: list, dx: float, dy: float) -> int:
     return bi
 
 
-def _gjk(al: list, bl: list):
+def _gjk(al: list, bl: list, max_iterations: int = MAX_ITERATIONS):
     """The GJK loop in the local frame. Returns (distance, pa, pb, iterations, origin_inside)."""
     # Simplex vertices: (ia, ib, wx, wy) with w = a[ia] - b[ib]; weights lam.
-    ia, ib = 0, 0
-    simplex = [(ia, ib, al[0][0] - bl[0][0], al[0][1] - bl[0][1])]
+    simplex = [(0, 0, al[0][0] - bl[0][0], al[0][1] - bl[0][1])]
     lam = [1.0]
     it = 0
     inside = False
-    vx, vy = simplex[0][2], simplex[0][3]
-    while it < MAX_ITERATIONS:
+    while it < max_iterations:
         it += 1
         simplex, lam = _solve(simplex)
         if len(simplex) == 3:
             inside = True
             break
-        vx = sum(l * s[2] for l, s in zip(lam, simplex))
-        vy = sum(l * s[3] for l, s in zip(lam, simplex))
+        vx, vy = _combine(lam, simplex, 2, 3)
         vv = vx * vx + vy * vy
         if vv == 0.0:
             inside = True
             break
         ia = _support(al, -vx, -vy)
         ib = _support(bl, vx, vy)
-        if any(s[0] == ia and s[1] == ib for s in simplex):
+        if (ia, ib) in [(s[0], s[1]) for s in simplex]:
             break  # the support is already in the simplex: converged (or cycling)
         wx, wy = al[ia][0] - bl[ib][0], al[ia][1] - bl[ib][1]
         if vv - (vx * wx + vy * wy) <= REL_TOL * vv:
             break  # no progress towards the origin
         simplex.append((ia, ib, wx, wy))
         lam.append(0.0)
-    pax = sum(l * al[s[0]][0] for l, s in zip(lam, simplex))
-    pay = sum(l * al[s[0]][1] for l, s in zip(lam, simplex))
-    pbx = sum(l * bl[s[1]][0] for l, s in zip(lam, simplex))
-    pby = sum(l * bl[s[1]][1] for l, s in zip(lam, simplex))
+    # Closest points: the same weights on the simplex's vertices of A and of B.
+    pax, pay = _combine(lam, [al[s[0]] for s in simplex], 0, 1)
+    pbx, pby = _combine(lam, [bl[s[1]] for s in simplex], 0, 1)
     if inside:
         # Certain overlap when the origin is deep inside the simplex (beyond any rounding).
         deep = len(simplex) == 3 and _depth_in_triangle(simplex) > EXACT_BAND * _scale(al, bl)
         return 0.0, (pax, pay), (pax, pay), it, "deep" if deep else True
     return math.hypot(pax - pbx, pay - pby), (pax, pay), (pbx, pby), it, False
+
+
+def _combine(lam: list, pts: list, ix: int, iy: int) -> tuple[float, float]:
+    """The point sum(lam[k] * pts[k]) of coordinates (pts[k][ix], pts[k][iy])."""
+    if len(lam) == 1:
+        return pts[0][ix], pts[0][iy]
+    p, q = pts[0], pts[1]
+    x = lam[0] * p[ix] + lam[1] * q[ix]
+    y = lam[0] * p[iy] + lam[1] * q[iy]
+    if len(lam) == 3:
+        r = pts[2]
+        x += lam[2] * r[ix]
+        y += lam[2] * r[iy]
+    return x, y
 
 
 def _solve(simplex: list):
@@ -221,9 +234,7 @@ def _depth_in_triangle(simplex: list) -> float:
 
 
 def _norm2(c) -> float:
-    simplex, lam = c
-    vx = sum(l * s[2] for l, s in zip(lam, simplex))
-    vy = sum(l * s[3] for l, s in zip(lam, simplex))
+    vx, vy = _combine(c[1], c[0], 2, 3)
     return vx * vx + vy * vy
 
 
@@ -244,17 +255,41 @@ def exact_relation(A, B) -> str:
     """
     from .hull import convex_hull
 
-    ha = [(Fraction(x), Fraction(y)) for x, y in convex_hull(as_array(A)).tolist()]
-    hb = [(Fraction(x), Fraction(y)) for x, y in convex_hull(as_array(B)).tolist()]
+    ga = convex_hull(as_array(A))
+    gb = convex_hull(as_array(B))
+    if len(ga) >= 3 and len(gb) >= 3:
+        return _relation_polygons(ga, gb)
+    ha = [(Fraction(x), Fraction(y)) for x, y in ga.tolist()]
+    hb = [(Fraction(x), Fraction(y)) for x, y in gb.tolist()]
     weak = False
     for ax in _axes(ha, hb):
         pa = [ax[0] * x + ax[1] * y for x, y in ha]
         pb = [ax[0] * x + ax[1] * y for x, y in hb]
-        for lo_a, hi_a, lo_b, hi_b in ((min(pa), max(pa), min(pb), max(pb)),):
-            if hi_a < lo_b or hi_b < lo_a:
-                return "separated"
-            if hi_a == lo_b or hi_b == lo_a:
-                weak = True
+        lo_a, hi_a, lo_b, hi_b = min(pa), max(pa), min(pb), max(pb)
+        if hi_a < lo_b or hi_b < lo_a:
+            return "separated"
+        if hi_a == lo_b or hi_b == lo_a:
+            weak = True
+    return "touching" if weak else "overlapping"
+
+
+def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:
+    """Separating axis test for two convex polygons (CCW hulls) with the exact predicate.
+
+    An edge of A separates iff every vertex of B lies right of its directed line
+    (orient2d < 0), weakly iff on or right of it; the same with A and B swapped.
+    Disjoint compact convex polygons always have a strictly separating edge line,
+    so no strict separator and a weak one means the sets touch.
+    """
+    weak = False
+    for g, h in ((ga, gb), (gb, ga)):
+        e0 = g[:, None, :]
+        e1 = np.roll(g, -1, axis=0)[:, None, :]
+        s = orient2d_cols(e0[..., 0], e0[..., 1], e1[..., 0], e1[..., 1], h[None, :, 0], h[None, :, 1])
+        outside = (s <= 0).all(axis=1)
+        if (outside & (s < 0).all(axis=1)).any():
+            return "separated"
+        weak = weak or bool(outside.any())
     return "touching" if weak else "overlapping"
 
 

@@ -1,8 +1,9 @@
 """GJK distance and EPA depth: per-query time, iterations, and peers in the same run.
 
-Pairs of random convex 8- and 64-gons, separated, touching (moved into exact contact along x)
-and overlapping. Peers: coal (C++, via its Python bindings; 2-D polygons as thin prisms) when it
-imports, and shapely's distance. Medians over repetitions; ratios printed.
+Pairs of random convex 8- and 64-gons, separated, touching (moved into contact along x)
+and overlapping. Peers: coal (C++, via its Python bindings; 2-D polygons as unit prisms) when it
+imports, and shapely's distance. EPA depths are checked against the exact depth of the
+materialised difference, for ours and for coal. Medians over repetitions; ratios printed.
 Usage: python scripts/bench_gjk.py [--pairs N] [--plot FILE]
 """
 import argparse
@@ -12,8 +13,9 @@ import time
 import numpy as np
 
 from cspace.epa import epa_penetration
-from cspace.gjk import gjk_distance
+from cspace.gjk import exact_relation, gjk_distance
 from cspace.hull import convex_hull
+from cspace.minkowski import minkowski_sum, reflect
 
 
 def rand_convex(rng, n, c):
@@ -31,79 +33,150 @@ def median_time(fn, pairs, reps=20):
     return statistics.median(t)
 
 
-def coal_shapes():
+def coal_api():
+    """coal's distance and penetration on 2-D polygons as unit-height prisms, or None.
+
+    coal is 3-D: a polygon becomes a prism (bottom and top fans plus two triangles per
+    side), built once per shape outside the timing. Two query styles are timed: a
+    fresh request/result per query (what a caller usually writes) and reused ones.
+    """
     try:
         import coal
     except ImportError:
         return None
 
     def prism(P):
-        v = [np.array([x, y, z]) for z in (-0.5, 0.5) for x, y in P]
         n = len(P)
-        return coal.Convex.convexHull(coal.StdVec_Vec3s(v) if hasattr(coal, "StdVec_Vec3s") else v, False, "") \
-            if hasattr(coal.Convex, "convexHull") else None
+        v = coal.StdVec_Vec3s()
+        for z in (-0.5, 0.5):
+            for x, y in P:
+                v.append(np.array([x, y, z]))
+        t = coal.StdVec_Triangle()
+        for i in range(1, n - 1):
+            t.append(coal.Triangle(0, i + 1, i))
+            t.append(coal.Triangle(n, n + i, n + i + 1))
+        for i in range(n):
+            j = (i + 1) % n
+            t.append(coal.Triangle(i, j, n + j))
+            t.append(coal.Triangle(i, n + j, n + i))
+        return coal.Convex(v, t)
 
-    def dist(A, B):
-        req, res = coal.DistanceRequest(), coal.DistanceResult()
-        return coal.distance(A, coal.Transform3s(), B, coal.Transform3s(), req, res)
+    eye = coal.Transform3s()
+    req, res = coal.DistanceRequest(), coal.DistanceResult()
 
-    return prism, dist
+    def dist_fresh(A, B):
+        return coal.distance(A, eye, B, eye, coal.DistanceRequest(), coal.DistanceResult())
+
+    def dist_reused(A, B):
+        return coal.distance(A, eye, B, eye, req, res)
+
+    def depth(A, B):
+        creq = coal.CollisionRequest()
+        creq.enable_contact = True
+        cres = coal.CollisionResult()
+        coal.collide(A, eye, B, eye, creq, cres)
+        return -cres.getContact(0).penetration_depth if cres.isCollision() else 0.0
+
+    return prism, dist_fresh, dist_reused, depth
+
+
+def make_pairs(rng, n, case, count):
+    """Pairs of n-gons of radius 1: separated (centres 3 apart), touching, overlapping."""
+    pairs = []
+    while len(pairs) < count:
+        A = rand_convex(rng, n, (0, 0))
+        off = {"separated": 3.0, "touching": 2.0, "overlapping": 1.0}[case]
+        B = rand_convex(rng, n, (off, rng.uniform(-0.5, 0.5)))
+        if case == "touching":  # slide B along x into contact
+            d = gjk_distance(A, B)
+            B[:, 0] -= d.distance if d.status == "separated" else 0.0
+        # Keep the pair only if the exact relation is the case's (random gons may miss).
+        if exact_relation(A, B) == case or (case == "touching" and gjk_distance(A, B).distance < 1e-12):
+            pairs.append((A, B))
+    return pairs
+
+
+def exact_depth(A, B):
+    """Penetration depth from the materialised A ⊕ (−B): distance from the origin to its boundary."""
+    import shapely
+
+    D = shapely.Polygon(minkowski_sum(A, reflect(B)))
+    return D.exterior.distance(shapely.Point(0, 0))
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--pairs", type=int, default=50)
-    ap.add_argument("--plot", default=None)
+    ap.add_argument("--plot", default=None, help="PNG: distance error against the iteration cap")
     args = ap.parse_args()
     import shapely
 
     rng = np.random.default_rng(0)
-    coal_api = coal_shapes()
-    print(f"{'n':>3} {'case':<12} {'ours':>9} {'iters':>6} {'shapely':>9} {'coal':>9} {'ours/coal':>9}")
-    rows = []
+    peer = coal_api()
+    print("GJK distance, per query (median over pairs of 20 repetitions each)")
+    print(f"{'n':>3} {'case':<12} {'ours':>9} {'iters':>6} {'max':>4} {'shapely':>9} {'coal new':>9} "
+          f"{'coal reuse':>10} {'ours/coal new':>13} {'ours/coal reuse':>15}")
     for n in (8, 64):
         for case in ("separated", "touching", "overlapping"):
-            pairs = []
-            for _ in range(args.pairs):
-                A = rand_convex(rng, n, (0, 0))
-                off = {"separated": 3.0, "touching": 2.0, "overlapping": 1.0}[case]
-                B = rand_convex(rng, n, (off, rng.uniform(-0.5, 0.5)))
-                if case == "touching":  # slide B along x into exact contact
-                    B[:, 0] -= gjk_distance(A, B).distance if gjk_distance(A, B).status == "separated" else 0.0
-                pairs.append((A, B))
+            pairs = make_pairs(rng, n, case, args.pairs)
             ours = median_time(gjk_distance, pairs)
-            its = statistics.mean(gjk_distance(A, B).iterations for A, B in pairs)
+            its = [gjk_distance(A, B).iterations for A, B in pairs]
             sp = [(shapely.Polygon(A), shapely.Polygon(B)) for A, B in pairs]
             shp = median_time(lambda a, b: a.distance(b), sp)
-            coal_t = float("nan")
-            if coal_api is not None:
-                prism, dist = coal_api
-                try:
-                    cp = [(prism(A), prism(B)) for A, B in pairs]
-                    if cp[0][0] is not None:
-                        coal_t = median_time(dist, cp)
-                except Exception:  # the bindings' signatures differ between versions
-                    coal_t = float("nan")
-            rows.append((n, case, ours, its))
-            print(f"{n:>3} {case:<12} {ours * 1e6:>7.1f}us {its:>6.2f} {shp * 1e6:>7.1f}us {coal_t * 1e6:>7.1f}us "
-                  f"{ours / coal_t:>9.2f}")
-        pairs = []
-        for _ in range(args.pairs):
-            pairs.append((rand_convex(rng, n, (0, 0)), rand_convex(rng, n, (1.0, rng.uniform(-0.5, 0.5)))))
-        epa = median_time(epa_penetration, pairs)
-        its = statistics.mean(epa_penetration(A, B).iterations for A, B in pairs)
-        print(f"{n:>3} {'EPA':<12} {epa * 1e6:>7.1f}us {its:>6.2f}")
+            fresh = reused = float("nan")
+            if peer is not None:
+                cp = [(peer[0](A), peer[0](B)) for A, B in pairs]
+                fresh, reused = median_time(peer[1], cp), median_time(peer[2], cp)
+            print(f"{n:>3} {case:<12} {ours * 1e6:>7.1f}us {statistics.mean(its):>6.2f} {max(its):>4} "
+                  f"{shp * 1e6:>7.1f}us {fresh * 1e6:>7.2f}us {reused * 1e6:>8.2f}us "
+                  f"{ours / fresh:>13.1f} {ours / reused:>15.1f}")
+    print("\nEPA penetration depth on overlapping pairs: time, and error against the exact depth of the")
+    print("materialised A ⊕ (−B) (relative to the sets' size 1)")
+    print(f"{'n':>3} {'ours':>9} {'iters':>6} {'max err':>9} {'coal':>9} {'coal max err':>12} {'coal wrong>1e-9':>15}")
+    for n in (8, 64):
+        pairs = make_pairs(rng, n, "overlapping", max(32, args.pairs // 2))
+        epa = median_time(epa_penetration, pairs, reps=5)
+        res = [epa_penetration(A, B) for A, B in pairs]
+        ref = [exact_depth(A, B) for A, B in pairs]
+        err = max(abs(r.depth - e) for r, e in zip(res, ref))
+        ct, cerr, wrong = float("nan"), float("nan"), "-"
+        if peer is not None:
+            cp = [(peer[0](A), peer[0](B)) for A, B in pairs]
+            ct = median_time(peer[3], cp, reps=5)
+            ce = [abs(peer[3](a, b) - e) for (a, b), e in zip(cp, ref)]
+            cerr, wrong = max(ce), f"{sum(e > 1e-9 for e in ce)}/{len(ce)}"
+        print(f"{n:>3} {epa * 1e6:>7.1f}us {statistics.mean(r.iterations for r in res):>6.2f} {err:>9.1e} "
+              f"{ct * 1e6:>7.1f}us {cerr:>12.1e} {wrong:>15}")
+    print("\nGJK distance error against the iteration cap (separated pairs; reference: shapely)")
+    caps = [1, 2, 3, 4, 5, 6, 8]
+    table = {}
+    for n in (8, 64):
+        pairs = make_pairs(rng, n, "separated", args.pairs)
+        ref = [shapely.Polygon(A).distance(shapely.Polygon(B)) for A, B in pairs]
+        table[n] = [statistics.median(abs(gjk_distance(A, B, max_iterations=c).distance - r) / r
+                                      for (A, B), r in zip(pairs, ref)) for c in caps]
+        table[n, "max"] = [max(abs(gjk_distance(A, B, max_iterations=c).distance - r) / r
+                               for (A, B), r in zip(pairs, ref)) for c in caps]
+    print(f"{'cap':>4} " + " ".join(f"{'median ' + str(n):>12} {'max ' + str(n):>10}" for n in (8, 64)))
+    for i, c in enumerate(caps):
+        print(f"{c:>4} " + " ".join(f"{table[n][i]:>12.1e} {table[n, 'max'][i]:>10.1e}" for n in (8, 64)))
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        fig, ax = plt.subplots(figsize=(6, 3.5))
-        labels = [f"{n}/{c[:4]}" for n, c, _, _ in rows]
-        ax.bar(labels, [t * 1e6 for _, _, t, _ in rows])
-        ax.set_ylabel("µs per GJK distance query")
+        fig, ax = plt.subplots(figsize=(5.5, 3.8))
+        for n in (8, 64):
+            floor = 1e-17  # exact answers drawn at the floor of the log axis
+            ax.semilogy(caps, [max(v, floor) for v in table[n]], "o-", label=f"{n}-gons, median")
+            ax.semilogy(caps, [max(v, floor) for v in table[n, "max"]], "s--", label=f"{n}-gons, max")
+        ax.set_xlabel("GJK iteration cap")
+        ax.set_ylabel("relative distance error vs shapely")
+        ax.set_title("GJK convergence (separated pairs)")
+        ax.legend()
         fig.tight_layout()
-        fig.savefig(args.plot)
+        fig.savefig(args.plot, dpi=120)
+        print(f"plot: {args.plot}")
 
 
 if __name__ == "__main__":
