@@ -195,7 +195,10 @@ class GridIndex:
                 continue
             if sat[j1 + 1][i1 + 1] - sat[j0][i1 + 1] - sat[j1 + 1][i0] + sat[j0][i0] == 0:
                 continue  # every cell near this piece of the segment is FREE
-            if (i1 - i0) < 2 and (j1 - j0) < 2:
+            # A leaf: at most 2 x 2 cells, or a piece shorter than a cell (the margin may
+            # span many cells when the scene is tiny against its coordinates, and halving
+            # cannot shrink the widened box then), or one floats can no longer halve.
+            if ((i1 - i0) < 2 and (j1 - j0) < 2) or (abs(qx - px) * iw < 1.0 and abs(qy - py) * ih < 1.0):
                 for j in range(j0, j1 + 1):
                     for i in range(i0, i1 + 1):
                         c = j * nx + i
@@ -210,6 +213,10 @@ class GridIndex:
                             cands.update(self._cand_list[self._starts_list[c]:self._starts_list[c + 1]])
                 continue
             mx, my = 0.5 * (px + qx), 0.5 * (py + qy)
+            if (mx == px and my == py) or (mx == qx and my == qy):
+                stack.append((px, py, px, py))  # cannot halve: one more pass as a leaf
+                stack.append((qx, qy, qx, qy))
+                continue
             stack.append((mx, my, qx, qy))
             stack.append((px, py, mx, my))
         return blockers, cands

@@ -820,6 +820,12 @@ def catalogue() -> list[Case]:
     # geometry leaves open by less than one ulp (decided consistently, within the rounding band)
     for w, o in ((0.3, 1e8 + 0.1), (1 / 3, 1e8 / 3)):
         add(f"cspace_exact_w{w:.3g}_o{o:.10g}", "cspace", _cspace_case(w, 0.0, o), "sums not representable")
+    # scenes far smaller than their coordinates (extent ~1e-13 |coordinate|): the broad phase's
+    # margin spans many grid cells, and its segment walk must still terminate
+    for w, o in ((1e-5, 1e8 + 0.1), (1e-3, 1e9)):
+        for label, slack in (("exact", 0.0), ("wider", 1e-6 * w)):
+            add(f"cspace_tiny_{label}_w{w:g}_o{o:.10g}", "cspace", _cspace_case(w, slack, o),
+                "extent near the float resolution of the coordinates")
 
     # planning (each <= 1 s)
     add("plan_exact_wider", "planning", _plan_case(1.0, 1e-6, 0.0, "exact", True))
