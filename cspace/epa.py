@@ -45,7 +45,11 @@ def epa_penetration(A, B) -> Penetration:
     b = as_array(B)
     d = gjk_distance(a, b)
     if d.status == "separated":
-        n = (d.point_b - d.point_a) / d.distance
+        # The closest points are rounded in the global frame: normalise their difference
+        # rather than divide by the (local-frame) distance, so the normal is a unit vector.
+        v = d.point_b - d.point_a
+        nv = math.hypot(v[0], v[1])
+        n = v / nv if nv > 0.0 else np.array([1.0, 0.0])
         return Penetration(0.0, n, d.iterations, "separated")
     origin = a[0].copy()
     al, bl = a - origin, b - origin
