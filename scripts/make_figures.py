@@ -1,0 +1,153 @@
+"""Regenerate every figure of the user guide (docs/guide.md) from the bundled scenarios.
+
+One command, no hand-edited pictures:
+
+    python scripts/make_figures.py [--out docs/figures] [--only basic,families,circles,...] [--list]
+
+Each figure is a plan with a fixed seed (``cspace plan --plot``), a C-space picture
+(``cspace show --plot``), the exact shortest path, the circles multi-query run, or the
+stability chart. PNGs are written atomically (temporary file, then rename) by
+:mod:`planners.plot`, so an interrupted run never leaves a half-written picture.
+``--only`` takes figure names or group names (see ``--list``). The whole set takes
+well under two minutes on a laptop core.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCENARIOS = os.path.join(ROOT, "scenarios")
+
+# One picture per scenario family (plan and C-space), with the seed each plan uses.
+FAMILIES = ("maze", "bug_trap", "narrow_passage", "random_polygons", "disks", "office", "combs", "parts", "theta")
+SEED = 1
+
+
+@dataclass
+class Figure:
+    """One PNG of the guide: its file name, its group and how to draw it."""
+
+    name: str
+    group: str
+    what: str
+    draw: Callable[[str], str]  # output path -> one-line summary
+
+
+def _scenario(name: str) -> str:
+    return os.path.join(SCENARIOS, f"{name}.toml")
+
+
+def plan_figure(scenario: str, planner: str | None = None, seed: int = SEED) -> Callable[[str], str]:
+    """A plan of the scenario with its own [planner] defaults (or ``planner``), as ``cspace plan --plot``."""
+
+    def draw(out: str) -> str:
+        from planners.plan import plan
+        from planners.plot import plot_result
+
+        res = plan(_scenario(scenario), planner=planner, seed=seed)
+        plot_result(res, out)
+        state = f"length {res.length:.6g}" if res.solved else "not solved"
+        return f"{res.planner} seed {res.seed}: {state}"
+
+    return draw
+
+
+def cspace_figure(scenario: str) -> Callable[[str], str]:
+    """Workspace, C-obstacles and their convex pieces, as ``cspace show --plot``."""
+
+    def draw(out: str) -> str:
+        from cspace.cspace import CSpace
+        from cspace.scenario import load_scenario
+        from planners.plot import plot_scene
+
+        sc = load_scenario(_scenario(scenario))
+        cs = CSpace.from_scenario(sc)
+        plot_scene(sc, cs, out)
+        return f"{len(cs.pieces)} C-obstacle pieces"
+
+    return draw
+
+
+def circles_figure(time_limit: float = 1.0, seed: int = 0) -> Callable[[str], str]:
+    """OMPL's circles problem: all 100 queries at ``time_limit`` each, on one C-space."""
+
+    def draw(out: str) -> str:
+        from planners.plan import plan
+        from planners.plot import plot_result
+
+        res = plan(os.path.join(SCENARIOS, "ompl", "circles.toml"), time=time_limit, seed=seed, all_queries=True)
+        plot_result(res, out)
+        solved = [q for q in res.queries if q.solved]
+        mean = sum(q.length for q in solved) / max(len(solved), 1)
+        return f"{len(solved)}/{len(res.queries)} solved, mean length {mean:.4g}"
+
+    return draw
+
+
+def stability_figure(out: str) -> str:
+    """The stability catalogue's chart, as ``cspace stability --plot``."""
+    from planners import stability
+
+    rows = stability.run_all()
+    stability.plot(rows, out)
+    passed = sum(1 for r in rows if r["passed"])
+    return f"{passed}/{len(rows)} cases pass"
+
+
+def figures() -> list[Figure]:
+    """Every figure the guide uses, in the guide's order."""
+    out = [
+        Figure("basic_plan", "basic", "first plan: basic.toml, RRTConnect", plan_figure("basic")),
+        Figure("basic_cspace", "basic", "C-space of basic.toml", cspace_figure("basic")),
+        Figure("basic_exact", "basic", "exact shortest path of basic.toml", plan_figure("basic", planner="exact")),
+    ]
+    for fam in FAMILIES:
+        out.append(Figure(f"{fam}_cspace", "families", f"C-space of {fam}.toml", cspace_figure(fam)))
+        out.append(Figure(f"{fam}_plan", "families", f"plan of {fam}.toml", plan_figure(fam)))
+    out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
+    out.append(Figure("stability", "stability", "stability catalogue", stability_figure))
+    return out
+
+
+def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
+    """The figures named by ``--only`` (names or groups, comma-separated); all when None."""
+    if not only:
+        return all_figs
+    keys = {k.strip() for k in only.split(",") if k.strip()}
+    known = {f.name for f in all_figs} | {f.group for f in all_figs}
+    unknown = keys - known
+    if unknown:
+        raise SystemExit(f"error: --only: unknown figure or group: {', '.join(sorted(unknown))} "
+                         f"(see --list)")
+    return [f for f in all_figs if f.name in keys or f.group in keys]
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "figures"), help="folder for the PNGs")
+    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, circles, stability)")
+    ap.add_argument("--list", action="store_true", help="list the figures and exit")
+    args = ap.parse_args(argv)
+    figs = select(figures(), args.only)
+    if args.list:
+        for f in figs:
+            print(f"{f.name:<24} {f.group:<10} {f.what}")
+        return 0
+    os.makedirs(args.out, exist_ok=True)
+    t_all = time.perf_counter()
+    for f in figs:
+        path = os.path.join(args.out, f"{f.name}.png")
+        t = time.perf_counter()
+        note = f.draw(path)
+        print(f"{path}: {f.what}; {note} ({time.perf_counter() - t:.1f} s)", flush=True)
+    print(f"{len(figs)} figures in {time.perf_counter() - t_all:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
