@@ -1,0 +1,678 @@
+"""``cspace bench``: error against run time for OMPL planners, measured against the exact shortest path.
+
+This module owns the benchmark sweep: scenarios x planners x time budgets x seeded runs,
+each run isolated in its own process (a planner that segfaults or hangs costs one row,
+recorded as ``crashed`` or ``timeout``, never the sweep), run locally by ``--workers``
+threads that each wait on one child process, or on a Dask cluster (``--scheduler``).
+It also owns the outputs: ``results.csv``, ``results.json``, one OMPL benchmark log per
+(scenario, budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns
+them into the Planner Arena database) and the ``error_vs_time.png`` figure.
+
+The reference is the exact shortest path (:mod:`cspace.shortest`), computed once per
+scenario in the parent. It is an infimum (it touches C-obstacle boundaries), so every
+verified planner path is at least as long: ``error = length / optimum - 1 >= 0``.
+
+Rows are sorted by (scenario, planner, budget, seed) in the order given on the command
+line, so the same sweep gives the same rows whatever the number of workers (timings aside;
+anytime planners stopped by a clock are not deterministic anyway, planners that stop at
+their first solution are).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+from .errors import InputError
+
+DEFAULT_PLANNERS = ("RRTConnect", "RRTstar", "PRMstar", "BITstar")
+DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
+# Hard limit of one run: budget x HARD_FACTOR + HARD_MARGIN seconds (process start,
+# C-space build, simplification and verification all fit many times over).
+HARD_FACTOR = 2.0
+HARD_MARGIN = 30.0
+# Anytime planners are solved in slices of budget / SLICES (at least MIN_SLICE s) to
+# time their first solution and record the best raw cost along the run.
+SLICES = 20
+MIN_SLICE = 0.002
+SLICED = {"rrtstar", "informedrrtstar", "sorrtstar", "bitstar", "prm", "prmstar"}  # not AORRTC: it crashes
+# Fields of a row, in CSV order. Times in seconds; lengths in scenario units.
+FIELDS = (
+    "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
+    "length", "length_unsimplified", "optimum", "error", "error_unsimplified",
+    "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks",
+    "wall_s", "message",
+)
+TIMING_FIELDS = ("first_solution_s", "solve_s", "simplify_s", "wall_s")
+STATUSES = ("ok", "crashed", "timeout")
+_MARK = "CSPACE_BENCH_ROW "
+
+
+# ---------------------------------------------------------------- command line
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("bench", help="error against run time for OMPL planners vs the exact shortest path",
+                       description="Benchmark OMPL planners: path length error against the exact shortest "
+                                   "path, per time budget. Exit 0 done, 2 bad input, 130 interrupted "
+                                   "(finished rows are written).")
+    p.add_argument("scenario", nargs="+", help="scenario TOML files")
+    p.add_argument("--planners", default=",".join(DEFAULT_PLANNERS),
+                   help=f"comma-separated OMPL planners (default {','.join(DEFAULT_PLANNERS)})")
+    p.add_argument("--times", default=",".join(f"{t:g}" for t in DEFAULT_TIMES),
+                   help="comma-separated time budgets in seconds (default 0.01,0.03,0.1,0.3,1)")
+    p.add_argument("--runs", type=int, default=10, help="seeded runs per planner and budget (seeds 0..N-1)")
+    p.add_argument("--iterations", type=int, help="also stop each run after this many planner iterations")
+    p.add_argument("--workers", type=int, default=1, help="runs in parallel (local processes)")
+    p.add_argument("--out", default="bench_out", help="output folder (created if missing)")
+    p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on")
+    p.add_argument("--no-plot", action="store_true", help="skip error_vs_time.png")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress line")
+    # Test hook: the child of this (planner, seed) calls os.abort(), as a segfaulting planner would.
+    p.add_argument("--abort-on", help=argparse.SUPPRESS)
+    p.set_defaults(run=run)
+
+
+def parse_planners(text: str, source: str = "bench") -> list[str]:
+    """Canonical OMPL planner names from a comma-separated list (``exact`` is the reference, not a contestant).
+
+    >>> parse_planners("rrtconnect,BITstar")
+    ['RRTConnect', 'BITstar']
+    """
+    from .ompl_glue import PLANNERS
+
+    table = {p.lower(): p for p in PLANNERS}
+    names = [s.strip() for s in str(text).split(",") if s.strip()]
+    if not names:
+        raise InputError(source, "--planners", "empty list")
+    out = []
+    for n in names:
+        canon = table.get(n.lower())
+        if canon is None:
+            raise InputError(source, "--planners", f"unknown planner {n!r} (choose from: {', '.join(PLANNERS)})")
+        if canon in out:
+            raise InputError(source, "--planners", f"planner {canon} given twice")
+        out.append(canon)
+    return out
+
+
+def parse_times(text: str, source: str = "bench") -> list[float]:
+    """Time budgets from a comma-separated list: positive, finite, distinct; returned sorted.
+
+    >>> parse_times("1,0.01,0.1")
+    [0.01, 0.1, 1.0]
+    """
+    parts = [s.strip() for s in str(text).split(",")]
+    if not parts or any(not s for s in parts):
+        raise InputError(source, "--times", f"expected comma-separated seconds, got {text!r}")
+    out = []
+    for s in parts:
+        try:
+            t = float(s)
+        except ValueError:
+            raise InputError(source, "--times", f"not a number: {s!r}") from None
+        if not (math.isfinite(t) and t > 0):
+            raise InputError(source, "--times", f"must be positive seconds, got {s!r}")
+        if t in out:
+            raise InputError(source, "--times", f"budget {s} given twice")
+        out.append(t)
+    return sorted(out)
+
+
+def run(args) -> int:
+    planners = parse_planners(args.planners)
+    times = parse_times(args.times)
+    if args.runs < 1:
+        raise InputError("bench", "--runs", f"must be at least 1, got {args.runs}")
+    if args.workers < 1:
+        raise InputError("bench", "--workers", f"must be at least 1, got {args.workers}")
+    if args.iterations is not None and args.iterations < 1:
+        raise InputError("bench", "--iterations", f"must be at least 1, got {args.iterations}")
+    abort_on = None
+    if args.abort_on:
+        name, _, seed = args.abort_on.partition(":")
+        abort_on = (parse_planners(name)[0], int(seed or 0))
+    out = args.out
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise InputError(out, "--out", "exists and is not a folder")
+    scenarios = reference(args.scenario, quiet=args.quiet)
+    os.makedirs(out, exist_ok=True)
+    tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on)
+    t0 = time.perf_counter()
+    rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet)
+    meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
+            "iterations": args.iterations, "workers": args.workers, "scheduler": args.scheduler,
+            "wall_s": time.perf_counter() - t0, "complete": not interrupted,
+            "hard_limit": f"budget * {HARD_FACTOR:g} + {HARD_MARGIN:g} s"}
+    write_outputs(rows, out, meta, plot=not args.no_plot)
+    if not args.quiet:
+        sys.stderr.write(summary(rows) + "\n")
+        sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
+                         + (" (interrupted)" if interrupted else "") + "\n")
+    return 130 if interrupted else 0
+
+
+# ---------------------------------------------------------------- the reference
+
+def reference(files: list[str], quiet: bool = True) -> list[dict]:
+    """Load each scenario and compute its exact shortest path length once.
+
+    Returns ``[{"file", "scenario", "optimum"}]`` (``optimum`` None if no path exists).
+    A missing or malformed file is a ScenarioError (exit 2).
+    """
+    from cspace.scenario import load_scenario
+
+    from .plan import plan
+
+    out = []
+    for f in files:
+        sc = load_scenario(f)
+        res = plan(sc, planner="exact")
+        out.append({"file": os.path.abspath(f), "scenario": sc.name,
+                    "optimum": float(res.length) if res.solved else None})
+        if not quiet:
+            sys.stderr.write(f"{sc.name}: exact shortest path {res.length:.6g} ({res.message})\n")
+    return out
+
+
+def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None) -> list[dict]:
+    """One task per (scenario, planner, budget, seed), in the deterministic row order."""
+    tasks = []
+    for si, sc in enumerate(scenarios):
+        for pi, p in enumerate(planners):
+            for t in times:
+                for seed in range(runs):
+                    tasks.append({"order": [si, pi, t, seed], "file": sc["file"], "scenario": sc["scenario"],
+                                  "optimum": sc["optimum"], "planner": p, "time_budget": t, "seed": seed,
+                                  "iterations": iterations, "abort": abort_on == (p, seed)})
+    return tasks
+
+
+# ---------------------------------------------------------------- one run (in the child)
+
+def run_one(task: dict) -> dict:
+    """Plan one seeded run in this process and return its row (status ``ok``).
+
+    The path is simplified and verified exactly as ``cspace plan`` does; a run is
+    solved only if the final path passes the exact segment test.
+    """
+    from cspace.cspace import CSpace
+    from cspace.scenario import load_scenario
+
+    from .ompl_glue import make_setup, ompl, path_states, set_query, termination
+    from .plan import _snap, _verify, path_length
+
+    if task.get("abort"):
+        os.abort()
+    ob = ompl()[0]
+    sc = load_scenario(task["file"])
+    cs = CSpace.from_scenario(sc)
+    q = sc.all_queries()[0]
+    planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
+    ss, space, _checker, _validator = make_setup(cs, planner, int(task["seed"]))
+    set_query(ss, space, q.start, q.goal)
+    p0, m0 = cs.point_count(), cs.checks["segments"]
+    first, progress = None, []
+    t0 = time.perf_counter()
+    if planner.lower() in SLICED and not iters:
+        # Continue the same search slice by slice: same total budget, plus the time
+        # of the first solution (to within one slice) and the best cost along the run.
+        step = max(budget / SLICES, MIN_SLICE)
+        while (left := budget - (time.perf_counter() - t0)) > 0:
+            ss.solve(ob.timedPlannerTerminationCondition(min(step, left)))
+            if ss.haveExactSolutionPath():
+                t = time.perf_counter() - t0
+                first = t if first is None else first
+                progress.append([t, ss.getSolutionPath().length()])
+    else:
+        ptc, _keep = termination(budget, iters)
+        ss.solve(ptc)
+        if ss.haveExactSolutionPath():
+            first = time.perf_counter() - t0
+            progress.append([first, ss.getSolutionPath().length()])
+    solve_s = time.perf_counter() - t0
+    checks = cs.point_count() - p0, cs.checks["segments"] - m0
+    found = ss.haveExactSolutionPath()
+    raw = _snap(path_states(ss.getSolutionPath()), q) if found else None
+    t1 = time.perf_counter()
+    if found:
+        ss.simplifySolution()
+    simplify_s = time.perf_counter() - t1 if found else 0.0
+    path = _snap(path_states(ss.getSolutionPath()), q) if found else None
+    ok, message = _verify(cs, path, q) if found else (False, "no exact solution within the budget")
+    opt = task["optimum"]
+    length = path_length(path) if ok else None
+    raw_len = path_length(raw) if ok else None
+    return {
+        "scenario": task["scenario"], "file": task["file"], "planner": planner, "time_budget": budget,
+        "seed": int(task["seed"]), "status": "ok", "solved": bool(ok),
+        "length": length, "length_unsimplified": raw_len, "optimum": opt,
+        "error": _error(length, opt), "error_unsimplified": _error(raw_len, opt),
+        "first_solution_s": first if ok else None, "solve_s": solve_s, "simplify_s": simplify_s,
+        "state_checks": int(checks[0]), "motion_checks": int(checks[1]), "wall_s": None,
+        "message": message, "progress": progress,
+    }
+
+
+def _error(length, optimum):
+    """Relative excess length over the optimum (None when either is missing).
+
+    >>> _error(3.0, 2.0)
+    0.5
+    """
+    if length is None or not optimum:
+        return None
+    return length / optimum - 1.0
+
+
+def _child_main() -> None:  # pragma: no cover - runs in the child process
+    """Entry of a child process: task JSON on stdin, one marked row line on stdout."""
+    import signal
+
+    task = json.loads(sys.stdin.read())
+    signal.alarm(int(task["hard_limit"]) + 5)  # backstop if the parent died without killing us
+    try:
+        row = run_one(task)
+    except Exception as exc:  # a Python error in the run: recorded, the sweep goes on
+        row = {"status": "crashed", "message": f"{type(exc).__name__}: {exc}"}
+    sys.stdout.write(_MARK + json.dumps(row) + "\n")
+    sys.stdout.flush()
+    os._exit(0)  # skip the bindings' "nanobind: leaked" report at exit
+
+
+# ---------------------------------------------------------------- one run (isolated)
+
+_live: set = set()  # child processes running now, killed on Ctrl-C
+_stop = threading.Event()
+
+
+def hard_limit(budget: float) -> float:
+    """Seconds after which a run is killed and recorded as ``timeout``.
+
+    >>> hard_limit(1.0)
+    32.0
+    """
+    return budget * HARD_FACTOR + HARD_MARGIN
+
+
+def isolated_run(task: dict, limit: float | None = None) -> dict | None:
+    """Run one task in a fresh child process; the row records ``ok``, ``crashed`` or ``timeout``.
+
+    A child that dies by a signal, exits without a row or raises is ``crashed``; one
+    still running after ``limit`` seconds (default :func:`hard_limit`) is killed and is
+    ``timeout``. Returns None if the sweep was interrupted meanwhile.
+    """
+    limit = hard_limit(task["time_budget"]) if limit is None else limit
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-c", "from planners.bench import _child_main; _child_main()"],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env=env, start_new_session=True, text=True)
+    _live.add(proc)
+    try:
+        out, err = proc.communicate(json.dumps({**task, "hard_limit": limit}), timeout=limit)
+        status = None
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        out, err = proc.communicate()
+        status = "timeout"
+    finally:
+        _live.discard(proc)
+    if _stop.is_set():
+        return None
+    wall = time.perf_counter() - t0
+    row = None
+    for line in (out or "").splitlines():
+        if line.startswith(_MARK):
+            row = json.loads(line[len(_MARK):])
+    if status == "timeout":
+        row = {"status": "timeout", "message": f"killed after {limit:g} s"}
+    elif row is None:
+        code = proc.returncode
+        how = f"signal {-code}" if code < 0 else f"exit code {code}"
+        tail = (err or "").strip().splitlines()
+        row = {"status": "crashed", "message": f"child died ({how})" + (f": {tail[-1][:200]}" if tail else "")}
+    return _complete(task, row, wall)
+
+
+def _complete(task: dict, row: dict, wall: float) -> dict:
+    """A full row: the task's identity, the child's results, the wall time."""
+    base = {f: None for f in FIELDS}
+    base.update({"scenario": task["scenario"], "file": task["file"], "planner": task["planner"],
+                 "time_budget": task["time_budget"], "seed": task["seed"], "optimum": task["optimum"],
+                 "solved": False, "progress": []})
+    base.update(row)
+    base["wall_s"] = wall
+    base["order"] = task["order"]
+    return base
+
+
+# ---------------------------------------------------------------- the sweep
+
+def sweep(tasks: list[dict], workers: int = 1, scheduler: str | None = None,
+          progress: bool = False) -> tuple[list[dict], bool]:
+    """Run every task; returns ``(rows sorted in task order, interrupted)``.
+
+    Ctrl-C stops the sweep: running children are killed, finished rows are kept.
+    """
+    _stop.clear()
+    rows: list[dict] = []
+    bar = _Progress(len(tasks), progress)
+    interrupted = False
+    try:
+        if scheduler:
+            _sweep_dask(tasks, scheduler, rows, bar)
+        else:
+            _sweep_local(tasks, workers, rows, bar)
+    except KeyboardInterrupt:
+        interrupted = True
+        _stop.set()
+        for proc in list(_live):
+            proc.kill()
+    bar.close()
+    rows.sort(key=lambda r: r["order"])
+    for r in rows:
+        del r["order"]
+    return rows, interrupted
+
+
+def _sweep_local(tasks, workers, rows, bar) -> None:
+    from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+
+    pool = ThreadPoolExecutor(max_workers=workers)
+    try:
+        pending = {pool.submit(isolated_run, t) for t in tasks}
+        while pending:
+            # A short timeout keeps the main thread responsive to Ctrl-C.
+            done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+            for fut in done:
+                row = fut.result()
+                if row is not None:
+                    rows.append(row)
+                    bar.step(row)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _sweep_dask(tasks, scheduler, rows, bar) -> None:
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise InputError("bench", "--scheduler", "needs dask[distributed] (pip install 'cspace[cluster]')") from None
+    try:
+        client = Client(scheduler, timeout="10s")
+    except OSError as exc:
+        raise InputError("bench", "--scheduler", f"cannot connect to {scheduler}: {exc}") from None
+    futures = client.map(isolated_run, tasks, pure=False)
+    try:
+        for fut in as_completed(futures):
+            row = fut.result()
+            if row is not None:
+                rows.append(row)
+                bar.step(row)
+    except KeyboardInterrupt:
+        client.cancel(futures)
+        raise
+    finally:
+        client.close()
+
+
+class _Progress:
+    """One self-overwriting progress line on stderr (plain lines when stderr is not a terminal)."""
+
+    def __init__(self, total: int, enabled: bool):
+        self.total, self.enabled, self.n, self.t0 = total, enabled, 0, time.perf_counter()
+        self.tty = enabled and sys.stderr.isatty()
+        self.bad = 0
+
+    def step(self, row: dict) -> None:
+        self.n += 1
+        self.bad += row["status"] != "ok"
+        if not self.enabled:
+            return
+        pct = 100 * self.n // max(self.total, 1)
+        fill = "#" * (pct // 5)
+        line = (f"[{fill:<20}] {self.n}/{self.total} {time.perf_counter() - self.t0:6.1f} s  "
+                f"{row['scenario']} {row['planner']} {row['time_budget']:g}s seed {row['seed']}: {row['status']}"
+                + (f"  ({self.bad} crashed/timeout)" if self.bad else ""))
+        if self.tty:
+            sys.stderr.write("\r\x1b[K" + line)
+        elif self.n == self.total or self.n % max(1, self.total // 20) == 0 or row["status"] != "ok":
+            sys.stderr.write(line + "\n")
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        if self.tty:
+            sys.stderr.write("\n")
+
+
+# ---------------------------------------------------------------- outputs
+
+def write_outputs(rows: list[dict], out: str, meta: dict, plot: bool = True) -> None:
+    """Write results.csv, results.json, the OMPL logs and (optionally) the figure, each atomically."""
+    from .output import write_json, write_text
+
+    write_text(os.path.join(out, "results.csv"), to_csv(rows))
+    write_json(os.path.join(out, "results.json"), {"meta": _clean(meta), "fields": list(FIELDS),
+                                                   "rows": [_clean(r) for r in rows]})
+    logs = os.path.join(out, "ompl")
+    os.makedirs(logs, exist_ok=True)
+    for name, text in ompl_logs(rows, meta).items():
+        write_text(os.path.join(logs, name), text)
+    if plot and rows:
+        plot_error_vs_time(rows, os.path.join(out, "error_vs_time.png"))
+
+
+def _clean(x):
+    """JSON-safe copy: non-finite floats become None."""
+    if isinstance(x, float):
+        return x if math.isfinite(x) else None
+    if isinstance(x, dict):
+        return {k: _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    return x
+
+
+def to_csv(rows: list[dict]) -> str:
+    """The rows as CSV text with the :data:`FIELDS` header (missing values empty).
+
+    >>> to_csv([]).strip() == ",".join(FIELDS)
+    True
+    """
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(FIELDS)
+    for r in rows:
+        w.writerow(["" if r.get(f) is None else (repr(r[f]) if isinstance(r[f], float) else r[f]) for f in FIELDS])
+    return buf.getvalue()
+
+
+# OMPL's benchmark log (the format ompl_benchmark_statistics.py parses): one
+# experiment per file, so one file per (scenario, time budget).
+_ENUM = ("status|Unknown status|Invalid start|Invalid goal|Unrecognized goal type|Timeout|"
+         "Approximate solution|Exact solution|Crash|Abort|Infeasible")
+_RUN_PROPS = (
+    ("time", "REAL", "solve_s"), ("solved", "BOOLEAN", "solved"), ("status", "ENUM", None),
+    ("correct solution", "BOOLEAN", "solved"), ("solution length", "REAL", "length_unsimplified"),
+    ("simplified solution length", "REAL", "length"), ("simplification time", "REAL", "simplify_s"),
+    ("optimum", "REAL", "optimum"), ("error", "REAL", "error"), ("first solution time", "REAL", "first_solution_s"),
+    ("state checks", "INTEGER", "state_checks"), ("motion checks", "INTEGER", "motion_checks"),
+    ("seed", "INTEGER", "seed"), ("wall time", "REAL", "wall_s"),
+)
+
+
+def _status_code(row: dict) -> int:
+    """Index into the status enum: exact solution, timeout, crash or abort (killed)."""
+    if row["status"] == "crashed":
+        return 7
+    if row["status"] == "timeout":
+        return 8
+    return 6 if row["solved"] else 4
+
+
+def _val(v) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "nan"
+    if isinstance(v, bool):
+        return str(int(v))
+    return repr(v) if isinstance(v, float) else str(v)
+
+
+def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
+    """OMPL benchmark logs ``{file name: text}``, one per (scenario, time budget).
+
+    Planners appear as ``geometric_NAME``; the runs table gets the columns of
+    ``_RUN_PROPS``; anytime runs add a progress table (time, best raw cost).
+    """
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        ver = version("ompl")
+    except PackageNotFoundError:  # pragma: no cover
+        ver = "0.0.0"
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault((r["scenario"], r["time_budget"]), []).append(r)
+    out = {}
+    date = time.strftime("%Y-%m-%d %H:%M:%S")
+    for (scen, budget), rs in groups.items():
+        planners: dict = {}
+        for r in rs:
+            planners.setdefault(r["planner"], []).append(r)
+        opt = rs[0]["optimum"]
+        lines = [f"OMPL version {ver}", f"Experiment {_token(scen)}_t{budget:g}",
+                 "2 experiment properties", f"optimum REAL = {_val(opt)}", f"budget REAL = {budget!r}",
+                 f"Running on {socket.gethostname()}", f"Starting at {date}",
+                 "<<<|", f"cspace bench: scenario {scen} ({rs[0]['file']}), budget {budget:g} s, "
+                         f"error against the exact shortest path", "|>>>",
+                 "<<<|", "|>>>", "0 is the random seed", f"{budget!r} seconds per run", "0 MB per run",
+                 f"{max(len(v) for v in planners.values())} runs per planner",
+                 f"{sum(r['wall_s'] or 0.0 for r in rs)!r} seconds spent to collect the data",
+                 "1 enum types", _ENUM, f"{len(planners)} planners"]
+        for p, prs in planners.items():
+            lines += [f"geometric_{p}", "0 common properties", f"{len(_RUN_PROPS)} properties for each run"]
+            lines += [f"{name} {kind}" for name, kind, _ in _RUN_PROPS]
+            lines.append(f"{len(prs)} runs")
+            for r in prs:
+                vals = [str(_status_code(r)) if key is None and name == "status" else _val(r.get(key))
+                        for name, _, key in _RUN_PROPS]
+                lines.append("; ".join(vals) + "; ")
+            if any(r.get("progress") for r in prs):
+                lines += ["2 progress properties", "time REAL", "best cost REAL", f"{len(prs)} runs"]
+                for r in prs:
+                    lines.append("".join(f"{t!r},{c!r},;" for t, c in (r.get("progress") or [])))
+            lines.append(".")
+        out[f"{_token(scen)}_t{budget:g}.log"] = "\n".join(lines) + "\n"
+    return out
+
+
+def _token(name: str) -> str:
+    """A name safe as one whitespace-free token and file name.
+
+    >>> _token("maze 8x8/a")
+    'maze_8x8_a'
+    """
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name)) or "scenario"
+
+
+# ---------------------------------------------------------------- statistics and the figure
+
+def curves(rows: list[dict]) -> dict:
+    """Per (scenario, planner): budgets, median / 25% / 75% error over solved runs, success rate.
+
+    >>> r = [{"scenario": "s", "planner": "P", "time_budget": 1.0, "status": "ok", "solved": True, "error": e}
+    ...      for e in (0.1, 0.2, 0.3)]
+    >>> curves(r)[("s", "P")]["median"]
+    [0.2]
+    """
+    import numpy as np
+
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault((r["scenario"], r["planner"]), {}).setdefault(r["time_budget"], []).append(r)
+    out = {}
+    for key, by_t in groups.items():
+        c = {"time": [], "median": [], "q25": [], "q75": [], "success": [], "runs": []}
+        for t in sorted(by_t):
+            rs = by_t[t]
+            errs = [r["error"] for r in rs if r["solved"] and r["error"] is not None]
+            c["time"].append(t)
+            c["runs"].append(len(rs))
+            c["success"].append(sum(bool(r["solved"]) for r in rs) / len(rs))
+            q = np.percentile(errs, [50, 25, 75]).tolist() if errs else [None] * 3
+            c["median"].append(q[0])
+            c["q25"].append(q[1])
+            c["q75"].append(q[2])
+        out[key] = c
+    return out
+
+
+def summary(rows: list[dict]) -> str:
+    """A table: median error and success rate at the largest budget, per scenario and planner."""
+    cs = curves(rows)
+    lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'success':>8}"]
+    for (scen, p), c in cs.items():
+        m = c["median"][-1]
+        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {'-' if m is None else f'{m:.4f}':>13} "
+                     f"{c['success'][-1]:>8.0%}")
+    return "\n".join(lines)
+
+
+ERROR_FLOOR = 1e-6  # errors below this are drawn at it (log axis); an exact 0 is essentially impossible
+
+
+def plot_error_vs_time(rows: list[dict], path: str) -> None:
+    """Median error (25-75 % band) and success rate against the time budget, one column per scenario."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .output import atomic_path
+
+    cs = curves(rows)
+    scens = list(dict.fromkeys(r["scenario"] for r in rows))
+    planners = list(dict.fromkeys(r["planner"] for r in rows))
+    colors = {p: f"C{i % 10}" for i, p in enumerate(planners)}
+    fig, axes = plt.subplots(2, len(scens), figsize=(3.6 * len(scens) + 0.6, 6.4), squeeze=False,
+                             sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+    for j, scen in enumerate(scens):
+        top, bot = axes[0][j], axes[1][j]
+        for p in planners:
+            c = cs.get((scen, p))
+            if c is None:
+                continue
+            pts = [(t, m, a, b) for t, m, a, b in zip(c["time"], c["median"], c["q25"], c["q75"]) if m is not None]
+            if pts:
+                t, m, a, b = (list(v) for v in zip(*pts))
+                fl = [max(v, ERROR_FLOOR) for v in m]
+                top.plot(t, fl, "o-", color=colors[p], label=p, ms=4)
+                top.fill_between(t, [max(v, ERROR_FLOOR) for v in a], [max(v, ERROR_FLOOR) for v in b],
+                                 color=colors[p], alpha=0.2, lw=0)
+            bot.plot(c["time"], c["success"], "o-", color=colors[p], ms=4)
+        top.set_xscale("log")
+        top.set_yscale("log")
+        top.set_title(scen)
+        top.grid(True, which="both", alpha=0.3)
+        bot.set_xscale("log")
+        bot.set_ylim(-0.05, 1.05)
+        bot.grid(True, which="both", alpha=0.3)
+        bot.set_xlabel("time budget (s)")
+        if j == 0:
+            top.set_ylabel("length / optimum - 1\n(median, 25-75 %, solved runs)")
+            bot.set_ylabel("success rate")
+    axes[0][0].legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
