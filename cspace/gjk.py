@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .polygon import as_array
-from .predicates import orient2d_cols
+from .predicates import orient2d_xy
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -279,17 +279,23 @@ def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:
     An edge of A separates iff every vertex of B lies right of its directed line
     (orient2d < 0), weakly iff on or right of it; the same with A and B swapped.
     Disjoint compact convex polygons always have a strictly separating edge line,
-    so no strict separator and a weak one means the sets touch.
+    so no strict separator and a weak one means the sets touch. An edge is dropped
+    as soon as one vertex of the other set lies strictly left of it.
     """
     weak = False
-    for g, h in ((ga, gb), (gb, ga)):
-        e0 = g[:, None, :]
-        e1 = np.roll(g, -1, axis=0)[:, None, :]
-        s = orient2d_cols(e0[..., 0], e0[..., 1], e1[..., 0], e1[..., 1], h[None, :, 0], h[None, :, 1])
-        outside = (s <= 0).all(axis=1)
-        if (outside & (s < 0).all(axis=1)).any():
-            return "separated"
-        weak = weak or bool(outside.any())
+    for g, h in ((ga.tolist(), gb.tolist()), (gb.tolist(), ga.tolist())):
+        for i in range(len(g)):
+            (x0, y0), (x1, y1) = g[i - 1], g[i]
+            on_line = False
+            for x, y in h:
+                s = orient2d_xy(x0, y0, x1, y1, x, y)
+                if s > 0:
+                    break
+                on_line = on_line or s == 0
+            else:
+                if not on_line:
+                    return "separated"
+                weak = True
     return "touching" if weak else "overlapping"
 
 

@@ -27,16 +27,25 @@ def convex_hull(points) -> np.ndarray:
     p = as_array(points)
     if len(p) == 0:
         return p.reshape(0, 2)
-    p = np.unique(p, axis=0)  # lexicographic (x, then y) and without repeats
-    if len(p) <= 2:
-        return lowest_first(p)
-    pts = p.tolist()
+    pts = _sorted_unique(p)  # lexicographic (x, then y) and without repeats
+    if len(pts) <= 2:
+        return lowest_first(np.array(pts, dtype=np.float64).reshape(-1, 2))
     lower = _chain(pts)
     upper = _chain(pts[::-1])
     hull = lower[:-1] + upper[:-1]
     if len(hull) < 2:  # all points equal cannot happen after unique; keep the guard
         hull = lower[:1]
     return lowest_first(np.array(hull, dtype=np.float64))
+
+
+def _sorted_unique(p: np.ndarray) -> list:
+    """The distinct points of p as a list of pairs, sorted by x then y."""
+    if len(p) <= 64:  # a Python sort of a few tuples beats numpy's per-call overhead
+        return sorted(set(map(tuple, p.tolist())))
+    q = p[np.lexsort((p[:, 1], p[:, 0]))]
+    keep = np.ones(len(q), dtype=bool)
+    keep[1:] = (q[1:] != q[:-1]).any(axis=1)
+    return q[keep].tolist()
 
 
 def _chain(pts: list) -> list:

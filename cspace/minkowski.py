@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
-from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, orient2d_xy
+from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, orient2d_xy, product_error, sum_error
 
 # Up to this many vertices in total the scalar merge is faster than numpy's overhead.
 _SCALAR_MAX = 96
@@ -502,9 +502,6 @@ def _parallel_pairs(ux, uy, half, integral, X, Y, order, first, ends, edged, w1,
     return fused
 
 
-_SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitter
-
-
 def _error_free_signs(ux: np.ndarray, uy: np.ndarray, doubt: np.ndarray) -> np.ndarray:
     """Exact signs of ux[t]*uy[t+1] - uy[t]*ux[t+1] where both products are exact.
 
@@ -518,7 +515,7 @@ def _error_free_signs(ux: np.ndarray, uy: np.ndarray, doubt: np.ndarray) -> np.n
     c, d = uy[doubt], ux[doubt + 1]
     with np.errstate(over="ignore", invalid="ignore"):
         left, right = a * b, c * d
-        ok = (_product_error(a, b, left) == 0) & (_product_error(c, d, right) == 0)
+        ok = (product_error(a, b, left) == 0) & (product_error(c, d, right) == 0)
         ok &= (np.abs(left) < 2.0**1000) & (np.abs(right) < 2.0**1000)
         det = left - right
     return np.where(ok, np.sign(det), 2).astype(np.int8)
@@ -533,21 +530,7 @@ def _diff_is_exact_cols(x: np.ndarray, first: np.ndarray, ends: np.ndarray) -> n
     b[:-1] = x[1:]
     b[ends - 1] = x[first]
     na = -x
-    s = b + na
-    bv = s - b
-    av = s - bv
-    return ((b - av) + (na - bv)) == 0.0
-
-
-def _product_error(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Dekker's TwoProduct error term: a*b - fl(a*b), exactly (barring over/underflow)."""
-    t = _SPLIT * a
-    ah = t - (t - a)
-    al = a - ah
-    t = _SPLIT * b
-    bh = t - (t - b)
-    bl = b - bh
-    return ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return sum_error(b, na, b + na) == 0.0
 
 
 def _exact_pair(edged: list, ends: np.ndarray, s: int, t: int) -> int:

@@ -137,7 +137,17 @@ def cross_diff_sign(ax: float, ay: float, bx: float, by: float,
             return -1
     elif detsum == 0.0 and (ux == 0.0 or vy == 0.0) and (uy == 0.0 or vx == 0.0):
         return 0
+    if 2.0**-900 < detsum < 2.0**1000 and _computed_exactly(ax, ay, bx, by, cx, cy, dx, dy, ux, uy, vx, vy,
+                                                            left, right):
+        return 1 if det > 0 else (-1 if det < 0 else 0)  # exact operands: one rounding keeps the sign
     return cross_diff_exact(ax, ay, bx, by, cx, cy, dx, dy)
+
+
+def _computed_exactly(ax, ay, bx, by, cx, cy, dx, dy, ux, uy, vx, vy, left, right) -> bool:
+    """Were the four differences and two products of :func:`cross_diff_sign` exact? (scalar)"""
+    return (sum_error(bx, -ax, ux) == 0.0 and sum_error(by, -ay, uy) == 0.0
+            and sum_error(dx, -cx, vx) == 0.0 and sum_error(dy, -cy, vy) == 0.0
+            and product_error(ux, vy, left) == 0.0 and product_error(uy, vx, right) == 0.0)
 
 
 def cross_diff_cols(ax, ay, bx, by, cx, cy, dx, dy) -> np.ndarray:
@@ -161,6 +171,66 @@ def cross_diff_cols(ax, ay, bx, by, cx, cy, dx, dy) -> np.ndarray:
     if not certain.all():
         cols = np.broadcast_arrays(ax, ay, bx, by, cx, cy, dx, dy, sign)
         sign = np.array(cols[-1], dtype=np.int8)
-        for idx in zip(*np.nonzero(~np.broadcast_to(certain, sign.shape))):
-            sign[idx] = cross_diff_exact(*(float(col[idx]) for col in cols[:8]))
+        doubt = np.nonzero(~np.broadcast_to(certain, sign.shape))
+        picked = [np.asarray(col[doubt], dtype=np.float64) for col in cols[:8]]
+        ef = error_free_cross_sign(*picked)
+        sign[doubt] = ef  # 2 marks the entries still undecided, fixed just below
+        for k in np.flatnonzero(ef == 2).tolist():
+            idx = tuple(d[k] for d in doubt)
+            sign[idx] = cross_diff_exact(*(float(col[k]) for col in picked))
     return sign
+
+
+_SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitter
+
+
+def error_free_cross_sign(ax, ay, bx, by, cx, cy, dx, dy) -> np.ndarray:
+    """Exact sign of ``(b - a) x (d - c)`` where floats compute it without error, else 2.
+
+    Knuth's TwoSum tells whether each difference was exact, Dekker's TwoProduct
+    whether each product was; when all six were, the one rounded subtraction keeps
+    the true sign. This settles at float speed the zeros the stage-A filter cannot
+    (touching contacts on integer or dyadic coordinates); what is left goes to
+    rationals.
+
+    >>> error_free_cross_sign(*(np.array([v]) for v in (0, 0, 3, 1, 0, 0, 6, 2))).tolist()
+    [0]
+    """
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+        ux, uy, vx, vy = bx - ax, by - ay, dx - cx, dy - cy
+        ok = (sum_error(bx, -ax, ux) == 0) & (sum_error(by, -ay, uy) == 0)
+        ok &= (sum_error(dx, -cx, vx) == 0) & (sum_error(dy, -cy, vy) == 0)
+        left, right = ux * vy, uy * vx
+        ok &= (product_error(ux, vy, left) == 0) & (product_error(uy, vx, right) == 0)
+        # far from over- and underflow, where TwoSum/TwoProduct are themselves exact
+        big = np.maximum(np.abs(left), np.abs(right))
+        ok &= (big < 2.0**1000) & ((big > 2.0**-900) | ((left == 0) & (right == 0)))
+        ok &= np.isfinite(ux) & np.isfinite(uy) & np.isfinite(vx) & np.isfinite(vy)
+        det = left - right
+    return np.where(ok, np.sign(det), 2).astype(np.int8)
+
+
+def sum_error(a, b, s):
+    """Knuth's TwoSum error term: a + b - fl(a + b), exactly (barring overflow).
+
+    >>> float(sum_error(np.float64(1.0), np.float64(2.0**-60), np.float64(1.0)))
+    8.673617379884035e-19
+    """
+    bv = s - a
+    av = s - bv
+    return (a - av) + (b - bv)
+
+
+def product_error(a, b, p):
+    """Dekker's TwoProduct error term: a*b - fl(a*b), exactly (barring over/underflow).
+
+    >>> float(product_error(np.float64(3.0), np.float64(1.0 / 3.0), np.float64(1.0)))
+    -5.551115123125783e-17
+    """
+    t = _SPLIT * a
+    ah = t - (t - a)
+    al = a - ah
+    t = _SPLIT * b
+    bh = t - (t - b)
+    bl = b - bh
+    return ((ah * bh - p) + ah * bl + al * bh) + al * bl
