@@ -38,7 +38,7 @@ DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
 # C-space build, simplification and verification all fit many times over).
 HARD_FACTOR = 2.0
 HARD_MARGIN = 30.0
-# Anytime planners are solved in slices of budget / SLICES (at least MIN_SLICE s) to
+# Anytime planners are solved in slices (MIN_SLICE s, doubling up to budget / SLICES) to
 # time their first solution and record the best raw cost along the run.
 SLICES = 20
 MIN_SLICE = 0.002
@@ -225,9 +225,12 @@ def run_one(task: dict) -> dict:
     if planner.lower() in SLICED and not iters:
         # Continue the same search slice by slice: same total budget, plus the time
         # of the first solution (to within one slice) and the best cost along the run.
-        step = max(budget / SLICES, MIN_SLICE)
+        # Slices double from MIN_SLICE up to budget / SLICES, so an early first
+        # solution is timed finely and a long run still takes few slices.
+        step, k = max(budget / SLICES, MIN_SLICE), 0
         while (left := budget - (time.perf_counter() - t0)) > 0:
-            ss.solve(ob.timedPlannerTerminationCondition(min(step, left)))
+            ss.solve(ob.timedPlannerTerminationCondition(min(step, MIN_SLICE * 2 ** k, left)))
+            k += 1
             if ss.haveExactSolutionPath():
                 t = time.perf_counter() - t0
                 first = t if first is None else first
@@ -660,6 +663,8 @@ def plot_error_vs_time(rows: list[dict], path: str) -> None:
                 top.fill_between(t, [max(v, ERROR_FLOOR) for v in a], [max(v, ERROR_FLOOR) for v in b],
                                  color=colors[p], alpha=0.2, lw=0)
             bot.plot(c["time"], c["success"], "o-", color=colors[p], ms=4)
+        if not any(r["solved"] for r in rows if r["scenario"] == scen):
+            top.text(0.5, 0.5, "no run solved", transform=top.transAxes, ha="center", va="center", color="0.4")
         top.set_xscale("log")
         top.set_yscale("log")
         top.set_title(scen)
