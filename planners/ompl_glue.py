@@ -113,12 +113,8 @@ def validity_function(cspace):
     :func:`clearance_checker` provides one, with ``clearance``, for the planners that
     ask for it.)
     """
-    test = cspace.point_test(cspace._points.__next__)
-
-    def is_valid(state) -> bool:
-        return test(state[0], state[1])
-
-    return is_valid
+    # The test reads ``state[0], state[1]`` itself: one Python frame per state, not two.
+    return cspace.point_test(cspace._points.__next__, state=True)
 
 
 def clearance_checker(si, cspace):
