@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .polygon import as_array
-from .predicates import orient2d_xy
+from .predicates import orient2d_cols, orient2d_xy
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -282,6 +282,8 @@ def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:
     so no strict separator and a weak one means the sets touch. An edge is dropped
     as soon as one vertex of the other set lies strictly left of it.
     """
+    if len(ga) * len(gb) > 144:  # large: all edge-vertex signs at once (one filter pass)
+        return _relation_polygons_cols(ga, gb)
     weak = False
     for g, h in ((ga.tolist(), gb.tolist()), (gb.tolist(), ga.tolist())):
         for i in range(len(g)):
@@ -296,6 +298,20 @@ def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:
                 if not on_line:
                     return "separated"
                 weak = True
+    return "touching" if weak else "overlapping"
+
+
+def _relation_polygons_cols(ga: np.ndarray, gb: np.ndarray) -> str:
+    """:func:`_relation_polygons` with the signs of every edge-vertex pair in one array."""
+    weak = False
+    for g, h in ((ga, gb), (gb, ga)):
+        e0 = np.roll(g, 1, axis=0)[:, None, :]
+        e1 = g[:, None, :]
+        s = orient2d_cols(e0[..., 0], e0[..., 1], e1[..., 0], e1[..., 1], h[None, :, 0], h[None, :, 1])
+        outside = (s <= 0).all(axis=1)
+        if (outside & (s < 0).all(axis=1)).any():
+            return "separated"
+        weak = weak or bool(outside.any())
     return "touching" if weak else "overlapping"
 
 
