@@ -15,6 +15,7 @@ from .epa import Penetration, epa_penetration
 from .decompose import convex_decompose
 from .nonconvex import minkowski_pieces, minkowski_sum_nonconvex
 from .cspace import CSpace
+from .direct import DirectChecker, cspace_band
 from .shortest import ShortestPath, shortest_path
 
 __version__ = "0.1.0"
