@@ -228,12 +228,11 @@ class CSpace:
         iw, ih = idx.inv_w, idx.inv_h
         a0, b0 = idx.x0 * iw, idx.y0 * ih
         nx, ny = idx.nx, idx.ny
-        # Rows padded with a MIXED sentinel column and row, so an index one past the
-        # end falls back to the slow path instead of raising.
-        rows = [idx.state[r * nx:(r + 1) * nx].tolist() + [1] for r in range(ny)] + [[1] * (nx + 1)]
+        fnx, fny = float(nx), float(ny)
+        # One byte per cell (FREE 0, MIXED 1, BLOCKED 2): compact enough to stay in cache.
+        cells = idx.state.astype(np.uint8).tobytes()
         exact = self._is_free_exact
         mixed = self._mixed_cell_test()
-        state_list = idx.state_list
         xmin, xmax, ymin, ymax = self.bounds
 
         def slow(x: float, y: float) -> bool:
@@ -242,9 +241,9 @@ class CSpace:
             if xmin <= x <= xmax and ymin <= y <= ymax:
                 i = x * iw - a0
                 j = y * ih - b0
-                if i >= 0.0 and j >= 0.0 and int(i) < nx and int(j) < ny:
+                if 0.0 <= i < fnx and 0.0 <= j < fny:
                     cell = int(j) * nx + int(i)
-                    if state_list[cell] == 1:
+                    if cells[cell] == 1:
                         return mixed(cell, x, y)
             return exact(x, y)
 
@@ -255,11 +254,8 @@ class CSpace:
             y = q[1]
             i = x * iw - a0
             j = y * ih - b0
-            if i >= 0.0 and j >= 0.0:
-                try:
-                    c = rows[int(j)][int(i)]
-                except IndexError:
-                    return slow(x, y)
+            if 0.0 <= i < fnx and 0.0 <= j < fny:
+                c = cells[int(j) * nx + int(i)]
                 if c != 1:
                     return c == 0  # FREE (0) or BLOCKED (2)
             return slow(x, y)
@@ -288,7 +284,7 @@ class CSpace:
         lists = self.packed._lists
         edges: list = [None] * len(lists)
         checks = self.checks
-        big = float("inf")
+        tiny = CCW_ERRBOUND_A * _UNDERFLOW_GUARD
 
         def edges_of(k: int) -> list:
             pts = lists[k]
@@ -307,13 +303,13 @@ class CSpace:
                     left = ex * (y - py)
                     right = ey * (x - px)
                     det = left - right
-                    detsum = abs(left) + abs(right)
-                    if _UNDERFLOW_GUARD < detsum < big:
-                        bound = CCW_ERRBOUND_A * detsum
-                        if det > bound:
-                            continue  # strictly left of this edge
-                        if -det > bound:
-                            break  # strictly right: outside piece k
+                    # bound > tiny: no underflow; an infinite detsum gives an infinite
+                    # bound that no det exceeds, and NaN fails every comparison.
+                    bound = CCW_ERRBOUND_A * (abs(left) + abs(right))
+                    if det > bound > tiny:
+                        continue  # strictly left of this edge
+                    if -det > bound > tiny:
+                        break  # strictly right: outside piece k
                     if orient2d_xy(px, py, qx, qy, x, y) < 0:
                         break
                 else:

@@ -13,7 +13,9 @@
     Per-state cost is measured with ``si.probabilityOfValidState(N)``: OMPL's own C++
     loop draws N uniform states with its state sampler and calls the checker once per
     state, so the sampling and calling overhead is identical for the three callbacks
-    and no Python loop is timed. Figures: medians over repetitions of N / seconds
+    and no Python loop is timed. Rounds are interleaved (each checker once per round)
+    and timed in process CPU time (time.process_time; the machine is shared, and wall
+    time counted other processes' slices). Figures: medians over rounds of N / seconds
     (states per second), and the ratios ours/no-op (target <= 5) and shapely/ours
     (target >= 5), all measured in one run. ``ob.AllValidStateValidityChecker`` (C++)
     is shown as the floor of the loop itself. Agreement: ours and the shapely checker
@@ -62,6 +64,7 @@ CLIP_SCALE = 2.0**20  # pyclipper works on integers: coordinates x 2^20, rounded
 TARGET_NOOP = 5.0  # ours / no-op per-state cost must be at most this
 TARGET_PEER = 5.0  # shapely / ours per-state cost must be at least this
 TARGET_CLIP = 0.1  # ours / pyclipper time must be at most this
+FINE_GRID = 4  # (A) also times a C-space whose grid has this many times the default cells
 
 
 def median_time(fn, reps: int) -> float:
@@ -135,13 +138,15 @@ def ompl_space_information(cs, seed: int):
     return si, (ss, space, checker, validator)
 
 
-def states_per_second(si, checkers: dict, reps: int) -> dict:
+def states_per_second(si, checkers: dict, reps: int, clock=time.process_time) -> dict:
     """Median states/s of each checker inside OMPL: ``{name: (checker, n)}`` ->
     ``{name: (states_per_s, fraction_valid, [per-round seconds per state])}``.
 
     Each round times ``si.probabilityOfValidState(n)`` once per checker, in turn, so
     a load change on the (shared) machine hits all checkers alike; ratios are taken
-    per round and their median reported by the caller.
+    per round and their median reported by the caller. The clock is this process's
+    CPU time by default: on a shared 2-core machine wall time also counts the time
+    other processes held the core.
     """
     per = {k: [] for k in checkers}
     frac = {}
@@ -151,10 +156,15 @@ def states_per_second(si, checkers: dict, reps: int) -> dict:
     for _ in range(reps):
         for name, (checker, n) in checkers.items():
             si.setStateValidityChecker(checker)
-            t = time.perf_counter()
+            t = clock()
             frac[name] = si.probabilityOfValidState(n)
-            per[name].append((time.perf_counter() - t) / n)
+            per[name].append((clock() - t) / n)
     return {k: (1.0 / statistics.median(v), frac[k], v) for k, v in per.items()}
+
+
+def per_round(res: dict, name: str) -> list:
+    """Per-round seconds per state of one checker of :func:`states_per_second`."""
+    return res[name][2]
 
 
 def agreement(sc, ours, peer, n: int, seed: int) -> dict:
@@ -189,7 +199,14 @@ def part_a(seed: int, size: int, n: int, reps: int, agree_n: int) -> dict:
 
     ob = ompl()[0]
     sc = random_scene(seed, size)
+    t = time.perf_counter()
     cs = CSpace.from_scenario(sc)
+    build = time.perf_counter() - t
+    # The same C-space with a 4x finer grid (fewer MIXED cells, a slower build): the
+    # query/build trade-off of the grid's default size, for reference.
+    t = time.perf_counter()
+    fine = CSpace.from_scenario(sc, grid_cells=FINE_GRID * cs.index.nx * cs.index.ny)
+    build_fine = time.perf_counter() - t
     si, keep = ompl_space_information(cs, seed)
     ours = validity_function(cs)
     peer_plain = shapely_checker(sc)
@@ -199,12 +216,18 @@ def part_a(seed: int, size: int, n: int, reps: int, agree_n: int) -> dict:
     peer_n = max(1000, n // 20)  # the peers are slower: fewer states, same per-state figure
     res = states_per_second(si, {
         "cpp": (ob.AllValidStateValidityChecker(si), n), "noop": (noop, n), "ours": (ours, n),
+        "ours_fine": (validity_function(fine), n),
         "shapely_candidates": (peer_plain, peer_n), "shapely_predicate": (peer_pred, peer_n)}, reps)
     rate = {k: v[0] for k, v in res.items()}
     peer_key = max(("shapely_candidates", "shapely_predicate"), key=rate.get)
     row.update({f"{k}_per_s": v for k, v in rate.items()})
     row["valid_ours"], row["valid_shapely"] = res["ours"][1], res[peer_key][1]
     row["peer"] = peer_key
+    row["grid"], row["grid_fine"] = [cs.index.nx, cs.index.ny], [fine.index.nx, fine.index.ny]
+    row["mixed_fraction"] = cs.index.stats()["mixed"] / (cs.index.nx * cs.index.ny)
+    row["mixed_fraction_fine"] = fine.index.stats()["mixed"] / (fine.index.nx * fine.index.ny)
+    row["build_s"], row["build_fine_s"] = build, build_fine
+    row["fine_over_noop"] = statistics.median(o / z for o, z in zip(per_round(res, "ours_fine"), per_round(res, "noop")))
     # cost ratios, per round (same load), then the median over rounds
     per = {k: v[2] for k, v in res.items()}
     row["ours_over_noop"] = statistics.median(o / z for o, z in zip(per["ours"], per["noop"]))
@@ -219,6 +242,7 @@ def print_a(r: dict) -> None:
           f"{r['pieces']} C-pieces; si.probabilityOfValidState, median of {r['reps']} interleaved rounds")
     print(f"{'checker':>30} {'states/s':>12} {'us/state':>9}")
     names = [("cpp", "C++ AllValid (loop floor)"), ("noop", "no-op Python lambda"), ("ours", "ours (validity_function)"),
+             ("ours_fine", f"ours, {FINE_GRID}x grid cells"),
              ("shapely_candidates", "shapely STRtree+prepared"), ("shapely_predicate", "shapely STRtree predicate")]
     for k, label in names:
         v = r[f"{k}_per_s"]
@@ -227,6 +251,9 @@ def print_a(r: dict) -> None:
     ok2 = "ok" if r["peer_over_ours"] >= TARGET_PEER else "MISSED"
     print(f"ours / no-op cost (median of per-round ratios): {r['ours_over_noop']:.2f}x (target <= {TARGET_NOOP:g}: {ok1}); "
           f"{r['peer']} / ours cost: {r['peer_over_ours']:.1f}x (target >= {TARGET_PEER:g}: {ok2})")
+    print(f"grid {r['grid'][0]}x{r['grid'][1]}: {r['mixed_fraction']:.1%} MIXED cells, build {r['build_s'] * 1e3:.0f} ms; "
+          f"{FINE_GRID}x cells ({r['grid_fine'][0]}x{r['grid_fine'][1]}): {r['mixed_fraction_fine']:.1%} MIXED, "
+          f"build {r['build_fine_s'] * 1e3:.0f} ms, ours / no-op {r['fine_over_noop']:.2f}x")
     a = r["agreement"]
     print(f"agreement on {a['states']} seeded states ({a['valid']} free): disagreements away from boundaries "
           f"{a['disagree_away']}, on boundaries (< {BOUNDARY_TOL:g}) {a['disagree_boundary']}")
@@ -452,7 +479,7 @@ def main(argv=None) -> int:
     out = {}
     parts = args.parts.upper()
     if "A" in parts:
-        n, reps, agree_n = (20000, 3, 2000) if args.quick else (200000, 7, 20000)
+        n, reps, agree_n = (20000, 5, 2000) if args.quick else (50000, 21, 20000)
         out["A"] = part_a(args.seed, 200, n, reps, agree_n)
         print_a(out["A"])
     if "B" in parts:
