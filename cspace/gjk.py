@@ -255,8 +255,8 @@ def exact_relation(A, B) -> str:
     """
     from .hull import convex_hull
 
-    ga = convex_hull(as_array(A))
-    gb = convex_hull(as_array(B))
+    ga = _as_hull(as_array(A), convex_hull)
+    gb = _as_hull(as_array(B), convex_hull)
     if len(ga) >= 3 and len(gb) >= 3:
         return _relation_polygons(ga, gb)
     ha = [(Fraction(x), Fraction(y)) for x, y in ga.tolist()]
@@ -271,6 +271,27 @@ def exact_relation(A, B) -> str:
         if hi_a == lo_b or hi_b == lo_a:
             weak = True
     return "touching" if weak else "overlapping"
+
+
+def _as_hull(p: np.ndarray, convex_hull) -> np.ndarray:
+    """p itself if it is already a strictly convex CCW polygon (the usual case: C-space
+    pieces), else its exact hull. Strict left turns everywhere and edge directions that
+    cross from the lower to the upper half-plane exactly once mean p winds once."""
+    n = len(p)
+    if 3 <= n <= 64:
+        pts = p.tolist()
+        ups = 0
+        for i in range(n):
+            (ax, ay), (bx, by), (cx, cy) = pts[i - 2], pts[i - 1], pts[i]
+            if orient2d_xy(ax, ay, bx, by, cx, cy) <= 0:
+                break
+            lower_before = by < ay or (by == ay and bx < ax)
+            upper_after = cy > by or (cy == by and cx > bx)
+            ups += lower_before and upper_after
+        else:
+            if ups == 1:
+                return p
+    return convex_hull(p)
 
 
 def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:

@@ -107,3 +107,19 @@ def test_degenerate_corpus_never_nan():
             p = epa_penetration(A, B)
             assert all(math.isfinite(x) for x in (d.distance, p.depth, *p.normal, *d.point_a, *d.point_b))
             assert d.iterations <= 64
+
+
+def test_relation_skips_hull_only_for_strictly_convex_ccw_input():
+    from cspace.gjk import _as_hull
+
+    t = np.arange(5) * 2 * np.pi / 5
+    pent = np.round(np.c_[np.cos(t), np.sin(t)] * 1000)
+    star = pent[[0, 2, 4, 1, 3]]  # every turn left, but winds twice
+    assert _as_hull(pent, convex_hull) is pent
+    assert _as_hull(star, convex_hull) is not star
+    assert sorted(map(tuple, _as_hull(star, convex_hull).tolist())) == sorted(map(tuple, pent.tolist()))
+    assert _as_hull(pent[::-1], convex_hull) is not pent  # clockwise
+    square_with_repeat = np.array([[0, 0], [1, 0], [1, 0], [1, 1], [0, 1.0]])
+    assert len(_as_hull(square_with_repeat, convex_hull)) == 4
+    # a touching pair given as a pentagram still reports touching, not a false overlap
+    assert exact_relation(star, 2 * pent[np.argmax(pent[:, 0])] - pent) == "touching"
