@@ -38,6 +38,15 @@ def check_output(path: str, option: str, suffixes: dict | None = None) -> str:
     return suffixes[ext]
 
 
+def _read_umask() -> int:
+    mask = os.umask(0)  # the only way to read it; done once, at import (not thread-safe later)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _read_umask()
+
+
 @contextlib.contextmanager
 def atomic_path(path: str):
     """Yield a temporary path beside ``path``; on success rename it over ``path``."""
@@ -47,6 +56,7 @@ def atomic_path(path: str):
     os.close(fd)
     try:
         yield tmp
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; give the usual mode of a new file
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
