@@ -5,9 +5,10 @@ One command, no hand-edited pictures:
     python scripts/make_figures.py [--out docs/figures] [--only basic,families,circles,...] [--list]
 
 Each figure is a plan with a fixed seed (``cspace plan --plot``), a C-space picture
-(``cspace show --plot``), the exact shortest path, the circles multi-query run, or the
-stability chart. PNGs are written atomically (temporary file, then rename) by
-:mod:`planners.plot`, so an interrupted run never leaves a half-written picture.
+(``cspace show --plot``), the exact shortest path, the circles multi-query run, a small
+``cspace bench`` sweep's error-against-run-time figure, or the stability chart. PNGs
+are written atomically (temporary file, then rename; :mod:`planners.plot` does it for
+the pictures it draws), so an interrupted run never leaves a half-written picture.
 ``--only`` takes figure names or group names (see ``--list``). The whole set takes
 well under two minutes on a laptop core.
 """
@@ -99,6 +100,33 @@ def stability_figure(out: str) -> str:
     return f"{passed}/{len(rows)} cases pass"
 
 
+BENCH_ARGS = ["scenarios/bug_trap.toml", "--planners", "RRTConnect,RRTstar", "--times", "0.03,0.1,0.3",
+              "--runs", "5", "--workers", "2", "--quiet"]
+
+
+def bench_figure(out: str) -> str:
+    """``cspace bench``'s error-against-run-time figure for a small sweep (copied atomically)."""
+    import json
+    import shutil
+    import subprocess
+    import tempfile
+
+    folder = os.path.dirname(os.path.abspath(out))
+    work = tempfile.mkdtemp(prefix=".bench-", dir=folder)  # same file system: the rename is atomic
+    try:
+        cmd = [sys.executable, "-c", "from planners.cli import console; console()", "bench", *BENCH_ARGS, "--out", work]
+        proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
+        png = os.path.join(work, "error_vs_time.png")
+        if proc.returncode != 0 or not os.path.exists(png):
+            raise RuntimeError(f"cspace bench failed (exit {proc.returncode}): {proc.stderr.strip()[-500:]}")
+        os.replace(png, out)
+        with open(os.path.join(work, "results.json")) as fh:
+            rows = json.load(fh)["rows"]
+        return f"{len(rows)} runs, {sum(bool(r['solved']) for r in rows)} solved"
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
 def figures() -> list[Figure]:
     """Every figure the guide uses, in the guide's order."""
     out = [
@@ -110,6 +138,7 @@ def figures() -> list[Figure]:
         out.append(Figure(f"{fam}_cspace", "families", f"C-space of {fam}.toml", cspace_figure(fam)))
         out.append(Figure(f"{fam}_plan", "families", f"plan of {fam}.toml", plan_figure(fam)))
     out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
+    out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure))
     out.append(Figure("stability", "stability", "stability catalogue", stability_figure))
     return out
 
@@ -130,7 +159,7 @@ def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "figures"), help="folder for the PNGs")
-    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, circles, stability)")
+    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, circles, bench, stability)")
     ap.add_argument("--list", action="store_true", help="list the figures and exit")
     args = ap.parse_args(argv)
     figs = select(figures(), args.only)

@@ -1,0 +1,295 @@
+"""Write docs/benchmarks.md from the bench scripts' own output: no number is typed by hand.
+
+    python scripts/make_benchmarks_page.py [--out docs/benchmarks.md] [--work DIR] [--from DIR]
+
+Each ``scripts/bench_*.py`` is run in its quick mode (``--quick`` where the script has
+it, else the small arguments in ``QUICK_ARGS``), with ``--out-json`` where it offers
+one. Its printed table (medians and the ratios against peers measured in the same
+run) is copied verbatim into the page, and its JSON rows, when there are any, are
+rendered as Markdown tables. ``cspace bench`` (planners: error against run time) is
+run on a small sweep too. Outputs of every run are kept in ``--work`` (default: a
+temporary folder); ``--from DIR`` re-renders the page from such a folder without
+running anything. A script missing from ``scripts/`` is listed as "not yet run".
+"""
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import glob
+import json
+import os
+import platform
+import shlex
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# Scripts the page expects; others found in scripts/ are run too.
+EXPECTED = ("bench_minkowski", "bench_gjk", "bench_scaling", "bench_cspace", "bench_direct")
+# Small arguments for scripts without a --quick mode (their defaults take minutes).
+QUICK_ARGS = {
+    "bench_minkowski": ["--sizes", "8,64,1024"],
+    "bench_gjk": ["--pairs", "3"],
+    "bench_scaling": ["--plot", ""],
+}
+# The planner sweep of ``cspace bench``: small, so that the page builds in minutes.
+PLANNER_SWEEP = ["scenarios/bug_trap.toml", "scenarios/maze.toml", "--planners", "RRTConnect,RRTstar",
+                 "--times", "0.1,0.3,1", "--runs", "5", "--workers", "2", "--no-plot", "--quiet"]
+TIMEOUT = 600  # seconds per script
+
+
+def help_text(script: str) -> str:
+    """The script's ``--help`` (to find which options it offers)."""
+    proc = subprocess.run([sys.executable, script, "--help"], capture_output=True, text=True, timeout=60, cwd=ROOT)
+    return proc.stdout
+
+
+def quick_command(name: str, script: str, json_path: str) -> tuple[list[str], bool]:
+    """The command line of a quick run, and whether it writes JSON to ``json_path``."""
+    h = help_text(script)
+    args = list(QUICK_ARGS.get(name, []))
+    if "--quick" in h:
+        args.append("--quick")
+    wants_json = "--out-json" in h
+    if wants_json:
+        args += ["--out-json", json_path]
+    return ["python", os.path.relpath(script, ROOT), *args], wants_json
+
+
+def run_script(name: str, script: str, work: str) -> dict:
+    """Run one bench script, keep its stdout, JSON and timing in ``work``; returns the record."""
+    json_path = os.path.join(work, f"{name}.json")
+    cmd, wants_json = quick_command(name, script, json_path)
+    t = time.perf_counter()
+    try:
+        proc = subprocess.run([sys.executable, *cmd[1:]], capture_output=True, text=True, timeout=TIMEOUT, cwd=ROOT)
+        rc, out, err = proc.returncode, proc.stdout, proc.stderr
+    except subprocess.TimeoutExpired as exc:
+        rc, out, err = "timeout", exc.stdout or "", f"timed out after {TIMEOUT} s"
+        out = out.decode() if isinstance(out, bytes) else out
+    rec = {"name": name, "command": _shown(cmd, json_path), "seconds": time.perf_counter() - t, "rc": rc,
+           "stdout": out, "stderr": err[-2000:], "json": json_path if wants_json and os.path.exists(json_path) else None}
+    with open(os.path.join(work, f"{name}.run.json"), "w") as fh:
+        json.dump(rec, fh, indent=1)
+    return rec
+
+
+def run_planner_sweep(work: str) -> dict:
+    """``cspace bench`` on a small sweep; the record points at its results.json."""
+    out_dir = os.path.join(work, "planners")
+    cmd = ["cspace", "bench", *PLANNER_SWEEP, "--out", out_dir]
+    t = time.perf_counter()
+    try:
+        proc = subprocess.run([sys.executable, "-c", "from planners.cli import console; console()", *cmd[1:]],
+                              capture_output=True, text=True, timeout=TIMEOUT, cwd=ROOT)
+        rc, out, err = proc.returncode, proc.stdout, proc.stderr
+    except subprocess.TimeoutExpired:
+        rc, out, err = "timeout", "", f"timed out after {TIMEOUT} s"
+    res = os.path.join(out_dir, "results.json")
+    rec = {"name": "cspace_bench", "command": " ".join(cmd[:-2] + ["--out", "OUT"]),
+           "seconds": time.perf_counter() - t, "rc": rc, "stdout": out, "stderr": err[-2000:],
+           "json": res if os.path.exists(res) else None}
+    with open(os.path.join(work, "cspace_bench.run.json"), "w") as fh:
+        json.dump(rec, fh, indent=1)
+    return rec
+
+
+def _shown(cmd: list[str], json_path: str) -> str:
+    """The command as a reader would type it (JSON into a local file name)."""
+    return " ".join(shlex.quote(c if c != json_path else os.path.basename(json_path)) for c in cmd)
+
+
+# ---------------------------------------------------------------- rendering
+
+def fmt(v) -> str:
+    """A cell: 4 significant digits for floats, as-is otherwise.
+
+    >>> fmt(0.000123456), fmt(12345.678), fmt(3), fmt(None), fmt(True), fmt([1, 2.5]), fmt([{"a": 1}])
+    ('0.0001235', '1.235e+04', '3', '-', 'True', '[1, 2.5]', '(1 items)')
+    """
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if isinstance(v, (list, tuple)) and not any(isinstance(x, (list, tuple, dict)) for x in v):
+        return "[" + ", ".join(fmt(x) for x in v) + "]"
+    if isinstance(v, (list, tuple, dict)):
+        return f"({len(v)} items)"  # nested records: the printed table above shows them
+    return str(v).replace("|", "\\|").replace("\n", " ")
+
+
+def md_table(rows: list[dict]) -> str:
+    """A Markdown table of dict rows (columns in first-seen order).
+
+    >>> print(md_table([{"a": 1, "b": 0.5}, {"a": 2, "c": "x"}]))
+    | a | b | c |
+    |---|---|---|
+    | 1 | 0.5 | - |
+    | 2 | - | x |
+    """
+    cols = list(dict.fromkeys(k for r in rows for k in r))
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    lines += ["| " + " | ".join(fmt(r.get(c)) for c in cols) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def json_tables(data, title: str = "") -> list[str]:
+    """Markdown for a JSON result: each list of rows becomes tables (rows grouped by their fields)."""
+    out = []
+    if isinstance(data, list) and data and all(isinstance(r, dict) for r in data):
+        groups: dict = {}
+        for r in data:
+            groups.setdefault(tuple(r), []).append(r)
+        for rows in groups.values():
+            out.append((f"*{title}*\n\n" if title else "") + md_table(rows))
+    elif isinstance(data, dict):
+        scalars = {k: v for k, v in data.items() if not isinstance(v, (list, dict))}
+        if scalars:
+            out.append((f"*{title}*: " if title else "") + ", ".join(f"{k} = {fmt(v)}" for k, v in scalars.items()))
+        for k, v in data.items():
+            if isinstance(v, (list, dict)):
+                out += json_tables(v, f"{title}.{k}" if title else k)
+    return out
+
+
+def planner_tables(path: str) -> list[str]:
+    """The error-against-run-time summary of a ``cspace bench`` results.json."""
+    sys.path.insert(0, ROOT)
+    from planners.bench import curves
+
+    with open(path) as fh:
+        data = json.load(fh)
+    rows = data["rows"] if isinstance(data, dict) and "rows" in data else data
+    table = []
+    for (scen, planner), c in curves(rows).items():
+        for i, t in enumerate(c["time"]):
+            table.append({"scenario": scen, "planner": planner, "budget s": t, "runs": c["runs"][i],
+                          "success": f"{c['success'][i]:.0%}", "median error": c["median"][i],
+                          "25%": c["q25"][i], "75%": c["q75"][i]})
+    return [md_table(table)] if table else ["(no rows)"]
+
+
+def machine_note(work: str) -> str:
+    """Where the numbers were measured (saved with the run, so --from keeps it)."""
+    path = os.path.join(work, "machine.json")
+    if os.path.exists(path):
+        with open(path) as fh:
+            m = json.load(fh)
+    else:
+        import numpy
+
+        m = {"date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+             "platform": platform.platform(), "processor": platform.processor() or platform.machine(),
+             "cpus": os.cpu_count(), "python": platform.python_version(), "numpy": numpy.__version__,
+             "load": list(os.getloadavg()) if hasattr(os, "getloadavg") else None}
+        with open(path, "w") as fh:
+            json.dump(m, fh)
+    load = f"; load average at start {', '.join(f'{x:.2f}' for x in m['load'])}" if m.get("load") else ""
+    return (f"Measured {m['date']} on {m['platform']} ({m['processor']}, {m['cpus']} logical CPUs{load}), "
+            f"Python {m['python']}, numpy {m['numpy']}.")
+
+
+def render(records: list[dict], missing: list[str], work: str) -> str:
+    lines = [
+        "# Benchmarks",
+        "",
+        "<!-- generated by scripts/make_benchmarks_page.py: do not edit by hand -->",
+        "",
+        "Generated by `python scripts/make_benchmarks_page.py` from the quick modes of the bench",
+        "scripts: every table below is the scripts' own output (medians over repetitions; ratios",
+        "against peers measured in the same run). Absolute times depend on the machine and its",
+        "load; the ratios are the meaningful part. The full (slower) runs are the same commands",
+        "without the quick arguments.",
+        "",
+        machine_note(work),
+        "",
+        "## Reproduce",
+        "",
+        "```sh",
+        "python scripts/make_benchmarks_page.py            # runs everything below, rewrites this page",
+    ]
+    lines += [r["command"] for r in records]
+    lines += ["```", ""]
+    for r in records:
+        lines += [f"## {r['name']}", "", f"`{r['command']}` ({r['seconds']:.0f} s wall, exit {r['rc']})", ""]
+        if r["name"] == "cspace_bench":
+            lines += ["Error = path length / exact optimum − 1 over the solved runs (median and the 25–75 %",
+                      "band), and the share of runs solved, per time budget. See the guide,",
+                      "[reading the error-against-run-time report](guide.md#reading-the-error-against-run-time-report).",
+                      ""]
+            if r.get("json"):
+                for t in planner_tables(r["json"]):
+                    lines += [t, ""]
+            if r["stdout"].strip():
+                lines += ["```", r["stdout"].rstrip(), "```", ""]
+        else:
+            if r["stdout"].strip():
+                lines += ["```", r["stdout"].rstrip(), "```", ""]
+            if r.get("json"):
+                with open(r["json"]) as fh:
+                    data = json.load(fh)
+                tables = json_tables(data)
+                if tables:
+                    lines += ["<details><summary>JSON rows</summary>", ""]
+                    for t in tables:
+                        lines += [t, ""]
+                    lines += ["</details>", ""]
+        if r["rc"] != 0:
+            lines += ["**This run did not finish cleanly:**", "", "```", (r["stderr"] or "").rstrip(), "```", ""]
+    if missing:
+        lines += ["## Not yet run", ""]
+        lines += [f"- `scripts/{m}.py`: not in the repository when this page was generated" for m in missing]
+        lines += [""]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"))
+    ap.add_argument("--work", help="folder for the runs' outputs (default: a temporary folder)")
+    ap.add_argument("--from", dest="source", help="render from the outputs in this folder, without running")
+    ap.add_argument("--only", help="comma-separated bench names to run (e.g. bench_minkowski,cspace_bench)")
+    ap.add_argument("--no-planners", action="store_true", help="skip the cspace bench sweep")
+    args = ap.parse_args(argv)
+    found = {os.path.splitext(os.path.basename(p))[0]: p for p in sorted(glob.glob(os.path.join(ROOT, "scripts", "bench_*.py")))}
+    order = [n for n in EXPECTED if n in found] + [n for n in found if n not in EXPECTED]
+    missing = [n for n in EXPECTED if n not in found]
+    only = set(args.only.split(",")) if args.only else None
+    if args.source:
+        work = args.source
+        records = []
+        for n in order + ["cspace_bench"]:
+            p = os.path.join(work, f"{n}.run.json")
+            if os.path.exists(p):
+                with open(p) as fh:
+                    records.append(json.load(fh))
+            elif n != "cspace_bench":
+                missing.append(n)
+    else:
+        work = args.work or tempfile.mkdtemp(prefix="cspace-bench-")
+        os.makedirs(work, exist_ok=True)
+        machine_note(work)
+        records = []
+        for n in order:
+            if only and n not in only:
+                continue
+            print(f"running {n} ...", flush=True)
+            records.append(run_script(n, found[n], work))
+            print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
+        if not args.no_planners and (not only or "cspace_bench" in only):
+            print("running cspace bench ...", flush=True)
+            records.append(run_planner_sweep(work))
+            print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
+    text = render(records, missing, work)
+    sys.path.insert(0, ROOT)
+    from planners.output import write_text
+
+    write_text(args.out, text + "\n")
+    print(f"wrote {args.out} (run outputs in {work})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
