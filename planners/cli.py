@@ -61,12 +61,27 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("interrupted\n")
         code = 130
+    except BrokenPipeError:  # the reader went away (`cspace ... | head`): stop quietly
+        _silence_stdout()
+        code = 141  # 128 + SIGPIPE, as a shell reports a process killed by it
     except Exception as exc:  # a bug, not bad input: still one line unless --verbose
         if getattr(args, "verbose", False):
             raise
         sys.stderr.write(f"internal error: {type(exc).__name__}: {exc} (run with --verbose for the traceback)\n")
         code = 3
     return code
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot raise again."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a real file: just replace it
+        sys.stdout = open(os.devnull, "w")
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
 
 
 def console() -> None:
@@ -77,7 +92,11 @@ def console() -> None:
     its output is flushed (unless ``--verbose`` asks to see everything).
     """
     code = main()
-    sys.stdout.flush()
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+        code = 141
     sys.stderr.flush()
     if "ompl" in sys.modules and "--verbose" not in sys.argv and "-v" not in sys.argv:
         os._exit(code)

@@ -102,7 +102,7 @@ def plot_result(res, out: str, fmt: str | None = None, scenario=None, cspace=Non
     ax.set_aspect("equal")
     if len(results) == 1:
         status = f"length {res.length:.4g}" if res.solved else "not solved"
-        ax.set_title(f"{sc.name}: {res.planner}, {status}, {res.timings.get('total', 0.0):.3g} s")
+        ax.set_title(f"{sc.name}: {res.planner}, seed {res.seed}, {status}")  # no wall time: same plan, same picture
     else:
         n = sum(r.solved for r in results)
         ax.set_title(f"{sc.name}: {res.planner}, {n}/{len(results)} queries solved")

@@ -30,7 +30,8 @@ def segment_point_distance(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.nd
 
 @pytest.fixture(scope="module")
 def runs():
-    exact = plan(CIRCLES, planner="exact", all_queries=True)
+    # the exact planner's per-query time limit, generous: a loaded CI machine must not cut it
+    exact = plan(CIRCLES, planner="exact", time=30.0, all_queries=True)
     sampled = plan(CIRCLES, planner="RRTConnect", time=0.5, seed=0, all_queries=True, cspace=exact.cspace)
     return exact, sampled
 

@@ -157,3 +157,19 @@ def test_show_prints_the_stages(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "minkowski" in r.stdout and "skipped" in r.stdout
     assert out.exists()
+
+
+def test_closed_pipe_is_quiet():
+    # `cspace show ... | head -c 1`: the reader goes away; no traceback, no "internal error"
+    code = (
+        "import sys, planners.cli as c\n"
+        "class Gone:\n"
+        "    def write(self, s): raise BrokenPipeError(32, 'Broken pipe')\n"
+        "    def flush(self): pass\n"
+        "sys.stdout = Gone()\n"
+        "sys.exit(c.main(['show', 'scenarios/basic.toml']))\n"
+    )
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    r = subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 141, r.stderr
+    assert r.stderr == ""
