@@ -95,11 +95,7 @@ def plot_result(res, out: str, fmt: str | None = None, scenario=None, cspace=Non
             ax.plot(r.path[:, 0], r.path[:, 1], "-", color=PATH, linewidth=1.4)
         draw_robot(ax, sc, *r.start, color=ROBOT, alpha=0.6)
         draw_robot(ax, sc, *r.goal, color="#c0392b", alpha=0.6)
-    xmin, xmax, ymin, ymax = sc.bounds
-    pad = 0.02 * max(xmax - xmin, ymax - ymin)
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
-    ax.set_aspect("equal")
+    _frame(ax, sc.bounds)
     if len(results) == 1:
         status = f"length {res.length:.4g}" if res.solved else "not solved"
         ax.set_title(f"{sc.name}: {res.planner}, seed {res.seed}, {status}")  # no wall time: same plan, same picture
@@ -107,6 +103,15 @@ def plot_result(res, out: str, fmt: str | None = None, scenario=None, cspace=Non
         n = sum(r.solved for r in results)
         ax.set_title(f"{sc.name}: {res.planner}, {n}/{len(results)} queries solved")
     _save(fig, out, fmt)
+
+
+def _frame(ax, bounds) -> None:
+    """Axes on the bounds, with a 2 % margin, at equal scale."""
+    xmin, xmax, ymin, ymax = bounds
+    pad = 0.02 * max(xmax - xmin, ymax - ymin)
+    ax.set_xlim(xmin - pad, xmax + pad)
+    ax.set_ylim(ymin - pad, ymax + pad)
+    ax.set_aspect("equal")
 
 
 def plot_scene(scenario, cspace, out: str, fmt: str | None = None) -> None:
@@ -117,11 +122,7 @@ def plot_scene(scenario, cspace, out: str, fmt: str | None = None) -> None:
     draw_scene(ax, sc, cspace, pieces_edges=True)
     draw_robot(ax, sc, *sc.start, color=ROBOT, alpha=0.6)
     draw_robot(ax, sc, *sc.goal, color="#c0392b", alpha=0.6)
-    xmin, xmax, ymin, ymax = sc.bounds
-    pad = 0.02 * max(xmax - xmin, ymax - ymin)
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
-    ax.set_aspect("equal")
+    _frame(ax, sc.bounds)
     ax.set_title(f"{sc.name}: {len(sc.obstacles)} obstacles, {len(cspace.pieces)} C-obstacle pieces")
     _save(fig, out, fmt)
 

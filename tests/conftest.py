@@ -1,6 +1,7 @@
 """Shared fixtures: scenario files written from TOML text, paths to bundled data."""
 from __future__ import annotations
 
+import importlib.util
 import os
 import textwrap
 
@@ -21,3 +22,11 @@ def write_toml(tmp_path):
         return str(p)
 
     return _write
+
+
+def load_script(name: str):
+    """Import ``scripts/NAME.py`` (the scripts are not a package) as a module."""
+    spec = importlib.util.spec_from_file_location(name, os.path.join(ROOT, "scripts", f"{name}.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod

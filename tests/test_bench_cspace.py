@@ -1,25 +1,20 @@
 """The C-space benchmark's pieces: the shapely peer, the OMPL timing loop, the combs,
 pyclipper's full sum and the stage table. Timings are not asserted (speed lives in
 scripts/bench_cspace.py), only that the pieces compute the right things."""
-import importlib.util
 import math
-import pathlib
 
 import numpy as np
 import pytest
 import shapely
 
+from conftest import load_script
 from cspace import CSpace, minkowski_sum_nonconvex
 
-SCRIPT = pathlib.Path(__file__).resolve().parent.parent / "scripts" / "bench_cspace.py"
 
 
 @pytest.fixture(scope="module")
 def bench():
-    spec = importlib.util.spec_from_file_location("bench_cspace", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("bench_cspace")
 
 
 @pytest.fixture(scope="module")

@@ -3,22 +3,16 @@
 Timings themselves are not asserted (speed lives in scripts/bench_*.py); only that
 the rows hold the fields the docs are generated from, with sane values.
 """
-import importlib.util
 import math
-import pathlib
 
 import numpy as np
 import pytest
-
-SCRIPT = pathlib.Path(__file__).resolve().parent.parent / "scripts" / "bench_scaling.py"
+from conftest import load_script
 
 
 @pytest.fixture(scope="module")
 def bench():
-    spec = importlib.util.spec_from_file_location("bench_scaling", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("bench_scaling")
 
 
 def test_fit_exponent_recovers_power_laws(bench):
