@@ -28,7 +28,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .polygon import as_array
-from .predicates import orient2d_cols, orient2d_xy
+from .predicates import _UNDERFLOW_GUARD as _GUARD
+from .predicates import CCW_ERRBOUND_A, orient2d_cols, orient2d_xy
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -283,8 +284,12 @@ def _as_hull(p: np.ndarray, convex_hull) -> np.ndarray:
         ups = 0
         for i in range(n):
             (ax, ay), (bx, by), (cx, cy) = pts[i - 2], pts[i - 1], pts[i]
-            if orient2d_xy(ax, ay, bx, by, cx, cy) <= 0:
-                break
+            # orient2d(a, b, c) > 0, Shewchuk's filter inlined (exact call only in doubt)
+            left, right = (ax - cx) * (by - cy), (ay - cy) * (bx - cx)
+            sm = abs(left) + abs(right)
+            if not (_GUARD < sm < math.inf and left - right > CCW_ERRBOUND_A * sm):
+                if orient2d_xy(ax, ay, bx, by, cx, cy) <= 0:
+                    break
             lower_before = by < ay or (by == ay and bx < ax)
             upper_after = cy > by or (cy == by and cx > bx)
             ups += lower_before and upper_after
@@ -311,6 +316,13 @@ def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:
             (x0, y0), (x1, y1) = g[i - 1], g[i]
             on_line = False
             for x, y in h:
+                # orient2d(p0, p1, v): Shewchuk's filter inlined, the exact call only in doubt
+                left, right = (x0 - x) * (y1 - y), (y0 - y) * (x1 - x)
+                det, sm = left - right, abs(left) + abs(right)
+                if _GUARD < sm < math.inf and abs(det) > CCW_ERRBOUND_A * sm:
+                    if det > 0:
+                        break
+                    continue
                 s = orient2d_xy(x0, y0, x1, y1, x, y)
                 if s > 0:
                     break
