@@ -58,8 +58,9 @@ class GridIndex:
         blocker = np.full(nx * ny, -1, dtype=np.int64)
         cand_cells: list[np.ndarray] = []
         cand_piece: list[np.ndarray] = []
+        cand_mask: list[np.ndarray] = []
         for k, p in enumerate(pieces):
-            cells_k, inside = self._classify(p)
+            cells_k, inside, masks = self._classify(p)
             if cells_k.size == 0:
                 continue
             blk = cells_k[inside]
@@ -68,18 +69,21 @@ class GridIndex:
             mixed = cells_k[~inside]
             cand_cells.append(mixed)
             cand_piece.append(np.full(mixed.size, k, dtype=np.int64))
+            cand_mask.append(masks[~inside])
         # A cell touched by any piece but not wholly inside one is MIXED.
         if cand_cells:
             cc = np.concatenate(cand_cells)
             cp = np.concatenate(cand_piece)
+            cm = np.concatenate(cand_mask)
             order = np.argsort(cc, kind="stable")
-            cc, cp = cc[order], cp[order]
+            cc, cp, cm = cc[order], cp[order], cm[order]
             touched = np.zeros(nx * ny, dtype=bool)
             touched[cc] = True
             state[touched & (state != BLOCKED)] = MIXED
             starts = np.searchsorted(cc, np.arange(nx * ny + 1))
         else:
             cp = np.zeros(0, dtype=np.int64)
+            cm = np.zeros(0, dtype=np.int64)
             starts = np.zeros(nx * ny + 1, dtype=np.int64)
         self.state = state
         self.blocker = blocker
@@ -89,6 +93,11 @@ class GridIndex:
         self.state_list = state.tolist()
         self.blocker_list = blocker.tolist()
         self._cand_list = cp.tolist()
+        # For each candidate (cell, piece): a bit mask of the piece's edges whose line
+        # may pass within the margin of the cell (bit e: edge from vertex e-1 to e).
+        # Every other edge has the whole widened cell strictly on its
+        # inner side, so a point located in the cell needs no test against it.
+        self.cand_masks_list = cm.tolist()
         self._starts_list = starts.tolist()
         # Summed-area table of non-FREE cells: the count in any block of cells in O(1).
         busy = (state != FREE).reshape(ny, nx).astype(np.int64)
@@ -98,8 +107,9 @@ class GridIndex:
 
     # -- build -------------------------------------------------------------------
 
-    def _classify(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Cells that closed convex ``p`` may meet, and which of them lie inside ``p``."""
+    def _classify(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Cells that closed convex ``p`` may meet, which of them lie inside ``p``, and for
+        each the bit mask of the edges whose line passes within the margin of it."""
         m = self.margin
         i0 = int(math.floor((p[:, 0].min() - m - self.x0) * self.inv_w))
         i1 = int(math.floor((p[:, 0].max() + m - self.x0) * self.inv_w))
@@ -108,7 +118,7 @@ class GridIndex:
         i0, j0 = max(i0, 0), max(j0, 0)
         i1, j1 = min(i1, self.nx - 1), min(j1, self.ny - 1)
         if i0 > i1 or j0 > j1:
-            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool)
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool), np.zeros(0, dtype=np.int64)
         ii, jj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
         ii, jj = ii.ravel(), jj.ravel()
         q = p - (self.ox, self.oy)
@@ -119,6 +129,12 @@ class GridIndex:
         c = np.einsum("ij,ij->i", nrm, q)
         inside = np.empty(ii.size, dtype=bool)
         separated = np.empty(ii.size, dtype=bool)
+        # Bit e stands for the edge ending at vertex e (q[e-1] -> q[e]); the half-planes
+        # above are for q[e] -> q[e+1], i.e. bit e+1. Up to 62 edges the masks are int64,
+        # beyond that Python ints (an object array).
+        wide = len(q) > 62
+        masks = np.empty(ii.size, dtype=object if wide else np.int64)
+        weights = None if wide else np.left_shift(np.int64(1), (np.arange(len(q)) + 1) % len(q))
         step = max(1, (1 << 21) // (4 * len(q)))  # bound the (cells, 4, edges) block
         for s in range(0, ii.size, step):
             cx0 = (self.x0 - self.ox) + ii[s : s + step] * self.cw
@@ -127,12 +143,18 @@ class GridIndex:
             ys = np.stack([cy0, cy0, cy0 + self.ch, cy0 + self.ch], axis=1)
             # signed distance of each corner beyond each edge line
             d = xs[:, :, None] * nrm[:, 0] + ys[:, :, None] * nrm[:, 1] - c
-            inside[s : s + step] = (d <= -m).all(axis=(1, 2))
+            strictly_in = (d <= -m).all(axis=1)  # (cells, edges): cell well inside the edge's half-plane
+            inside[s : s + step] = strictly_in.all(axis=1)
+            if wide:
+                bits = np.packbits(np.roll(~strictly_in, 1, axis=1), axis=1, bitorder="little")
+                masks[s : s + step] = [int.from_bytes(b.tobytes(), "little") for b in bits]
+            else:
+                masks[s : s + step] = (~strictly_in) @ weights
             # Separated when all four corners lie beyond one edge; the cell's own
             # axes are covered by the bounding-box range above.
             separated[s : s + step] = (d >= m).all(axis=1).any(axis=1)
         keep = ~separated
-        return (jj * self.nx + ii)[keep], inside[keep]
+        return (jj * self.nx + ii)[keep], inside[keep], masks[keep]
 
     # -- queries -----------------------------------------------------------------
 

@@ -281,25 +281,30 @@ class CSpace:
         from .predicates import _UNDERFLOW_GUARD, CCW_ERRBOUND_A, orient2d_xy
 
         starts, cand = self.index._starts_list, self.index._cand_list
+        masks = self.index.cand_masks_list
         lists = self.packed._lists
-        edges: list = [None] * len(lists)
+        chosen: dict = {}  # (piece, mask) -> that piece's edges named by the mask
         checks = self.checks
         tiny = CCW_ERRBOUND_A * _UNDERFLOW_GUARD
 
-        def edges_of(k: int) -> list:
+        def edges_of(k: int, mask: int) -> list:
             pts = lists[k]
             out = []
             px, py = pts[-1]
-            for qx, qy in pts:
-                out.append((px, py, qx, qy, qx - px, qy - py))
+            for e, (qx, qy) in enumerate(pts):
+                if mask == -1 or (mask >> e) & 1:
+                    out.append((px, py, qx, qy, qx - px, qy - py))
                 px, py = qx, qy
-            edges[k] = out
+            chosen[k, mask] = out
             return out
 
         def free_in_cell(cell: int, x: float, y: float) -> bool:
             checks["exact_points"] += 1
-            for k in cand[starts[cell]:starts[cell + 1]]:
-                for px, py, qx, qy, ex, ey in edges[k] or edges_of(k):
+            for t in range(starts[cell], starts[cell + 1]):
+                k, mask = cand[t], masks[t]
+                # Only the edges whose line passes near this cell: the cell lies well
+                # inside every other edge's half-plane (certified at build, with margin).
+                for px, py, qx, qy, ex, ey in chosen.get((k, mask)) or edges_of(k, mask):
                     left = ex * (y - py)
                     right = ey * (x - px)
                     det = left - right

@@ -123,3 +123,35 @@ def test_clearance_matches_shapely_distance():
             n += 1
     assert n > 50
     assert math.isinf(CSpace((0, 1, 0, 1), []).clearance((0.5, 0.5)))
+
+
+@pytest.mark.parametrize("name", ["random_polygons.toml", "combs.toml", "disks.toml", "maze.toml"])
+def test_mixed_cell_edge_masks_are_conservative(name):
+    # The narrow phase of a MIXED cell skips a candidate's edges outside the cell's mask:
+    # every point of the cell (and its margin) must lie strictly inside those edges' half-planes.
+    from cspace.predicates import orient2d_many
+
+    cs = CSpace.from_scenario(load_scenario(os.path.join(SCENARIOS, name)))
+    g = cs.index
+    rng = np.random.default_rng(0)
+    starts, cand, masks = g._starts_list, g._cand_list, g.cand_masks_list
+    cells = np.flatnonzero(g.state == 1)
+    skipped = 0
+    for cell in rng.choice(cells, size=min(300, len(cells)), replace=False).tolist():
+        i, j = cell % g.nx, cell // g.nx
+        x0, y0 = g.x0 + i * g.cw - g.margin, g.y0 + j * g.ch - g.margin
+        w, h = g.cw + 2 * g.margin, g.ch + 2 * g.margin
+        pts = np.column_stack([x0 + w * rng.random(40), y0 + h * rng.random(40)])
+        pts = np.vstack([pts, [[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]])
+        for t in range(starts[cell], starts[cell + 1]):
+            k, mask = cand[t], masks[t]
+            if mask == -1:
+                continue
+            p = cs.pieces[k]
+            for e in range(len(p)):
+                if (mask >> e) & 1:
+                    continue
+                skipped += 1
+                s = orient2d_many(np.broadcast_to(p[e - 1], pts.shape), np.broadcast_to(p[e], pts.shape), pts)
+                assert (s > 0).all(), (name, cell, k, e)
+    assert skipped > 0  # the masks really drop edges
