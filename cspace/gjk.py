@@ -65,13 +65,13 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
     origin = a[0].copy()
     al = (a - origin).tolist()
     bl = (b - origin).tolist()
-    dist, pa, pb, it, inside = _gjk(al, bl, max_iterations)
+    dist, pa, pb, it, inside, simplex = _gjk(al, bl, max_iterations)
     ox, oy = origin.tolist()
     if inside == "deep":
         p = np.array((pa[0] + ox, pa[1] + oy))
         return Distance(0.0, p, p.copy(), it, "overlapping")
     if inside or dist <= EXACT_BAND * _scale(al, bl):
-        status = exact_relation(a, b)
+        status = _contact_relation(a.tolist(), b.tolist(), simplex) or exact_relation(a, b)
         if status != "separated":
             p = np.array((pa[0] + ox, pa[1] + oy))
             return Distance(0.0, p, p.copy(), it, status)
@@ -107,7 +107,10 @@ def _support(pts: list, dx: float, dy: float) -> int:
 
 
 def _gjk(al: list, bl: list, max_iterations: int = MAX_ITERATIONS):
-    """The GJK loop in the local frame. Returns (distance, pa, pb, iterations, origin_inside)."""
+    """The GJK loop in the local frame.
+
+    Returns (distance, pa, pb, iterations, origin_inside, simplex); the simplex's
+    vertices carry the indices (ia, ib) of the supporting vertices of A and B."""
     # Simplex vertices: (ia, ib, wx, wy) with w = a[ia] - b[ib]; weights lam.
     simplex = [(0, 0, al[0][0] - bl[0][0], al[0][1] - bl[0][1])]
     lam = [1.0]
@@ -139,8 +142,8 @@ def _gjk(al: list, bl: list, max_iterations: int = MAX_ITERATIONS):
     if inside:
         # Certain overlap when the origin is deep inside the simplex (beyond any rounding).
         deep = len(simplex) == 3 and _depth_in_triangle(simplex) > EXACT_BAND * _scale(al, bl)
-        return 0.0, (pax, pay), (pax, pay), it, "deep" if deep else True
-    return math.hypot(pax - pbx, pay - pby), (pax, pay), (pbx, pby), it, False
+        return 0.0, (pax, pay), (pax, pay), it, "deep" if deep else True, simplex
+    return math.hypot(pax - pbx, pay - pby), (pax, pay), (pbx, pby), it, False, simplex
 
 
 def _combine(lam: list, pts: list, ix: int, iy: int) -> tuple[float, float]:
@@ -232,6 +235,64 @@ def _depth_in_triangle(simplex: list) -> float:
             return 0.0
         best = min(best, (ex * (-py) - ey * (-px)) / n)
     return best
+
+
+def _contact_relation(A: list, B: list, simplex: list) -> str | None:
+    """The exact relation proved by one line near GJK's contact, or None if none is found.
+
+    Candidates are the lines of the edges at the supporting vertices of GJK's final
+    simplex. A line L weakly separates when A lies on one closed side and B on the
+    other (exact signs). Then A and B meet iff their traces on L overlap; the traces
+    are the vertices exactly on L, ordered along L by their (x, y) order, so the
+    overlap test is exact too. For touching convex polygons such a line always exists
+    along an edge at a contact vertex; when none is found the caller runs the full
+    separating-axis test.
+    """
+    lines = set()
+    for P, idx in ((A, {s[0] for s in simplex}), (B, {s[1] for s in simplex})):
+        n = len(P)
+        if n < 2:
+            continue
+        for i in idx:
+            for j in ((i - 1) % n, (i + 1) % n):
+                p, q = P[i], P[j]
+                if p != q:
+                    lines.add((tuple(p), tuple(q)) if tuple(p) < tuple(q) else (tuple(q), tuple(p)))
+    for (x0, y0), (x1, y1) in lines:
+        sa = _side_of(A, x0, y0, x1, y1)
+        if sa is None:
+            continue
+        sb = _side_of(B, x0, y0, x1, y1)
+        if sb is None or sa[0] * sb[0] > 0:
+            continue
+        on_a, on_b = sa[1], sb[1]
+        if not on_a or not on_b:
+            return "separated"  # a strict gap on one side of L
+        lo_a, hi_a = min(on_a), max(on_a)  # points exactly on L: (x, y) order is the order along L
+        lo_b, hi_b = min(on_b), max(on_b)
+        return "touching" if max(lo_a, lo_b) <= min(hi_a, hi_b) else "separated"
+    return None
+
+
+def _side_of(P: list, x0: float, y0: float, x1: float, y1: float):
+    """(+1 or -1, points on the line) if P lies on one closed side of line (x0,y0)->(x1,y1),
+    else None. Signs from Shewchuk's filter, the exact predicate only in doubt."""
+    side = 0
+    on = []
+    for x, y in P:
+        left, right = (x0 - x) * (y1 - y), (y0 - y) * (x1 - x)
+        det, sm = left - right, abs(left) + abs(right)
+        if _GUARD < sm < math.inf and abs(det) > CCW_ERRBOUND_A * sm:
+            s = 1 if det > 0 else -1
+        else:
+            s = orient2d_xy(x0, y0, x1, y1, x, y)
+        if s == 0:
+            on.append((x, y))
+        elif side == 0:
+            side = s
+        elif s != side:
+            return None
+    return (side or 1), on
 
 
 def _norm2(c) -> float:

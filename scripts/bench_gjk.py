@@ -87,11 +87,14 @@ def make_pairs(rng, n, case, count):
         A = rand_convex(rng, n, (0, 0))
         off = {"separated": 3.0, "touching": 2.0, "overlapping": 1.0}[case]
         B = rand_convex(rng, n, (off, rng.uniform(-0.5, 0.5)))
-        if case == "touching":  # slide B along x into contact
-            d = gjk_distance(A, B)
-            B[:, 0] -= d.distance if d.status == "separated" else 0.0
+        if case == "touching":
+            # Exact vertex contact: on a 2^-20 grid, move B's lowest vertex along u onto
+            # A's highest (the line normal to u through it separates them weakly).
+            A, B = np.round(A * 2**20) / 2**20, np.round(B * 2**20) / 2**20
+            u = B.mean(axis=0) - A.mean(axis=0)
+            B -= B[np.argmin(B @ u)] - A[np.argmax(A @ u)]
         # Keep the pair only if the exact relation is the case's (random gons may miss).
-        if exact_relation(A, B) == case or (case == "touching" and gjk_distance(A, B).distance < 1e-12):
+        if exact_relation(A, B) == case:
             pairs.append((A, B))
     return pairs
 

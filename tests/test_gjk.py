@@ -123,3 +123,25 @@ def test_relation_skips_hull_only_for_strictly_convex_ccw_input():
     assert len(_as_hull(square_with_repeat, convex_hull)) == 4
     # a touching pair given as a pentagram still reports touching, not a false overlap
     assert exact_relation(star, 2 * pent[np.argmax(pent[:, 0])] - pent) == "touching"
+
+
+def test_contact_shortcut_agrees_with_the_full_separating_axis_test():
+    # gjk_distance proves near-contact relations from one line at GJK's contact when it can;
+    # on exact integer contacts (vertex-vertex, edge-edge, vertex-edge, one unit off) it must
+    # give the relation of the full exact test, which it otherwise falls back to.
+    rng = np.random.default_rng(7)
+    seen = set()
+    for _ in range(120):
+        A = convex_hull(rng.integers(0, 20, (int(rng.integers(3, 12)), 2)).astype(float))
+        if len(A) < 3:
+            continue
+        v = A[np.argmax(A[:, 0])]
+        w, h = np.ptp(A[:, 0]), np.ptp(A[:, 1])
+        others = [2 * v - A + s for s in ((0, 0), (1, 0), (-1, 0), (0, 1), (1, 1))]
+        others += [A + [w, int(rng.integers(-5, 6))], A + [0, h], A + [w + 1, 0]]
+        for B in others:
+            for P, Q in ((A, B), (B, A)):
+                status = gjk_distance(P, Q).status
+                assert status == exact_relation(P, Q)
+                seen.add(status)
+    assert seen == {"separated", "touching", "overlapping"}
