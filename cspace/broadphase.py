@@ -27,6 +27,17 @@ FREE, MIXED, BLOCKED = 0, 1, 2
 _MARGIN = 1e-9
 
 
+# Most (piece, cell) pairs the build classifies, before the grid is coarsened.
+_PAIR_BUDGET = float(1 << 22)
+
+
+def _box_share(p: np.ndarray, xmin: float, xmax: float, ymin: float, ymax: float) -> float:
+    """Fraction of the bounds covered by p's bounding box (clipped to the bounds)."""
+    bw = min(float(p[:, 0].max()), xmax) - max(float(p[:, 0].min()), xmin)
+    bh = min(float(p[:, 1].max()), ymax) - max(float(p[:, 1].min()), ymin)
+    return max(bw, 0.0) * max(bh, 0.0) / ((xmax - xmin) * (ymax - ymin))
+
+
 class GridIndex:
     """Uniform grid over ``bounds`` classifying cells against convex ``pieces``.
 
@@ -39,9 +50,14 @@ class GridIndex:
         xmin, xmax, ymin, ymax = map(float, bounds)
         self.bounds = (xmin, xmax, ymin, ymax)
         n = len(pieces)
+        w, h = xmax - xmin, ymax - ymin
         if cells is None:
             cells = int(min(max(1024 * n, 1 << 16), 1 << 20))
-        w, h = xmax - xmin, ymax - ymin
+            # Large, overlapping pieces (comb sums) would each cover a big share of that
+            # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
+            cover = sum(_box_share(p, xmin, xmax, ymin, ymax) for p in pieces)
+            if cover * cells > _PAIR_BUDGET:
+                cells = max(int(_PAIR_BUDGET / cover), 1 << 12)
         nx = max(1, min(4096, int(round(math.sqrt(cells * w / h)))))
         ny = max(1, min(4096, int(round(cells / nx))))
         self.nx, self.ny = nx, ny
@@ -135,24 +151,28 @@ class GridIndex:
         wide = len(q) > 62
         masks = np.empty(ii.size, dtype=object if wide else np.int64)
         weights = None if wide else np.left_shift(np.int64(1), (np.arange(len(q)) + 1) % len(q))
-        step = max(1, (1 << 21) // (4 * len(q)))  # bound the (cells, 4, edges) block
+        # Over a cell [x, x + cw] x [y, y + ch] the signed distance n . corner - c is
+        # largest at the corner picked by the signs of n and smallest at the opposite one:
+        # d = n . (x, y) - c, plus hi (resp. lo) per edge. One (cells, edges) block.
+        hi = np.maximum(nrm[:, 0], 0.0) * self.cw + np.maximum(nrm[:, 1], 0.0) * self.ch
+        lo = np.minimum(nrm[:, 0], 0.0) * self.cw + np.minimum(nrm[:, 1], 0.0) * self.ch
+        step = max(1, (1 << 21) // len(q))  # bound the (cells, edges) block
         for s in range(0, ii.size, step):
             cx0 = (self.x0 - self.ox) + ii[s : s + step] * self.cw
             cy0 = (self.y0 - self.oy) + jj[s : s + step] * self.ch
-            xs = np.stack([cx0, cx0 + self.cw, cx0 + self.cw, cx0], axis=1)
-            ys = np.stack([cy0, cy0, cy0 + self.ch, cy0 + self.ch], axis=1)
-            # signed distance of each corner beyond each edge line
-            d = xs[:, :, None] * nrm[:, 0] + ys[:, :, None] * nrm[:, 1] - c
-            strictly_in = (d <= -m).all(axis=1)  # (cells, edges): cell well inside the edge's half-plane
+            d = np.multiply.outer(cx0, nrm[:, 0])
+            d += np.multiply.outer(cy0, nrm[:, 1])
+            d -= c
+            strictly_in = d <= -m - hi  # (cells, edges): every corner well inside the edge's half-plane
             inside[s : s + step] = strictly_in.all(axis=1)
             if wide:
                 bits = np.packbits(np.roll(~strictly_in, 1, axis=1), axis=1, bitorder="little")
                 masks[s : s + step] = [int.from_bytes(b.tobytes(), "little") for b in bits]
             else:
                 masks[s : s + step] = (~strictly_in) @ weights
-            # Separated when all four corners lie beyond one edge; the cell's own
-            # axes are covered by the bounding-box range above.
-            separated[s : s + step] = (d >= m).all(axis=1).any(axis=1)
+            # Separated when every corner lies beyond one edge; the cell's own axes are
+            # covered by the bounding-box range above.
+            separated[s : s + step] = (d >= m - lo).any(axis=1)
         keep = ~separated
         return (jj * self.nx + ii)[keep], inside[keep], masks[keep]
 
