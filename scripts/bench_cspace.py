@@ -56,6 +56,8 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from benchutil import median_time  # noqa: E402
 from cspace import CSpace, load_scenario, minkowski_pieces, minkowski_sum_nonconvex, reflect
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -65,20 +67,6 @@ TARGET_NOOP = 5.0  # ours / no-op per-state cost must be at most this
 TARGET_PEER = 5.0  # shapely / ours per-state cost must be at least this
 TARGET_CLIP = 0.1  # ours / pyclipper time must be at most this
 FINE_GRID = 4  # (A) also times a C-space whose grid has this many times the default cells
-
-
-def median_time(fn, reps: int) -> float:
-    """Median wall seconds of ``fn()`` over ``reps`` calls.
-
-    >>> median_time(lambda: None, 3) >= 0
-    True
-    """
-    out = []
-    for _ in range(reps):
-        t = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t)
-    return statistics.median(out)
 
 
 # ------------------------------------------------------------------ (A) validity in OMPL

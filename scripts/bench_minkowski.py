@@ -6,11 +6,13 @@ edge vectors summed (Valtr's construction), so n vertices really are n.
 Usage: python scripts/bench_minkowski.py [--sizes 8,64,1024,16384] [--reps N]
 """
 import argparse
-import statistics
-import time
+import os
+import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from benchutil import median_time  # noqa: E402
 from cspace.minkowski import minkowski_sum
 
 
@@ -25,13 +27,6 @@ def random_convex(n, rng, span=2**20):
             return p - p.min(axis=0)
 
 
-def timeit(fn, reps):
-    out = []
-    for _ in range(reps):
-        t = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t)
-    return statistics.median(out)
 
 
 def main():
@@ -48,13 +43,13 @@ def main():
     for n in map(int, args.sizes.split(",")):
         P, Q = random_convex(n, rng), random_convex(n, rng)
         reps = args.reps or max(5, min(2000, 200000 // n))
-        ours = timeit(lambda: minkowski_sum(P, Q), reps)
+        ours = median_time(lambda: minkowski_sum(P, Q), reps)
         e = np.concatenate([np.roll(P, -1, 0) - P, np.roll(Q, -1, 0) - Q])
         ang = np.arctan2(e[:, 1], e[:, 0])
-        srt = timeit(lambda: np.argsort(ang), reps)
+        srt = median_time(lambda: np.argsort(ang), reps)
         pi, qi = P.astype(np.int64).tolist(), Q.astype(np.int64).tolist()
-        clip = timeit(lambda: pyclipper.MinkowskiSum(pi, qi, True), max(3, reps // 10)) if n <= 256 else float("nan")
-        pairs = (timeit(lambda: shapely.MultiPoint((P[:, None] + Q[None]).reshape(-1, 2)).convex_hull,
+        clip = median_time(lambda: pyclipper.MinkowskiSum(pi, qi, True), max(3, reps // 10)) if n <= 256 else float("nan")
+        pairs = (median_time(lambda: shapely.MultiPoint((P[:, None] + Q[None]).reshape(-1, 2)).convex_hull,
                         max(3, reps // 10)) if n <= 1024 else float("nan"))
         # Exactness on integer input: the area agrees with the all-pairs hull where that runs.
         print(f"{n:>6} {ours * 1e6:>9.1f}us {clip * 1e6:>9.1f}us {pairs * 1e6:>9.1f}us {srt * 1e6:>9.1f}us "
@@ -62,10 +57,10 @@ def main():
     # k-way: one merge of k polygons against one sort of all their edges.
     k, n = 8, 2048
     polys = [random_convex(n, rng) for _ in range(k)]
-    kway = timeit(lambda: minkowski_sum(*polys), 20)
+    kway = median_time(lambda: minkowski_sum(*polys), 20)
     e = np.concatenate([np.roll(p, -1, 0) - p for p in polys])
     ang = np.arctan2(e[:, 1], e[:, 0])
-    srt = timeit(lambda: np.argsort(ang), 20)
+    srt = median_time(lambda: np.argsort(ang), 20)
     print(f"k-way: {k} polygons x {n} vertices: {kway * 1e3:.2f} ms, one argsort of all edges "
           f"{srt * 1e3:.2f} ms, ratio {kway / srt:.2f}")
     print("(pyclipper skipped above 256 vertices: O(n m) quads, minutes at 1024; pairs+hull above 1024)")
