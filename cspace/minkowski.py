@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
-from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, orient2d_xy, product_error, sum_error
+from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, error_free_cross_sign, orient2d_xy, sum_error
 
 # Up to this many vertices in total the scalar merge is faster than numpy's overhead.
 _SCALAR_MAX = 96
@@ -503,22 +503,14 @@ def _parallel_pairs(ux, uy, half, integral, X, Y, order, first, ends, edged, w1,
 
 
 def _error_free_signs(ux: np.ndarray, uy: np.ndarray, doubt: np.ndarray) -> np.ndarray:
-    """Exact signs of ux[t]*uy[t+1] - uy[t]*ux[t+1] where both products are exact.
+    """Exact signs of ux[t]*uy[t+1] - uy[t]*ux[t+1] where floats get them without error, else 2.
 
-    Dekker's TwoProduct tells whether a float product was exact (its error term is
-    zero). When both products are exact, the one rounded subtraction keeps the true
-    sign. Returns 2 where this cannot certify (the caller goes to rationals). The
-    edges themselves must be exact differences, which holds for integer coordinates
-    below 2^52 and is checked by the caller's choice of route.
+    :func:`cspace.predicates.error_free_cross_sign` on the edge vectors (as differences
+    from the origin, which are exact). The edges themselves must be exact differences
+    of the input vertices, which the caller checks.
     """
-    a, b = ux[doubt], uy[doubt + 1]
-    c, d = uy[doubt], ux[doubt + 1]
-    with np.errstate(over="ignore", invalid="ignore"):
-        left, right = a * b, c * d
-        ok = (product_error(a, b, left) == 0) & (product_error(c, d, right) == 0)
-        ok &= (np.abs(left) < 2.0**1000) & (np.abs(right) < 2.0**1000)
-        det = left - right
-    return np.where(ok, np.sign(det), 2).astype(np.int8)
+    z = np.zeros(len(doubt))
+    return error_free_cross_sign(z, z, ux[doubt], uy[doubt], z, z, ux[doubt + 1], uy[doubt + 1])
 
 
 def _diff_is_exact_cols(x: np.ndarray, first: np.ndarray, ends: np.ndarray) -> np.ndarray:

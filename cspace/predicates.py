@@ -202,9 +202,11 @@ def error_free_cross_sign(ax, ay, bx, by, cx, cy, dx, dy) -> np.ndarray:
         ok &= (sum_error(dx, -cx, vx) == 0) & (sum_error(dy, -cy, vy) == 0)
         left, right = ux * vy, uy * vx
         ok &= (product_error(ux, vy, left) == 0) & (product_error(uy, vx, right) == 0)
-        # far from over- and underflow, where TwoSum/TwoProduct are themselves exact
-        big = np.maximum(np.abs(left), np.abs(right))
-        ok &= (big < 2.0**1000) & ((big > 2.0**-900) | ((left == 0) & (right == 0)))
+        # Far from over- and underflow, where TwoProduct is itself exact: each product
+        # in (2^-900, 2^1000), or zero because a factor is (a product that underflowed
+        # to zero from non-zero factors would look exact and is not).
+        ok &= ((np.abs(left) > 2.0**-900) | (ux == 0) | (vy == 0)) & (np.abs(left) < 2.0**1000)
+        ok &= ((np.abs(right) > 2.0**-900) | (uy == 0) | (vx == 0)) & (np.abs(right) < 2.0**1000)
         ok &= np.isfinite(ux) & np.isfinite(uy) & np.isfinite(vx) & np.isfinite(vy)
         det = left - right
     return np.where(ok, np.sign(det), 2).astype(np.int8)

@@ -264,3 +264,17 @@ def test_vectorised_route_rejects_non_convex_operands():
     a = 4 * np.pi * np.arange(101) / 101
     with pytest.raises(ValueError):
         minkowski_sum(np.c_[np.cos(a), np.sin(a)], Q)
+
+
+def test_vectorised_route_at_underflowing_scale():
+    # Edge-vector products of operands scaled by 2^-700 underflow to zero; they must not
+    # be taken as exactly parallel (which fused 390 of 400 vertices away). Scaling by a
+    # power of two is exact, so the sum is the unit-scale sum scaled.
+    t = np.linspace(0, 2 * np.pi, 201)[:-1]
+    P = np.round(np.c_[np.cos(t), np.sin(t)] * 2**20)
+    Q = P.copy()
+    Q[:, 1] += Q[:, 0] * 2.0**-30  # edges a hair off P's
+    s = 2.0**-700
+    ref = minkowski_sum(P, Q)
+    assert len(ref) == 400
+    assert np.array_equal(minkowski_sum(P * s, Q * s), ref * s)

@@ -48,3 +48,14 @@ def test_columns_match_scalar_on_touching_grid():
            for i in range(len(p))]
     assert cols.tolist() == ref
     assert (cols == 0).sum() > 100  # the corpus really exercises the zeros
+
+
+def test_underflowing_products_are_not_taken_as_exact():
+    # (1e-200, 0) x (0, 1e-200) = 1e-400 > 0: both float products underflow to zero, and
+    # TwoProduct's error terms underflow with them; the sign must still come out +1.
+    v = (0.0, 0.0, 1e-200, 0.0, 0.0, 0.0, 0.0, 1e-200)
+    cols = [np.array([x]) for x in v]
+    assert exact(*v) == 1
+    assert int(error_free_cross_sign(*cols)[0]) == 2  # undecided: left to rationals
+    assert cross_diff_cols(*cols).tolist() == [1]
+    assert cross_diff_sign(*v) == 1
