@@ -235,18 +235,6 @@ class CSpace:
         mixed = self._mixed_cell_test()
         xmin, xmax, ymin, ymax = self.bounds
 
-        def slow(x: float, y: float) -> bool:
-            # A MIXED cell inside the bounds (same rounded index as the fast path)
-            # goes to the inlined narrow phase; everything else to the exact path.
-            if xmin <= x <= xmax and ymin <= y <= ymax:
-                i = x * iw - a0
-                j = y * ih - b0
-                if 0.0 <= i < fnx and 0.0 <= j < fny:
-                    cell = int(j) * nx + int(i)
-                    if cells[cell] == 1:
-                        return mixed(cell, x, y)
-            return exact(x, y)
-
         def is_free_q(q) -> bool:
             if tick is not None:
                 tick()
@@ -255,10 +243,13 @@ class CSpace:
             i = x * iw - a0
             j = y * ih - b0
             if 0.0 <= i < fnx and 0.0 <= j < fny:
-                c = cells[int(j) * nx + int(i)]
+                cell = int(j) * nx + int(i)
+                c = cells[cell]
                 if c != 1:
                     return c == 0  # FREE (0) or BLOCKED (2)
-            return slow(x, y)
+                if xmin <= x <= xmax and ymin <= y <= ymax:
+                    return mixed(cell, x, y)  # MIXED, inside the bounds: the inlined narrow phase
+            return exact(x, y)  # the bounds' edges and anything outside
 
         if state:
             return is_free_q
@@ -292,7 +283,7 @@ class CSpace:
             out = []
             px, py = pts[-1]
             for e, (qx, qy) in enumerate(pts):
-                if mask == -1 or (mask >> e) & 1:
+                if (mask >> e) & 1:
                     out.append((px, py, qx, qy, qx - px, qy - py))
                 px, py = qx, qy
             chosen[k, mask] = out

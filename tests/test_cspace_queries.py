@@ -145,8 +145,6 @@ def test_mixed_cell_edge_masks_are_conservative(name):
         pts = np.vstack([pts, [[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]])
         for t in range(starts[cell], starts[cell + 1]):
             k, mask = cand[t], masks[t]
-            if mask == -1:
-                continue
             p = cs.pieces[k]
             for e in range(len(p)):
                 if (mask >> e) & 1:
