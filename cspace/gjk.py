@@ -28,8 +28,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .polygon import as_array
-from .predicates import _UNDERFLOW_GUARD as _GUARD
-from .predicates import CCW_ERRBOUND_A, orient2d_cols, orient2d_xy
+from .predicates import orient2d_cols, orient2d_xy
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -276,16 +275,11 @@ def _contact_relation(A: list, B: list, simplex: list) -> str | None:
 
 def _side_of(P: list, x0: float, y0: float, x1: float, y1: float):
     """(+1 or -1, points on the line) if P lies on one closed side of line (x0,y0)->(x1,y1),
-    else None. Signs from Shewchuk's filter, the exact predicate only in doubt."""
+    else None (exact signs)."""
     side = 0
     on = []
     for x, y in P:
-        left, right = (x0 - x) * (y1 - y), (y0 - y) * (x1 - x)
-        det, sm = left - right, abs(left) + abs(right)
-        if _GUARD < sm < math.inf and abs(det) > CCW_ERRBOUND_A * sm:
-            s = 1 if det > 0 else -1
-        else:
-            s = orient2d_xy(x0, y0, x1, y1, x, y)
+        s = orient2d_xy(x0, y0, x1, y1, x, y)
         if s == 0:
             on.append((x, y))
         elif side == 0:
@@ -345,12 +339,8 @@ def _as_hull(p: np.ndarray, convex_hull) -> np.ndarray:
         ups = 0
         for i in range(n):
             (ax, ay), (bx, by), (cx, cy) = pts[i - 2], pts[i - 1], pts[i]
-            # orient2d(a, b, c) > 0, Shewchuk's filter inlined (exact call only in doubt)
-            left, right = (ax - cx) * (by - cy), (ay - cy) * (bx - cx)
-            sm = abs(left) + abs(right)
-            if not (_GUARD < sm < math.inf and left - right > CCW_ERRBOUND_A * sm):
-                if orient2d_xy(ax, ay, bx, by, cx, cy) <= 0:
-                    break
+            if orient2d_xy(ax, ay, bx, by, cx, cy) <= 0:
+                break
             lower_before = by < ay or (by == ay and bx < ax)
             upper_after = cy > by or (cy == by and cx > bx)
             ups += lower_before and upper_after
@@ -377,13 +367,6 @@ def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:
             (x0, y0), (x1, y1) = g[i - 1], g[i]
             on_line = False
             for x, y in h:
-                # orient2d(p0, p1, v): Shewchuk's filter inlined, the exact call only in doubt
-                left, right = (x0 - x) * (y1 - y), (y0 - y) * (x1 - x)
-                det, sm = left - right, abs(left) + abs(right)
-                if _GUARD < sm < math.inf and abs(det) > CCW_ERRBOUND_A * sm:
-                    if det > 0:
-                        break
-                    continue
                 s = orient2d_xy(x0, y0, x1, y1, x, y)
                 if s > 0:
                     break
