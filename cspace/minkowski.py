@@ -443,8 +443,8 @@ def _merge_vectorised(polys: list) -> np.ndarray | None:
         return out
     # Float input: each vertex is the sum of one input vertex per operand, rounded
     # once per addition; the count of an operand's edges taken so far is its index.
-    vx = np.full(len(keep), start[0] - X[first].sum())
-    vy = np.full(len(keep), start[1] - Y[first].sum())
+    vx = np.zeros(len(keep))
+    vy = np.zeros(len(keep))
     owner = np.repeat(np.arange(len(edged)), sizes)[order]
     for i, lo in enumerate(first):
         cnt = np.cumsum(owner == i)[keep] % sizes[i] + lo
