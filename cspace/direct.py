@@ -101,17 +101,12 @@ class DirectChecker:
         >>> DirectChecker.from_scenario(f).is_free((2, 2))
         False
         """
-        from .decompose import convex_decompose
-        from .polygon import is_convex
+        from .decompose import convex_decompose  # a convex shape comes back whole
         from .scenario import Scenario, load_scenario
 
         sc = scenario if isinstance(scenario, Scenario) else load_scenario(os.fspath(scenario))
-        obstacles = []
-        for o in sc.obstacles:
-            obstacles += [o.polygon] if not o.holes and is_convex(o.polygon) else convex_decompose(o.polygon, o.holes)
-        robot = []
-        for r in sc.robot:
-            robot += [r.polygon] if sc.robot_kind == "disk" or is_convex(r.polygon) else convex_decompose(r.polygon)
+        obstacles = [p for o in sc.obstacles for p in convex_decompose(o.polygon, o.holes)]
+        robot = [p for r in sc.robot for p in convex_decompose(r.polygon)]
         return cls(robot, obstacles, sc.bounds)
 
     # -- queries ---------------------------------------------------------------------
