@@ -228,28 +228,39 @@ class CSpace:
         iw, ih = idx.inv_w, idx.inv_h
         a0, b0 = idx.x0 * iw, idx.y0 * ih
         nx, ny = idx.nx, idx.ny
-        fnx, fny = float(nx), float(ny)
-        # One byte per cell (FREE 0, MIXED 1, BLOCKED 2): compact enough to stay in cache.
-        cells = idx.state.astype(np.uint8).tobytes()
+        # One byte per cell (FREE 0, MIXED 1, BLOCKED 2), one bytes object per row:
+        # compact enough to stay in cache, and rows[j][i] saves the j * nx + i of a
+        # flat index on the FREE and BLOCKED states, which are most of them. Each row
+        # ends with a border cell (3) and a border row follows the last: a point up
+        # to a cell past the top or right edge reads a border cell, one further raises
+        # IndexError (inf: OverflowError), so only the lower edges need a comparison.
+        flat = idx.state.astype(np.uint8).tobytes()
+        border = bytes([3])
+        rows = [flat[r * nx:(r + 1) * nx] + border for r in range(ny)] + [border * (nx + 1)]
         exact = self._is_free_exact
         mixed = self._mixed_cell_test()
         xmin, xmax, ymin, ymax = self.bounds
+        count = int if tick is None else tick  # int() is a C-level no-op: no branch per query
 
         def is_free_q(q) -> bool:
-            if tick is not None:
-                tick()
+            count()
             x = q[0]
             y = q[1]
             i = x * iw - a0
             j = y * ih - b0
-            if 0.0 <= i < fnx and 0.0 <= j < fny:
-                cell = int(j) * nx + int(i)
-                c = cells[cell]
-                if c != 1:
-                    return c == 0  # FREE (0) or BLOCKED (2)
-                if xmin <= x <= xmax and ymin <= y <= ymax:
-                    return mixed(cell, x, y)  # MIXED, inside the bounds: the inlined narrow phase
-            return exact(x, y)  # the bounds' edges and anything outside
+            if i >= 0.0 and j >= 0.0:  # also False for NaN
+                try:
+                    c = rows[int(j)][int(i)]
+                except (IndexError, OverflowError):
+                    return exact(x, y)  # off the grid's top or right
+                if not c:
+                    return True  # FREE
+                if c == 2:
+                    return False  # BLOCKED
+                if c == 1 and xmin <= x <= xmax and ymin <= y <= ymax:
+                    # MIXED, inside the bounds: the inlined narrow phase
+                    return mixed(int(j) * nx + int(i), x, y)
+            return exact(x, y)  # the bounds' edges, the border and anything outside
 
         if state:
             return is_free_q
@@ -274,28 +285,30 @@ class CSpace:
         starts, cand = self.index._starts_list, self.index._cand_list
         masks = self.index.cand_masks_list
         lists = self.packed._lists
-        chosen: dict = {}  # (piece, mask) -> that piece's edges named by the mask
+        by_cell: dict = {}  # cell -> per candidate piece, its edges named by the cell's mask
         checks = self.checks
         tiny = CCW_ERRBOUND_A * _UNDERFLOW_GUARD
 
-        def edges_of(k: int, mask: int) -> list:
-            pts = lists[k]
-            out = []
-            px, py = pts[-1]
-            for e, (qx, qy) in enumerate(pts):
-                if (mask >> e) & 1:
-                    out.append((px, py, qx, qy, qx - px, qy - py))
-                px, py = qx, qy
-            chosen[k, mask] = out
-            return out
+        def edges_near(cell: int) -> list:
+            # Only the edges whose line passes near this cell: the cell lies well
+            # inside every other edge's half-plane (certified at build, with margin).
+            groups = []
+            for t in range(starts[cell], starts[cell + 1]):
+                pts, mask = lists[cand[t]], masks[t]
+                edges = []
+                px, py = pts[-1]
+                for e, (qx, qy) in enumerate(pts):
+                    if (mask >> e) & 1:
+                        edges.append((px, py, qx, qy, qx - px, qy - py))
+                    px, py = qx, qy
+                groups.append(edges)
+            by_cell[cell] = groups
+            return groups
 
         def free_in_cell(cell: int, x: float, y: float) -> bool:
             checks["exact_points"] += 1
-            for t in range(starts[cell], starts[cell + 1]):
-                k, mask = cand[t], masks[t]
-                # Only the edges whose line passes near this cell: the cell lies well
-                # inside every other edge's half-plane (certified at build, with margin).
-                for px, py, qx, qy, ex, ey in chosen.get((k, mask)) or edges_of(k, mask):
+            for edges in by_cell.get(cell) or edges_near(cell):
+                for px, py, qx, qy, ex, ey in edges:
                     left = ex * (y - py)
                     right = ey * (x - px)
                     det = left - right
@@ -305,11 +318,11 @@ class CSpace:
                     if det > bound > tiny:
                         continue  # strictly left of this edge
                     if -det > bound > tiny:
-                        break  # strictly right: outside piece k
+                        break  # strictly right: outside this piece
                     if orient2d_xy(px, py, qx, qy, x, y) < 0:
                         break
                 else:
-                    return False  # on or left of every edge: in closed piece k
+                    return False  # on or left of every edge: in this closed piece
             return True
 
         return free_in_cell

@@ -153,3 +153,27 @@ def test_mixed_cell_edge_masks_are_conservative(name):
                 s = orient2d_many(np.broadcast_to(p[e - 1], pts.shape), np.broadcast_to(p[e], pts.shape), pts)
                 assert (s > 0).all(), (name, cell, k, e)
     assert skipped > 0  # the masks really drop edges
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e8])
+def test_point_test_off_the_grid_goes_to_the_exact_test(offset):
+    # The hot path reads a border cell or raises IndexError past the grid's top and
+    # right edges and compares only against the lower edges: every point around the
+    # bounds, at 0, a fraction of a cell, one, two and many cells out, and the
+    # non-finite ones, must get the exact answer. Obstacles straddle two corners, so
+    # a point read from a wrong (neighbouring or wrapped) cell would be answered wrong.
+    o = offset
+    sq = lambda x0, y0, s: np.array([[x0, y0], [x0 + s, y0], [x0 + s, y0 + s], [x0, y0 + s]]) + o
+    cs = CSpace((o, o + 10.0, o, o + 10.0), [sq(8.0, 8.0, 4.0), sq(-2.0, -2.0, 4.0), sq(4.0, 4.0, 1.0)])
+    cw, ch = 10.0 / cs.index.nx, 10.0 / cs.index.ny
+    xs = [o + d for d in (-1e6, -2.5 * cw, -1.5 * cw, -0.5 * cw, 0.0, 0.5 * cw, 3.0, 4.5, 9.0, 10.0 - 0.5 * cw,
+                          10.0, 10.0 + 0.5 * cw, 10.0 + 1.5 * cw, 10.0 + 2.5 * cw, 1e6)]
+    ys = [o + d for d in (-1e6, -1.5 * ch, -0.5 * ch, 0.0, 1.0, 4.5, 9.0, 10.0, 10.0 + 0.5 * ch, 10.0 + 1.5 * ch, 1e6)]
+    odd = [math.nan, math.inf, -math.inf, 1e308, -1e308]
+    q_test, xy_test = cs.point_test(state=True), cs.point_test()
+    for x in xs + odd:
+        for y in ys + odd:
+            inside = o <= x <= o + 10.0 and o <= y <= o + 10.0
+            blocked = any(shapely.Polygon(p).intersects(shapely.Point(x, y)) for p in cs.pieces) if inside else True
+            want = inside and not blocked
+            assert q_test((x, y)) == want and xy_test(x, y) == want == cs._is_free_exact(x, y), (x, y)
