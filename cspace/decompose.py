@@ -9,30 +9,30 @@ them, so a polygon without holes with r reflex vertices gets at most 2r + 1
 pieces, within 4x of the optimum. Convexity of a merge is decided exactly
 (:func:`cspace.predicates.orient2d_xy`).
 
-Which diagonals survive depends on the order they are tried in. Longer diagonals
-are tried first (removing them merges big triangles early), and for small polygons
-a few more orders are tried and the one with the fewest pieces kept: cheap, and it
-finds the optimum on most hand-sized shapes (L, U, combs, rooms). A convex input
-without holes is returned as it is, never triangulated.
+Which diagonals survive depends on the order they are tried in. A diagonal that
+*resolves* a reflex vertex (splits its angle into two angles of at most pi) is
+worth keeping, and one resolving both its ends (a comb's tooth base) does the work
+of two cuts. So diagonals are tried in ranks: between two convex vertices first,
+then those touching a reflex vertex, then those resolving one, then two; longest
+first within a rank (removing them merges big triangles early). One pass is enough: a merge refused once stays refused, since
+pieces only grow. A convex input without holes is returned as it is, never
+triangulated.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .polygon import as_array, drop_collinear, is_convex, normalize
-from .predicates import orient2d_xy
-
-# Polygons with at most this many vertices get extra diagonal orders tried.
-_SMALL = 64
-_EXTRA_ORDERS = 6
+from .predicates import orient2d_cols, orient2d_xy
 
 
 def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
     """Split a simple polygon (with optional holes) into convex CCW pieces.
 
     The pieces' union is the polygon, their interiors are disjoint, and every
-    piece vertex is an input vertex. ``polygon`` may also be a shapely Polygon
-    (its interiors are then the holes).
+    piece vertex is an input vertex. Each piece is strictly convex (no collinear
+    vertex) and starts at its lowest (then leftmost) vertex. ``polygon`` may also
+    be a shapely Polygon (its interiors are then the holes).
 
     >>> pieces = convex_decompose([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]])
     >>> len(pieces), sorted(len(p) for p in pieces)
@@ -46,58 +46,92 @@ def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
     hole_list = [normalize(h, ccw=False) for h in (holes or [])]
     if not hole_list and is_convex(shell):
         return [shell]
-    tris, pts = _triangulate(shell, hole_list)
-    best = None
-    orders = [None] + (list(range(_EXTRA_ORDERS)) if len(pts) <= _SMALL else [])
-    for seed in orders:
-        pieces = _hertel_mehlhorn(tris, pts, seed)
-        if best is None or len(pieces) < len(best):
-            best = pieces
-    return [_finish(pts, cyc) for cyc in best]
+    rings = [shell] + hole_list
+    pts = np.concatenate(rings) if hole_list else shell
+    tris = _triangulate(rings, pts)
+    diagonals = _diagonals(tris)
+    if not len(diagonals):
+        return _finish(pts, tris.tolist())
+    rank = _diagonal_ranks(rings, pts, diagonals)
+    vec = pts[diagonals[:, 0]] - pts[diagonals[:, 1]]
+    order = np.lexsort((-np.hypot(vec[:, 0], vec[:, 1]), rank))
+    return _finish(pts, _hertel_mehlhorn(tris, pts, diagonals[order].tolist()))
 
 
-def _triangulate(shell: np.ndarray, holes: list) -> tuple[list, np.ndarray]:
-    """CCW index triangles of the polygon, over the array of its distinct vertices."""
+def _diagonals(tris: np.ndarray) -> np.ndarray:
+    """The triangulation's inner edges (u, v), u < v, once each."""
+    e = np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]])
+    e = np.sort(e, axis=1)
+    e = e[np.lexsort((e[:, 1], e[:, 0]))]
+    twice = np.flatnonzero((e[1:] == e[:-1]).all(axis=1))
+    return e[twice]
+
+
+def _triangulate(rings: list, pts: np.ndarray) -> np.ndarray:
+    """CCW index triangles ``(T, 3)`` of the polygon, over the array of its vertices."""
     import shapely
 
-    poly = shapely.Polygon(shell, holes)
-    tri = shapely.constrained_delaunay_triangles(poly)
-    pts = np.concatenate([shell] + holes) if holes else shell
+    tri = shapely.constrained_delaunay_triangles(shapely.Polygon(rings[0], rings[1:]))
+    corners = shapely.get_coordinates(tri).reshape(-1, 4, 2)[:, :3].reshape(-1, 2)
     index = {(x, y): i for i, (x, y) in enumerate(pts.tolist())}
-    tris = []
-    for g in shapely.get_parts(tri):
-        c = np.asarray(g.exterior.coords)[:3].tolist()
-        try:
-            ids = [index[(x, y)] for x, y in c]
-        except KeyError:  # never expected: GEOS's CDT uses the input vertices only
-            raise ValueError("convex_decompose: triangulation introduced a new vertex") from None
-        a, b, d = (pts[i] for i in ids)
-        turn = orient2d_xy(*a, *b, *d)
-        if turn == 0:
-            continue  # a zero-area sliver: covers nothing
-        tris.append(ids if turn > 0 else ids[::-1])
-    return tris, pts
+    try:
+        ids = np.array([index[(x, y)] for x, y in corners.tolist()], dtype=np.intp).reshape(-1, 3)
+    except KeyError:  # never expected: GEOS's CDT uses the input vertices only
+        raise ValueError("convex_decompose: triangulation introduced a new vertex") from None
+    a, b, c = pts[ids[:, 0]], pts[ids[:, 1]], pts[ids[:, 2]]
+    turn = orient2d_cols(a[:, 0], a[:, 1], b[:, 0], b[:, 1], c[:, 0], c[:, 1])
+    ids[turn < 0] = ids[turn < 0][:, ::-1]
+    return ids[turn != 0]  # a zero-area sliver covers nothing
 
 
-def _hertel_mehlhorn(tris: list, pts: np.ndarray, seed) -> list[list[int]]:
-    """Merge triangles across inessential diagonals; return the pieces as index cycles."""
-    pieces = {k: list(t) for k, t in enumerate(tris)}
+def _ring_neighbours(rings: list) -> tuple[np.ndarray, np.ndarray]:
+    """Indices of each vertex's predecessor and successor along its own ring."""
+    prev, nxt, start = [], [], 0
+    for r in rings:
+        k = np.arange(start, start + len(r))
+        prev.append(np.roll(k, 1))
+        nxt.append(np.roll(k, -1))
+        start += len(r)
+    return np.concatenate(prev), np.concatenate(nxt)
+
+
+def _diagonal_ranks(rings: list, pts: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """How worth keeping each diagonal (u, v) of ``d`` is: 0 between two convex
+    vertices, else 1 plus the number of reflex endpoints it *resolves*.
+
+    The polygon's interior lies left of every ring (CCW shell, CW holes). A reflex
+    vertex v (right turn prev -> v -> next) is resolved by a diagonal v -> w when w
+    lies in the cone where both parts of the angle are at most pi: left of or on
+    v -> next and right of or on v -> prev, exactly. One cut that resolves both its
+    ends does the work of two (a comb's tooth bases).
+    """
+    prev, nxt = _ring_neighbours(rings)
+    P, N = pts[prev], pts[nxt]
+    reflex = orient2d_cols(P[:, 0], P[:, 1], pts[:, 0], pts[:, 1], N[:, 0], N[:, 1]) < 0
+    rank = (reflex[d[:, 0]] | reflex[d[:, 1]]).astype(np.int8)
+    for v, w in ((d[:, 0], d[:, 1]), (d[:, 1], d[:, 0])):
+        k = np.flatnonzero(reflex[v])
+        v, w = v[k], w[k]
+        cv, cw, cn, cp = pts[v], pts[w], pts[nxt[v]], pts[prev[v]]
+        ok = orient2d_cols(cv[:, 0], cv[:, 1], cn[:, 0], cn[:, 1], cw[:, 0], cw[:, 1]) >= 0
+        ok &= orient2d_cols(cv[:, 0], cv[:, 1], cw[:, 0], cw[:, 1], cp[:, 0], cp[:, 1]) >= 0
+        rank[k] += ok
+    return rank
+
+
+def _hertel_mehlhorn(tris: np.ndarray, pts: np.ndarray, diagonals: list) -> list[list[int]]:
+    """Merge triangles across the diagonals, tried in the given order, while the
+    merge stays convex; return the pieces as index cycles."""
+    pieces = {k: t for k, t in enumerate(tris.tolist())}
     owner: dict = {}  # directed edge (u, v) -> piece holding it
-    for k, t in pieces.items():
-        for i in range(3):
-            owner[(t[i], t[(i + 1) % 3])] = k
-    diagonals = [(u, v) for (u, v) in owner if u < v and (v, u) in owner]
-    if seed is None:
-        d = pts[[u for u, _ in diagonals]] - pts[[v for _, v in diagonals]] if diagonals else np.zeros((0, 2))
-        order = np.argsort(-np.hypot(d[:, 0], d[:, 1]), kind="stable")
-    else:
-        order = np.random.default_rng(seed).permutation(len(diagonals))
-    for idx in order:
-        u, v = diagonals[idx]
+    for k, (a, b, c) in pieces.items():
+        owner[(a, b)] = owner[(b, c)] = owner[(c, a)] = k
+    xy = pts.tolist()
+    for u, v in diagonals:
         a, b = owner.get((u, v)), owner.get((v, u))
         if a is None or b is None or a == b:
             continue
-        merged = _merge(pieces[a], pieces[b], u, v, pts)
+        merged = _merge(pieces[a], pieces[b], u, v, xy, owner)
         if merged is None:
             continue
         del pieces[b]
@@ -110,23 +144,56 @@ def _hertel_mehlhorn(tris: list, pts: np.ndarray, seed) -> list[list[int]]:
     return list(pieces.values())
 
 
-def _merge(p: list, q: list, u: int, v: int, pts: np.ndarray) -> list | None:
-    """p holds edge u->v, q holds v->u; their union if it is convex at u and at v."""
+def _merge(p: list, q: list, u: int, v: int, xy: list, owner: dict) -> list | None:
+    """p holds edge u->v, q holds v->u; their union if it is convex at u and at v.
+
+    A corner the merge makes straight is dropped at once: it stays straight (pieces
+    only grow, so no later merge can be convex there), and the edges through it can
+    no longer be merged across, so they leave ``owner``.
+    """
     i = p.index(u)
-    p_rot = p[i:] + p[:i]          # u, v, ..., (back to u)
     j = q.index(v)
-    q_rot = q[j:] + q[:j]          # v, u, ..., (back to v)
-    merged = p_rot[1:] + q_rot[1:]  # v ... (p's path to u) u ... (q's path to v)
-    # Corners to check: u (between p's last and q's first after u) and v.
+    merged = p[i + 1:] + p[:i] + q[j + 1:] + q[:j]  # v ... (p's path to u) u ... (q's path to v)
     n = len(merged)
-    for corner in (u, v):
-        k = merged.index(corner)
-        a, b, c = pts[merged[k - 1]], pts[corner], pts[merged[(k + 1) % n]]
-        if orient2d_xy(a[0], a[1], b[0], b[1], c[0], c[1]) < 0:
+    straight = []
+    for k in (n - len(q) + 1, 0):  # the positions of u and v
+        (ax, ay), (bx, by), (cx, cy) = xy[merged[k - 1]], xy[merged[k]], xy[merged[(k + 1) % n]]
+        turn = orient2d_xy(ax, ay, bx, by, cx, cy)
+        if turn < 0:
             return None
+        if turn == 0:
+            straight.append(k)
+    for k in sorted(straight, reverse=True):
+        owner.pop((merged[k - 1], merged[k]), None)
+        owner.pop((merged[k], merged[(k + 1) % len(merged)]), None)
+        del merged[k]
     return merged
 
 
-def _finish(pts: np.ndarray, cycle: list[int]) -> np.ndarray:
-    """A piece as a CCW array starting at its lowest vertex, collinear corners dropped."""
-    return normalize(drop_collinear(pts[cycle]))
+def _finish(pts: np.ndarray, cycles: list) -> list[np.ndarray]:
+    """The pieces as CCW arrays from their lowest (then leftmost) vertex.
+
+    An exact check of every corner in one vectorised pass guards the invariant that
+    no straight corner survived the merges (a zero-area sliver skipped by the
+    triangulation could leave one); such a piece is cleaned the slow way.
+    """
+    sizes = np.array([len(c) for c in cycles])
+    flat = np.array([i for c in cycles for i in c], dtype=np.intp)
+    ends = np.cumsum(sizes)
+    starts = ends - sizes
+    pos = np.arange(len(flat))
+    owner = np.repeat(np.arange(len(cycles)), sizes)
+    prev = np.where(pos == starts[owner], ends[owner] - 1, pos - 1)
+    nxt = np.where(pos == ends[owner] - 1, starts[owner], pos + 1)
+    P, V, N = pts[flat[prev]], pts[flat], pts[flat[nxt]]
+    turn = orient2d_cols(P[:, 0], P[:, 1], V[:, 0], V[:, 1], N[:, 0], N[:, 1])
+    bad = np.zeros(len(cycles), dtype=bool)
+    bad[owner[turn <= 0]] = True
+    # lowest-then-leftmost vertex of each cycle: lexsort by (piece, y, x), first of each piece
+    first = np.lexsort((V[:, 0], V[:, 1], owner))[starts]
+    out = []
+    for c in range(len(cycles)):
+        s, e, f = starts[c], ends[c], first[c]
+        piece = np.concatenate([V[f:e], V[s:f]])
+        out.append(normalize(drop_collinear(piece)) if bad[c] else piece)
+    return out

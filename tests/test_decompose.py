@@ -65,6 +65,15 @@ def test_comb_is_optimal_and_holes_are_covered():
     assert sum(shapely.Polygon(p).area for p in pieces) == pytest.approx(ref.area, rel=1e-12)
 
 
+@pytest.mark.parametrize("k", range(8))
+def test_an_l_shape_is_two_pieces_in_every_rotation_and_mirror(k):
+    L = np.array([[96.0, 51], [100, 51], [100, 53], [97, 53], [97, 52], [96, 52]])  # one reflex vertex
+    P = L @ np.linalg.matrix_power(np.array([[0.0, -1.0], [1.0, 0.0]]), k % 4)  # k quarter turns
+    if k >= 4:
+        P = P * [-1.0, 1.0]
+    assert len(convex_decompose(P)) == 2
+
+
 def reference_sum(A, B):
     """Independent: the union of all triangle-pair sums (GEOS triangulation, hull of the 9 vertex sums)."""
     def tris(P):
