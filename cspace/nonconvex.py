@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .decompose import convex_decompose
-from .minkowski import minkowski_sum
+from .pairsums import pairwise_sums
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -25,9 +25,7 @@ def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
     >>> len(minkowski_pieces(L, [[0, 0], [1, 0], [0, 1]]))
     2
     """
-    pa = convex_decompose(A, holes_a)
-    pb = convex_decompose(B, holes_b)
-    return [minkowski_sum(a, b) for a in pa for b in pb]
+    return pairwise_sums(convex_decompose(A, holes_a), convex_decompose(B, holes_b))
 
 
 def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
@@ -42,10 +40,15 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
     """
     import shapely
 
-    pieces = minkowski_pieces(A, B, holes_a, holes_b)
-    return shapely.union_all(shapely.polygons(pieces) if _same_size(pieces) else
-                             [shapely.Polygon(p) for p in pieces])
-
-
-def _same_size(pieces: list) -> bool:
-    return len({len(p) for p in pieces}) == 1 and len(pieces[0]) >= 3
+    pa, pb = convex_decompose(A, holes_a), convex_decompose(B, holes_b)
+    pieces = pairwise_sums(pa, pb)
+    sizes = np.array([len(p) for p in pieces])
+    if (sizes < 3).any():  # a degenerate pairwise sum (never from a proper decomposition)
+        polys = np.array([shapely.Polygon(p) if len(p) >= 3 else shapely.Polygon() for p in pieces])
+    else:
+        rings = shapely.linearrings(np.concatenate(pieces), indices=np.repeat(np.arange(len(pieces)), sizes))
+        polys = shapely.polygons(rings)
+    # Union row by row (row i is A_i ⊕ B: pieces that overlap a lot), then the rows:
+    # GEOS's cascaded union is about twice as fast this way as on the flat list.
+    rows = shapely.union_all(polys.reshape(len(pa), len(pb)), axis=1)
+    return shapely.union_all(rows)
