@@ -1,8 +1,10 @@
 """Minkowski sums of non-convex polygons (holes included) as unions of convex sums.
 
 A ⊕ B = ∪_{i,j} (A_i ⊕ B_j) for convex decompositions {A_i} of A and {B_j} of B
-(the sum distributes over union). Each pairwise sum is an exact angular merge
-(:func:`cspace.minkowski.minkowski_sum`); the union is shapely's (GEOS OverlayNG).
+(the sum distributes over union). Each pairwise sum is an exact angular merge, all
+pairs in one batch (:func:`cspace.pairsums.pairwise_sums`, equal to
+:func:`cspace.minkowski.minkowski_sum` pair for pair); the union is shapely's (GEOS
+OverlayNG), first per piece of A, then of those rows.
 The boundary of the union can have Θ(n²m²) complexity in the worst case (comb ⊕
 comb), which is why the C-space keeps the pieces and never needs the union.
 
