@@ -14,11 +14,12 @@ import numpy as np
 from .predicates import orient2d_many, orient2d_xy
 
 
-def as_array(polygon) -> np.ndarray:
+def as_array(polygon, copy: bool = True) -> np.ndarray:
     """Vertices of ``polygon`` as a fresh ``(N, 2)`` float64 array, closing repeat dropped.
 
     Accepts an array-like of points or a shapely ``Polygon`` / ``LinearRing`` /
-    ``LineString`` / ``Point`` (a polygon's exterior is used).
+    ``LineString`` / ``Point`` (a polygon's exterior is used). With ``copy=False`` a
+    float64 array comes back as a view of itself (for callers that only read it).
 
     >>> as_array([[0, 0], [1, 0], [0, 1], [0, 0]]).tolist()
     [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
@@ -29,7 +30,7 @@ def as_array(polygon) -> np.ndarray:
             geom = geom.exterior
         pts = np.array(geom.coords, dtype=np.float64)[:, :2]
     else:
-        pts = np.array(polygon, dtype=np.float64)
+        pts = np.array(polygon, dtype=np.float64, copy=True if copy else None)
     if pts.ndim == 1 and pts.size == 2:
         pts = pts.reshape(1, 2)
     if pts.ndim != 2 or pts.shape[1] != 2:

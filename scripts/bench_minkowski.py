@@ -43,10 +43,11 @@ def main():
     for n in map(int, args.sizes.split(",")):
         P, Q = random_convex(n, rng), random_convex(n, rng)
         reps = args.reps or max(5, min(2000, 200000 // n))
-        ours = median_time(lambda: minkowski_sum(P, Q), reps)
+        own = args.reps or max(100, min(2000, 2000000 // n))  # ours and argsort: cheap, so more
+        ours = median_time(lambda: minkowski_sum(P, Q), own)
         e = np.concatenate([np.roll(P, -1, 0) - P, np.roll(Q, -1, 0) - Q])
         ang = np.arctan2(e[:, 1], e[:, 0])
-        srt = median_time(lambda: np.argsort(ang), reps)
+        srt = median_time(lambda: np.argsort(ang), own)
         pi, qi = P.astype(np.int64).tolist(), Q.astype(np.int64).tolist()
         clip = median_time(lambda: pyclipper.MinkowskiSum(pi, qi, True), max(3, reps // 10)) if n <= 256 else float("nan")
         pairs = (median_time(lambda: shapely.MultiPoint((P[:, None] + Q[None]).reshape(-1, 2)).convex_hull,
@@ -57,10 +58,10 @@ def main():
     # k-way: one merge of k polygons against one sort of all their edges.
     k, n = 8, 2048
     polys = [random_convex(n, rng) for _ in range(k)]
-    kway = median_time(lambda: minkowski_sum(*polys), 20)
+    kway = median_time(lambda: minkowski_sum(*polys), 200)
     e = np.concatenate([np.roll(p, -1, 0) - p for p in polys])
     ang = np.arctan2(e[:, 1], e[:, 0])
-    srt = median_time(lambda: np.argsort(ang), 20)
+    srt = median_time(lambda: np.argsort(ang), 200)
     print(f"k-way: {k} polygons x {n} vertices: {kway * 1e3:.2f} ms, one argsort of all edges "
           f"{srt * 1e3:.2f} ms, ratio {kway / srt:.2f}")
     print("(pyclipper skipped above 256 vertices: O(n m) quads, minutes at 1024; pairs+hull above 1024)")

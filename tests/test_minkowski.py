@@ -278,3 +278,27 @@ def test_vectorised_route_at_underflowing_scale():
     ref = minkowski_sum(P, Q)
     assert len(ref) == 400
     assert np.array_equal(minkowski_sum(P * s, Q * s), ref * s)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.integers(2, 3), st.sampled_from(["int", "float", "parallel"]))
+def test_vectorised_route_is_independent_of_start_vertex_and_orientation(seed, reverse, k, kind):
+    # The large path reads each operand from its lowest vertex in place (no rotated
+    # copy) and, for two operands, rebuilds every vertex from the two counts of edges
+    # taken: any start vertex and either orientation must give the same sum, equal to
+    # the scalar merge. 'parallel': scaled copies, so every edge fuses with another.
+    rng = np.random.default_rng(seed)
+    integer = kind != "float"
+    base = _random_convex(rng, int(rng.integers(60, 400)), 2.0**20, integer=integer)
+    polys = [base * 2.0**i if kind == "parallel" else _random_convex(rng, int(rng.integers(60, 400)), 2.0**20,
+                                                                     integer=integer) for i in range(k)]
+    want = minkowski_sum(*polys)
+    moved = []
+    for p in polys:
+        q = np.roll(p, int(rng.integers(1, len(p))), axis=0)
+        moved.append(q[::-1] if reverse else q)
+    S = minkowski_sum(*moved)
+    assert strictly_convex(S)
+    assert S.tolist() == want.tolist() == [list(v) for v in _scalar_reference(*polys)]
+    if integer and k == 2 and len(polys[0]) * len(polys[1]) <= 20000:  # the Fraction hull is O(nm)
+        assert as_fr(S) == exact_sum(*polys)
