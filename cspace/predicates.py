@@ -169,6 +169,8 @@ def cross_diff_cols(ax, ay, bx, by, cx, cy, dx, dy) -> np.ndarray:
         certain = sign != 0
         certain |= (detsum == 0.0) & ((ux == 0.0) | (vy == 0.0)) & ((uy == 0.0) | (vx == 0.0))
     if not certain.all():
+        if np.ndim(certain) == 0:  # all scalars: the scalar exact route
+            return np.array(cross_diff_sign(ax, ay, bx, by, cx, cy, dx, dy), dtype=np.int8)
         cols = np.broadcast_arrays(ax, ay, bx, by, cx, cy, dx, dy, sign)
         sign = np.array(cols[-1], dtype=np.int8)
         doubt = np.nonzero(~np.broadcast_to(certain, sign.shape))

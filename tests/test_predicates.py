@@ -59,3 +59,14 @@ def test_underflowing_products_are_not_taken_as_exact():
     assert int(error_free_cross_sign(*cols)[0]) == 2  # undecided: left to rationals
     assert cross_diff_cols(*cols).tolist() == [1]
     assert cross_diff_sign(*v) == 1
+
+
+def test_column_predicates_take_plain_scalars_in_doubt():
+    # Scalars whose sign the filter cannot decide (a collinear triple, and the note's
+    # near-parallel pair) reach the exact stage as 0-d arrays.
+    from cspace.predicates import cross_diff_cols, orient2d_cols
+
+    assert int(orient2d_cols(0.0, 0.0, 1.0, 1.0, 3.0, 3.0)) == 0
+    assert int(orient2d_cols(0.1, 0.1, 0.3, 0.3, 0.7, 0.7)) == orient2d_xy(0.1, 0.1, 0.3, 0.3, 0.7, 0.7)
+    d = 2.0**-30
+    assert int(cross_diff_cols(0.0, 0.0, 1e6, 1.0, 0.0, 0.0, 2e6, 2.0 + d)) == 1
