@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polygon import as_array, drop_collinear, is_convex, normalize
-from .predicates import orient2d_cols, orient2d_xy
+from .polygon import as_array, drop_collinear, is_convex, normalize, ring_neighbours
+from .predicates import orient2d_many, orient2d_xy
 
 
 def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
@@ -78,21 +78,9 @@ def _triangulate(rings: list, pts: np.ndarray) -> np.ndarray:
         ids = np.array([index[(x, y)] for x, y in corners.tolist()], dtype=np.intp).reshape(-1, 3)
     except KeyError:  # never expected: GEOS's CDT uses the input vertices only
         raise ValueError("convex_decompose: triangulation introduced a new vertex") from None
-    a, b, c = pts[ids[:, 0]], pts[ids[:, 1]], pts[ids[:, 2]]
-    turn = orient2d_cols(a[:, 0], a[:, 1], b[:, 0], b[:, 1], c[:, 0], c[:, 1])
+    turn = orient2d_many(pts[ids[:, 0]], pts[ids[:, 1]], pts[ids[:, 2]])
     ids[turn < 0] = ids[turn < 0][:, ::-1]
     return ids[turn != 0]  # a zero-area sliver covers nothing
-
-
-def _ring_neighbours(rings: list) -> tuple[np.ndarray, np.ndarray]:
-    """Indices of each vertex's predecessor and successor along its own ring."""
-    prev, nxt, start = [], [], 0
-    for r in rings:
-        k = np.arange(start, start + len(r))
-        prev.append(np.roll(k, 1))
-        nxt.append(np.roll(k, -1))
-        start += len(r)
-    return np.concatenate(prev), np.concatenate(nxt)
 
 
 def _diagonal_ranks(rings: list, pts: np.ndarray, d: np.ndarray) -> np.ndarray:
@@ -105,16 +93,15 @@ def _diagonal_ranks(rings: list, pts: np.ndarray, d: np.ndarray) -> np.ndarray:
     v -> next and right of or on v -> prev, exactly. One cut that resolves both its
     ends does the work of two (a comb's tooth bases).
     """
-    prev, nxt = _ring_neighbours(rings)
-    P, N = pts[prev], pts[nxt]
-    reflex = orient2d_cols(P[:, 0], P[:, 1], pts[:, 0], pts[:, 1], N[:, 0], N[:, 1]) < 0
+    prev, nxt = ring_neighbours([len(r) for r in rings])
+    reflex = orient2d_many(pts[prev], pts, pts[nxt]) < 0
     rank = (reflex[d[:, 0]] | reflex[d[:, 1]]).astype(np.int8)
     for v, w in ((d[:, 0], d[:, 1]), (d[:, 1], d[:, 0])):
         k = np.flatnonzero(reflex[v])
         v, w = v[k], w[k]
-        cv, cw, cn, cp = pts[v], pts[w], pts[nxt[v]], pts[prev[v]]
-        ok = orient2d_cols(cv[:, 0], cv[:, 1], cn[:, 0], cn[:, 1], cw[:, 0], cw[:, 1]) >= 0
-        ok &= orient2d_cols(cv[:, 0], cv[:, 1], cw[:, 0], cw[:, 1], cp[:, 0], cp[:, 1]) >= 0
+        cv, cw = pts[v], pts[w]
+        ok = orient2d_many(cv, pts[nxt[v]], cw) >= 0
+        ok &= orient2d_many(cv, cw, pts[prev[v]]) >= 0
         rank[k] += ok
     return rank
 
@@ -181,12 +168,10 @@ def _finish(pts: np.ndarray, cycles: list) -> list[np.ndarray]:
     flat = np.array([i for c in cycles for i in c], dtype=np.intp)
     ends = np.cumsum(sizes)
     starts = ends - sizes
-    pos = np.arange(len(flat))
     owner = np.repeat(np.arange(len(cycles)), sizes)
-    prev = np.where(pos == starts[owner], ends[owner] - 1, pos - 1)
-    nxt = np.where(pos == ends[owner] - 1, starts[owner], pos + 1)
-    P, V, N = pts[flat[prev]], pts[flat], pts[flat[nxt]]
-    turn = orient2d_cols(P[:, 0], P[:, 1], V[:, 0], V[:, 1], N[:, 0], N[:, 1])
+    prev, nxt = ring_neighbours(sizes)
+    V = pts[flat]
+    turn = orient2d_many(V[prev], V, V[nxt])
     bad = np.zeros(len(cycles), dtype=bool)
     bad[owner[turn <= 0]] = True
     # lowest-then-leftmost vertex of each cycle: lexsort by (piece, y, x), first of each piece

@@ -24,7 +24,8 @@ import numpy as np
 
 from .hull import convex_hull
 from .minkowski import minkowski_sum
-from .predicates import cross_diff_cols, orient2d_cols
+from .polygon import ring_neighbours
+from .predicates import cross_diff_cols, orient2d_many
 
 
 def pairwise_sums(pa: list, pb: list) -> list[np.ndarray]:
@@ -59,18 +60,16 @@ class _Pieces:
             pieces = [p if len(p) >= 3 else np.zeros((3, 2)) for p in pieces]
             self.sizes = np.array([len(p) for p in pieces])
         self.pts = np.concatenate(pieces).reshape(-1, 2)
-        self.ends = np.cumsum(self.sizes)
-        self.starts = self.ends - self.sizes
+        self.starts = np.cumsum(self.sizes) - self.sizes
         self.piece = np.repeat(np.arange(len(pieces)), self.sizes)
         self.local = np.arange(len(self.pts)) - self.starts[self.piece]
-        self.nxt = np.where(self.local == self.sizes[self.piece] - 1, self.starts[self.piece], np.arange(len(self.pts)) + 1)
-        self.prv = np.where(self.local == 0, self.ends[self.piece] - 1, np.arange(len(self.pts)) - 1)
+        self.prv, self.nxt = ring_neighbours(self.sizes)
         e = self.pts[self.nxt] - self.pts
         self.half = (e[:, 1] < 0.0) | ((e[:, 1] == 0.0) & (e[:, 0] <= 0.0))
         # Canonical: strictly convex (exact left turns), lowest-then-leftmost first, and
         # the halves read upper...lower once (winding once).
-        P, V, N = self.pts[self.prv], self.pts, self.pts[self.nxt]
-        bad = orient2d_cols(P[:, 0], P[:, 1], V[:, 0], V[:, 1], N[:, 0], N[:, 1]) <= 0
+        V = self.pts
+        bad = orient2d_many(V[self.prv], V, V[self.nxt]) <= 0
         bad |= (V[:, 1] < V[self.starts[self.piece], 1]) | (
             (V[:, 1] == V[self.starts[self.piece], 1]) & (V[:, 0] < V[self.starts[self.piece], 0]))
         bad |= (self.local > 0) & (self.half < self.half[self.prv])
@@ -117,16 +116,13 @@ def _batch(A: _Pieces, B: _Pieces, out: list) -> None:
     starts = ends - counts
     doubt = np.bincount(pair[inexact], minlength=len(counts)) > 0
     if doubt.any():  # rounded pairs: accept those whose output turns strictly left everywhere
-        pos = np.arange(len(s))
-        prv = np.where(pos == starts[pair], ends[pair] - 1, pos - 1)
-        nxt = np.where(pos == ends[pair] - 1, starts[pair], pos + 1)
+        prv, nxt = ring_neighbours(counts)
         sel = np.flatnonzero(doubt[pair])
-        P, V, N = s[prv[sel]], s[sel], s[nxt[sel]]
-        turn = orient2d_cols(P[:, 0], P[:, 1], V[:, 0], V[:, 1], N[:, 0], N[:, 1])
+        turn = orient2d_many(s[prv[sel]], s[sel], s[nxt[sel]])
         doubt[:] = np.bincount(pair[sel[turn <= 0]], minlength=len(counts)) > 0
     good = np.repeat(A.ok, nb) & np.tile(B.ok, len(A.ok))
     for p in np.flatnonzero(good & ~doubt).tolist():
         out[p] = s[starts[p]:ends[p]]
     for p in np.flatnonzero(good & doubt).tolist():
         # a rounded turn that is not strictly left: minkowski_sum's repair, the exact hull
-        out[p] = np.array(convex_hull(s[starts[p]:ends[p]].tolist()).tolist(), dtype=np.float64)
+        out[p] = convex_hull(s[starts[p]:ends[p]])

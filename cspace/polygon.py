@@ -121,6 +121,24 @@ def normalize(polygon, *, ccw: bool = True) -> np.ndarray:
     return lowest_first(p)
 
 
+def ring_neighbours(sizes) -> tuple[np.ndarray, np.ndarray]:
+    """For rings of the given sizes stored one after another, each vertex's
+    predecessor and successor along its own ring (indices into the concatenation).
+
+    >>> [a.tolist() for a in ring_neighbours([3, 2])]
+    [[2, 0, 1, 4, 3], [1, 2, 0, 4, 3]]
+    """
+    sizes = np.asarray(sizes, dtype=np.intp)
+    ends = np.cumsum(sizes)
+    starts = ends - sizes
+    pos = np.arange(int(ends[-1]) if len(ends) else 0)
+    prev, nxt = pos - 1, pos + 1
+    some = sizes > 0
+    prev[starts[some]] = ends[some] - 1  # a ring's first vertex follows its last
+    nxt[ends[some] - 1] = starts[some]
+    return prev, nxt
+
+
 def lowest_first(p: np.ndarray) -> np.ndarray:
     """Rotate the vertex cycle to start at the lowest vertex (then leftmost).
 
