@@ -27,8 +27,6 @@ def random_convex(n, rng, span=2**20):
             return p - p.min(axis=0)
 
 
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--sizes", default="8,64,1024,16384")
