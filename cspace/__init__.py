@@ -14,6 +14,7 @@ from .gjk import Distance, gjk_distance, gjk_intersects
 from .epa import Penetration, epa_penetration
 from .decompose import convex_decompose
 from .pairsums import pairwise_sums
+from .convolution import convolution_cycles, convex_sums_with
 from .nonconvex import minkowski_pieces, minkowski_sum_nonconvex
 from .cspace import CSpace
 from .direct import DirectChecker, cspace_band

@@ -46,6 +46,16 @@ def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
     hole_list = [normalize(h, ccw=False) for h in (holes or [])]
     if not hole_list and is_convex(shell):
         return [shell]
+    return decompose_normalized(shell, hole_list)
+
+
+def decompose_normalized(shell: np.ndarray, hole_list: list) -> list[np.ndarray]:
+    """:func:`convex_decompose` of a shell already normalised CCW, not convex or with
+    holes, and holes normalised CW (callers that checked this themselves).
+
+    >>> len(decompose_normalized(normalize([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]), []))
+    2
+    """
     rings = [shell] + hole_list
     pts = np.concatenate(rings) if hole_list else shell
     tris = _triangulate(rings, pts)

@@ -1,14 +1,20 @@
-"""Minkowski sums of non-convex polygons (holes included) as unions of convex sums.
+"""Minkowski sums of non-convex polygons (holes included).
 
 A ⊕ B = ∪_{i,j} (A_i ⊕ B_j) for convex decompositions {A_i} of A and {B_j} of B
 (the sum distributes over union). Each pairwise sum is an exact angular merge, all
 pairs in one batch (:func:`cspace.pairsums.pairwise_sums`, equal to
-:func:`cspace.minkowski.minkowski_sum` pair for pair); the union is shapely's (GEOS
-OverlayNG), first per piece of A, then of those rows.
-The boundary of the union can have Θ(n²m²) complexity in the worst case (comb ⊕
-comb), which is why the C-space keeps the pieces and never needs the union.
+:func:`cspace.minkowski.minkowski_sum` pair for pair). :func:`minkowski_pieces`
+returns these pieces; the C-space keeps them and never needs their union, whose
+boundary can have Θ(n²m²) complexity (comb ⊕ comb).
 
-Holes of the sum survive the union: a hole is a region no pairwise sum covers, so
+:func:`minkowski_sum_nonconvex` returns the region itself. When one operand is
+simple (no holes) and not convex, it decomposes only the other one and sums each
+piece A_i with the whole simple operand Q through the convolution cycle
+(:mod:`cspace.convolution`): A ⊕ Q = ∪_i (A_i ⊕ Q), one GEOS region per piece and
+one union of those. Otherwise (a convex operand, or holes in both) it takes the
+union of the pairwise convex sums, first per piece of A, then of those rows.
+
+Holes of the sum survive either way: a hole is a region no partial sum covers, so
 it is kept however small it is next to the operands (the case CGAL's
 reduced-convolution method must handle with care).
 """
@@ -16,8 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .decompose import convex_decompose
+from .convolution import convex_sums_with
+from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
+from .polygon import as_array, is_convex, normalize
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -39,13 +47,65 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
     >>> L = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
     >>> minkowski_sum_nonconvex(L, [[0, 0], [1, 0], [1, 1], [0, 1]]).area
     8.0
+    >>> minkowski_sum_nonconvex(L, L).area  # the convolution route
+    13.0
     """
+    import shapely
+
+    (A, holes_a), (B, holes_b) = _operand(A, holes_a), _operand(B, holes_b)
+    route = _convolution_roles(A, holes_a, B, holes_b)
+    if route is not None:
+        X, holes_x, Q = route
+        pieces = [X] if not holes_x and is_convex(X) else decompose_normalized(X, holes_x)
+        if all(len(p) >= 3 for p in pieces):
+            return shapely.union_all(convex_sums_with(pieces, Q))
+    return _union_of_pairwise_sums(A, holes_a, B, holes_b)
+
+
+def _operand(P, holes):
+    """(normalised CCW shell, list of holes) of an array or a shapely Polygon."""
+    if hasattr(P, "geom_type") and P.geom_type == "Polygon" and holes is None:
+        holes = [as_array(r) for r in P.interiors]
+    holes = [normalize(h, ccw=False) for h in (holes or [])]
+    return normalize(P), [h for h in holes if len(h) >= 3]
+
+
+def _convolution_roles(A, holes_a, B, holes_b):
+    """(X, holes of X, Q): decompose X, convolve its pieces with the simple,
+    non-convex Q; None when no operand can be Q (holes, convexity, degeneracy).
+
+    With two candidates, Q is the one whose boundary turns less. Every piece of X
+    walks all of Q and inserts its edges once per full turn of Q, and GEOS's cost
+    grows faster than linearly with one cycle's self-crossings, so many short cycles
+    beat a few long ones.
+    """
+    def simple_nonconvex(P, holes):
+        return len(P) >= 3 and not holes and not is_convex(P)
+
+    a_ok, b_ok = simple_nonconvex(A, holes_a), simple_nonconvex(B, holes_b)
+    if len(A) < 3 or len(B) < 3 or not (a_ok or b_ok):
+        return None
+    if a_ok and b_ok:
+        a_ok = (_turning(A), len(A)) < (_turning(B), len(B))
+    return (B, holes_b, A) if a_ok else (A, holes_a, B)
+
+
+def _turning(P: np.ndarray) -> float:
+    """Total absolute turning of a polygon's boundary, in full turns (a float estimate)."""
+    u = P - np.roll(P, 1, axis=0)
+    v = np.roll(u, -1, axis=0)
+    angle = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))
+    return float(np.abs(angle).sum() / (2 * np.pi))
+
+
+def _union_of_pairwise_sums(A, holes_a, B, holes_b):
+    """∪ (A_i ⊕ B_j): every pairwise convex sum, unioned per piece of A, then."""
     import shapely
 
     pa, pb = convex_decompose(A, holes_a), convex_decompose(B, holes_b)
     pieces = pairwise_sums(pa, pb)
     sizes = np.array([len(p) for p in pieces])
-    if (sizes < 3).any():  # a degenerate pairwise sum (never from a proper decomposition)
+    if (sizes < 3).any():  # a degenerate pairwise sum (a point or segment operand)
         polys = np.array([shapely.Polygon(p) if len(p) >= 3 else shapely.Polygon() for p in pieces])
     else:
         rings = shapely.linearrings(np.concatenate(pieces), indices=np.repeat(np.arange(len(pieces)), sizes))
