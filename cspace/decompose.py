@@ -83,11 +83,16 @@ def _triangulate(rings: list, pts: np.ndarray) -> np.ndarray:
 
     tri = shapely.constrained_delaunay_triangles(shapely.Polygon(rings[0], rings[1:]))
     corners = shapely.get_coordinates(tri).reshape(-1, 4, 2)[:, :3].reshape(-1, 2)
-    index = {(x, y): i for i, (x, y) in enumerate(pts.tolist())}
-    try:
-        ids = np.array([index[(x, y)] for x, y in corners.tolist()], dtype=np.intp).reshape(-1, 3)
-    except KeyError:  # never expected: GEOS's CDT uses the input vertices only
-        raise ValueError("convex_decompose: triangulation introduced a new vertex") from None
+    # Each corner's vertex index: look the (x, y) pairs up as complex numbers, which
+    # numpy sorts by x, then y.
+    keys = np.ascontiguousarray(pts, dtype=np.float64).view(np.complex128).ravel()
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    wanted = np.ascontiguousarray(corners).view(np.complex128).ravel()
+    at = np.minimum(np.searchsorted(sorted_keys, wanted), len(keys) - 1)
+    if not (sorted_keys[at] == wanted).all():  # never expected: GEOS's CDT uses the input vertices only
+        raise ValueError("convex_decompose: triangulation introduced a new vertex")
+    ids = order[at].reshape(-1, 3)
     turn = orient2d_many(pts[ids[:, 0]], pts[ids[:, 1]], pts[ids[:, 2]])
     ids[turn < 0] = ids[turn < 0][:, ::-1]
     return ids[turn != 0]  # a zero-area sliver covers nothing
@@ -104,16 +109,19 @@ def _diagonal_ranks(rings: list, pts: np.ndarray, d: np.ndarray) -> np.ndarray:
     ends does the work of two (a comb's tooth bases).
     """
     prev, nxt = ring_neighbours([len(r) for r in rings])
-    reflex = orient2d_many(pts[prev], pts, pts[nxt]) < 0
+    # All the turns in one exact call: every corner, then for each diagonal end v
+    # (both ends) the two cone tests v -> next -> w and v -> w -> prev.
+    v = np.concatenate([d[:, 0], d[:, 1]])
+    w = np.concatenate([d[:, 1], d[:, 0]])
+    a = np.concatenate([prev, v, v])
+    b = np.concatenate([np.arange(len(pts)), nxt[v], w])
+    c = np.concatenate([nxt, w, prev[v]])
+    turn = orient2d_many(pts[a], pts[b], pts[c])
+    reflex = turn[:len(pts)] < 0
+    cone = turn[len(pts):].reshape(2, -1) >= 0
+    resolves = (reflex[v] & cone[0] & cone[1]).reshape(2, -1)
     rank = (reflex[d[:, 0]] | reflex[d[:, 1]]).astype(np.int8)
-    for v, w in ((d[:, 0], d[:, 1]), (d[:, 1], d[:, 0])):
-        k = np.flatnonzero(reflex[v])
-        v, w = v[k], w[k]
-        cv, cw = pts[v], pts[w]
-        ok = orient2d_many(cv, pts[nxt[v]], cw) >= 0
-        ok &= orient2d_many(cv, cw, pts[prev[v]]) >= 0
-        rank[k] += ok
-    return rank
+    return rank + resolves.sum(axis=0, dtype=np.int8)
 
 
 def _hertel_mehlhorn(tris: np.ndarray, pts: np.ndarray, diagonals: list) -> list[list[int]]:
