@@ -25,7 +25,8 @@ import numpy as np
 from .convolution import convex_sums_with
 from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
-from .polygon import as_array, is_convex, normalize
+from .polygon import as_array, normalize
+from .predicates import orient2d_many
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -55,8 +56,8 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
     (A, holes_a), (B, holes_b) = _operand(A, holes_a), _operand(B, holes_b)
     route = _convolution_roles(A, holes_a, B, holes_b)
     if route is not None:
-        X, holes_x, Q = route
-        pieces = [X] if not holes_x and is_convex(X) else decompose_normalized(X, holes_x)
+        X, holes_x, x_convex, Q = route
+        pieces = [X] if x_convex else decompose_normalized(X, holes_x)
         if all(len(p) >= 3 for p in pieces):
             return shapely.union_all(convex_sums_with(pieces, Q))
     return _union_of_pairwise_sums(A, holes_a, B, holes_b)
@@ -71,31 +72,36 @@ def _operand(P, holes):
 
 
 def _convolution_roles(A, holes_a, B, holes_b):
-    """(X, holes of X, Q): decompose X, convolve its pieces with the simple,
-    non-convex Q; None when no operand can be Q (holes, convexity, degeneracy).
+    """(X, holes of X, is X convex, Q): decompose X, convolve its pieces with the
+    simple, non-convex Q; None when no operand can be Q (holes, convexity, degeneracy).
 
     With two candidates, Q is the one whose boundary turns less. Every piece of X
     walks all of Q and inserts its edges once per full turn of Q, and GEOS's cost
     grows faster than linearly with one cycle's self-crossings, so many short cycles
     beat a few long ones.
     """
-    def simple_nonconvex(P, holes):
-        return len(P) >= 3 and not holes and not is_convex(P)
-
-    a_ok, b_ok = simple_nonconvex(A, holes_a), simple_nonconvex(B, holes_b)
-    if len(A) < 3 or len(B) < 3 or not (a_ok or b_ok):
+    if len(A) < 3 or len(B) < 3:
+        return None
+    (a_convex, a_turns), (b_convex, b_turns) = _shape(A), _shape(B)
+    a_ok, b_ok = not holes_a and not a_convex, not holes_b and not b_convex
+    if not (a_ok or b_ok):
         return None
     if a_ok and b_ok:
-        a_ok = (_turning(A), len(A)) < (_turning(B), len(B))
-    return (B, holes_b, A) if a_ok else (A, holes_a, B)
+        a_ok = (a_turns, len(A)) < (b_turns, len(B))
+    return (B, holes_b, b_convex and not holes_b, A) if a_ok else (A, holes_a, a_convex and not holes_a, B)
 
 
-def _turning(P: np.ndarray) -> float:
-    """Total absolute turning of a polygon's boundary, in full turns (a float estimate)."""
-    u = P - np.roll(P, 1, axis=0)
-    v = np.roll(u, -1, axis=0)
+def _shape(P: np.ndarray) -> tuple[bool, float]:
+    """(convex?, total absolute turning in full turns) of a normalised CCW polygon.
+
+    Convex: no turn to the right (exact test) and the boundary winds once; the
+    turning is a float estimate (it only ranks the operands).
+    """
+    prev, nxt = np.roll(P, 1, axis=0), np.roll(P, -1, axis=0)
+    u, v = P - prev, nxt - P
     angle = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))
-    return float(np.abs(angle).sum() / (2 * np.pi))
+    convex = not (orient2d_many(prev, P, nxt) < 0).any() and abs(angle.sum() / (2 * np.pi) - 1) < 0.5
+    return convex, float(np.abs(angle).sum() / (2 * np.pi))
 
 
 def _union_of_pairwise_sums(A, holes_a, B, holes_b):

@@ -123,7 +123,7 @@ def test_holes_go_to_the_decomposed_operand():
     ring = shapely.Polygon([[0, 0], [10, 0], [10, 10], [0, 10]], [[[3, 3], [3, 7], [7, 7], [7, 3]]])
     L = np.array([[0, 0], [2, 0], [2, 0.5], [0.5, 0.5], [0.5, 2], [0, 2.0]]) - 1.0
     (a, ha), (b, hb) = _operand(ring, None), _operand(L, None)
-    X, holes_x, Q = _convolution_roles(a, ha, b, hb)
+    X, holes_x, x_convex, Q = _convolution_roles(a, ha, b, hb)
     assert len(holes_x) == 1 and Q.tolist() == b.tolist()  # the ring is decomposed, the L convolved
     got = minkowski_sum_nonconvex(ring, L)
     ref = reference_sum(ring, L)
