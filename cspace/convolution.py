@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from .polygon import ring_neighbours
-from .predicates import cross_diff_cols, orient2d_many
+from .predicates import cross_diff_cols, lower_half, orient2d_many
 
 # Most (Q edge, piece edge) comparisons in one vectorised block.
 _BLOCK = 1 << 20
@@ -63,9 +63,9 @@ def convolution_cycles(pieces: list, Q) -> tuple[np.ndarray, np.ndarray]:
     # its vertex pos % n_i is the one extreme along edge t's outer normal.
     pos = np.empty((len(Q), len(pieces)), dtype=np.intp)
     fused = np.empty((len(Q), len(pieces)), dtype=bool)
-    qlow = _lower_half(Q1[:, 0] - Q[:, 0], Q1[:, 1] - Q[:, 1])[:, None]
+    qlow = lower_half(Q1[:, 0] - Q[:, 0], Q1[:, 1] - Q[:, 1])[:, None]
     step = max(1, _BLOCK // max(len(pts), 1))
-    plow = _lower_half(pts[nxt, 0] - pts[:, 0], pts[nxt, 1] - pts[:, 1])[None, :]
+    plow = lower_half(pts[nxt, 0] - pts[:, 0], pts[nxt, 1] - pts[:, 1])[None, :]
     for t0 in range(0, len(Q), step):
         t = slice(t0, t0 + step)
         cross = cross_diff_cols(pts[:, 0], pts[:, 1], pts[nxt, 0], pts[nxt, 1],
@@ -119,9 +119,3 @@ def convex_sums_with(pieces: list, Q) -> np.ndarray:
     rings = shapely.linearrings(pts, indices=np.repeat(np.arange(len(sizes)), sizes))
     # Depth >= 1 of the (self-overlapping) ring: the points of positive winding number.
     return shapely.buffer(shapely.polygons(rings), 0.0)
-
-
-def _lower_half(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
-    """Directions in [pi, 2 pi): below the x-axis, or along -x (signs of float
-    differences are exact, so this split is too)."""
-    return (dy < 0) | ((dy == 0) & (dx < 0))

@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 
 from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
-from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, error_free_cross_sign, orient2d_xy, sum_error
+from .predicates import (CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, error_free_cross_sign, lower_half,
+                         orient2d_xy, sum_error)
 
 # Up to this many vertices in total the scalar merge is faster than numpy's overhead.
 _SCALAR_MAX = 96
@@ -216,10 +217,6 @@ def _turns_cols(ux, uy, vx, vy, a, b, c, d) -> np.ndarray:
 def _half(dx: float, dy: float) -> int:
     """0 for directions in [0, pi) (upper half-plane), 1 for [pi, 2 pi)."""
     return 0 if dy > 0.0 or (dy == 0.0 and dx > 0.0) else 1
-
-
-def _halves(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
-    return ((dy < 0.0) | ((dy == 0.0) & (dx <= 0.0))).view(np.int8)
 
 
 # ---------------------------------------------------------------- merges
@@ -456,7 +453,7 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
         return None
     order = _sort_keys(key, len(edged), order)
     ux, uy = np.take(ex, order, out=key), np.take(ey, order, out=scratch)
-    half = _halves(ux, uy)  # exact, from the signs of the sorted edges
+    half = lower_half(ux, uy)  # exact, from the signs of the sorted edges
     if (half[:-1] > half[1:]).any():
         return None
     # At most one output vertex per edge: the output's buffer is scratch until then.
@@ -674,5 +671,5 @@ def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
 def _winds_more_than_once(p: np.ndarray) -> bool:
     p = np.roll(p, -_lowest_index(p), axis=0)
     e = np.roll(p, -1, axis=0) - p
-    h = _halves(e[:, 0], e[:, 1])
+    h = lower_half(e[:, 0], e[:, 1])
     return bool((h[:-1] > h[1:]).any())

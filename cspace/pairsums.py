@@ -25,7 +25,7 @@ import numpy as np
 from .hull import convex_hull
 from .minkowski import minkowski_sum
 from .polygon import ring_neighbours
-from .predicates import cross_diff_cols, orient2d_many
+from .predicates import cross_diff_cols, lower_half, orient2d_many
 
 
 def pairwise_sums(pa: list, pb: list) -> list[np.ndarray]:
@@ -65,7 +65,7 @@ class _Pieces:
         self.local = np.arange(len(self.pts)) - self.starts[self.piece]
         self.prv, self.nxt = ring_neighbours(self.sizes)
         e = self.pts[self.nxt] - self.pts
-        self.half = (e[:, 1] < 0.0) | ((e[:, 1] == 0.0) & (e[:, 0] <= 0.0))
+        self.half = lower_half(e[:, 0], e[:, 1])
         # Canonical: strictly convex (exact left turns), lowest-then-leftmost first, and
         # the halves read upper...lower once (winding once).
         V = self.pts

@@ -101,6 +101,17 @@ def cross_sign(u, v) -> int:
     return orient2d_xy(0.0, 0.0, float(u[0]), float(u[1]), float(v[0]), float(v[1]))
 
 
+def lower_half(dx, dy) -> np.ndarray:
+    """Is each direction (dx, dy) in the lower half [pi, 2 pi) of the angle order,
+    rather than the upper half [0, pi)? The first, exact step of every angular
+    comparison (the signs of float differences are exact).
+
+    >>> lower_half(np.array([1.0, -1.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0, 1.0])).tolist()
+    [False, True, True, False]
+    """
+    return (dy < 0.0) | ((dy == 0.0) & (dx <= 0.0))
+
+
 def cross_diff_exact(ax, ay, bx, by, cx, cy, dx, dy) -> int:
     """Exact sign of ``(b - a) x (d - c)`` in rational arithmetic.
 
