@@ -25,8 +25,7 @@ import numpy as np
 from .convolution import convex_sums_with
 from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
-from .polygon import as_array, normalize
-from .predicates import orient2d_many
+from .polygon import as_array, is_convex, normalize
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -82,26 +81,22 @@ def _convolution_roles(A, holes_a, B, holes_b):
     """
     if len(A) < 3 or len(B) < 3:
         return None
-    (a_convex, a_turns), (b_convex, b_turns) = _shape(A), _shape(B)
+    a_convex, b_convex = is_convex(A), is_convex(B)
     a_ok, b_ok = not holes_a and not a_convex, not holes_b and not b_convex
     if not (a_ok or b_ok):
         return None
     if a_ok and b_ok:
-        a_ok = (a_turns, len(A)) < (b_turns, len(B))
+        a_ok = (_turning(A), len(A)) < (_turning(B), len(B))
     return (B, holes_b, b_convex and not holes_b, A) if a_ok else (A, holes_a, a_convex and not holes_a, B)
 
 
-def _shape(P: np.ndarray) -> tuple[bool, float]:
-    """(convex?, total absolute turning in full turns) of a normalised CCW polygon.
-
-    Convex: no turn to the right (exact test) and the boundary winds once; the
-    turning is a float estimate (it only ranks the operands).
-    """
-    prev, nxt = np.roll(P, 1, axis=0), np.roll(P, -1, axis=0)
-    u, v = P - prev, nxt - P
+def _turning(P: np.ndarray) -> float:
+    """Total absolute turning of a polygon's boundary, in full turns (a float
+    estimate: it only ranks the operands)."""
+    u = P - np.roll(P, 1, axis=0)
+    v = np.roll(u, -1, axis=0)
     angle = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))
-    convex = not (orient2d_many(prev, P, nxt) < 0).any() and abs(angle.sum() / (2 * np.pi) - 1) < 0.5
-    return convex, float(np.abs(angle).sum() / (2 * np.pi))
+    return float(np.abs(angle).sum() / (2 * np.pi))
 
 
 def _union_of_pairwise_sums(A, holes_a, B, holes_b):
