@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polygon import ring_neighbours
+from .polygon import PackedPieces
 from .predicates import cross_diff_cols, lower_half, orient2d_many
 
 # Most (Q edge, piece edge) comparisons in one vectorised block.
@@ -53,11 +53,12 @@ def convolution_cycles(pieces: list, Q) -> tuple[np.ndarray, np.ndarray]:
     [7]
     """
     Q = np.asarray(Q, dtype=np.float64)
-    sizes = np.array([len(p) for p in pieces], dtype=np.intp)
-    pts = np.concatenate(pieces).astype(np.float64, copy=False)
-    nxt = ring_neighbours(sizes)[1]
+    packed = PackedPieces([np.asarray(p, dtype=np.float64) for p in pieces])
+    if not packed.ok.all():
+        bad = int(np.flatnonzero(~packed.ok)[0])
+        raise ValueError(f"convolution_cycles: piece {bad} is not strictly convex, CCW from its lowest vertex")
+    pts, sizes, starts, nxt = packed.pts, packed.sizes, packed.starts, packed.nxt
     Q1 = np.roll(Q, -1, axis=0)
-    starts = np.cumsum(sizes) - sizes
     # pos[t, i]: how many edges of piece i come strictly before edge t of Q in angle,
     # counted from the +x direction. Piece i's edges are in that order already, so
     # its vertex pos % n_i is the one extreme along edge t's outer normal.
@@ -65,7 +66,7 @@ def convolution_cycles(pieces: list, Q) -> tuple[np.ndarray, np.ndarray]:
     fused = np.empty((len(Q), len(pieces)), dtype=bool)
     qlow = lower_half(Q1[:, 0] - Q[:, 0], Q1[:, 1] - Q[:, 1])[:, None]
     step = max(1, _BLOCK // max(len(pts), 1))
-    plow = lower_half(pts[nxt, 0] - pts[:, 0], pts[nxt, 1] - pts[:, 1])[None, :]
+    plow = packed.half[None, :]
     for t0 in range(0, len(Q), step):
         t = slice(t0, t0 + step)
         cross = cross_diff_cols(pts[:, 0], pts[:, 1], pts[nxt, 0], pts[nxt, 1],

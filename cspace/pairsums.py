@@ -24,8 +24,8 @@ import numpy as np
 
 from .hull import convex_hull
 from .minkowski import minkowski_sum
-from .polygon import ring_neighbours
-from .predicates import cross_diff_cols, lower_half, orient2d_many
+from .polygon import PackedPieces, ring_neighbours
+from .predicates import cross_diff_cols, orient2d_many
 
 
 def pairwise_sums(pa: list, pb: list) -> list[np.ndarray]:
@@ -40,7 +40,7 @@ def pairwise_sums(pa: list, pb: list) -> list[np.ndarray]:
     pb = [np.asarray(p, dtype=np.float64) for p in pb]
     if not pa or not pb:
         return []
-    A, B = _Pieces(pa), _Pieces(pb)
+    A, B = PackedPieces(pa), PackedPieces(pb)
     out: list = [None] * (len(pa) * len(pb))
     if A.ok.any() and B.ok.any():
         _batch(A, B, out)
@@ -50,33 +50,7 @@ def pairwise_sums(pa: list, pb: list) -> list[np.ndarray]:
     return out
 
 
-class _Pieces:
-    """Concatenated vertices of a list of pieces, their edges and half-planes."""
-
-    def __init__(self, pieces: list):
-        self.sizes = np.array([len(p) for p in pieces])
-        self.ok = self.sizes >= 3
-        if not self.ok.all():  # points, segments, malformed: left to minkowski_sum
-            pieces = [p if len(p) >= 3 else np.zeros((3, 2)) for p in pieces]
-            self.sizes = np.array([len(p) for p in pieces])
-        self.pts = np.concatenate(pieces).reshape(-1, 2)
-        self.starts = np.cumsum(self.sizes) - self.sizes
-        self.piece = np.repeat(np.arange(len(pieces)), self.sizes)
-        self.local = np.arange(len(self.pts)) - self.starts[self.piece]
-        self.prv, self.nxt = ring_neighbours(self.sizes)
-        e = self.pts[self.nxt] - self.pts
-        self.half = lower_half(e[:, 0], e[:, 1])
-        # Canonical: strictly convex (exact left turns), lowest-then-leftmost first, and
-        # the halves read upper...lower once (winding once).
-        V = self.pts
-        bad = orient2d_many(V[self.prv], V, V[self.nxt]) <= 0
-        bad |= (V[:, 1] < V[self.starts[self.piece], 1]) | (
-            (V[:, 1] == V[self.starts[self.piece], 1]) & (V[:, 0] < V[self.starts[self.piece], 0]))
-        bad |= (self.local > 0) & (self.half < self.half[self.prv])
-        self.ok &= np.bincount(self.piece[bad], minlength=len(pieces)) == 0
-
-
-def _batch(A: _Pieces, B: _Pieces, out: list) -> None:
+def _batch(A: PackedPieces, B: PackedPieces, out: list) -> None:
     nb = len(B.sizes)
     a0, a1, b0, b1 = A.pts, A.pts[A.nxt], B.pts, B.pts[B.nxt]
     # cross[a, b] = sign of edge_a x edge_b (exact); > 0: b turns CCW from a (a first).

@@ -1,4 +1,5 @@
-"""Polygons as (N, 2) float64 arrays: conversion, orientation, clean-up, convexity.
+"""Polygons as (N, 2) float64 arrays: conversion, orientation, clean-up, convexity,
+and convex pieces packed one after another (:class:`PackedPieces`).
 
 This module owns the polygon currency of the package. A polygon is an ``(N, 2)``
 float64 array of vertices, counter-clockwise, without the closing repeat. Every
@@ -11,7 +12,7 @@ import math
 
 import numpy as np
 
-from .predicates import orient2d_many, orient2d_xy
+from .predicates import lower_half, orient2d_many, orient2d_xy
 
 
 def as_array(polygon, copy: bool = True) -> np.ndarray:
@@ -137,6 +138,41 @@ def ring_neighbours(sizes) -> tuple[np.ndarray, np.ndarray]:
     prev[starts[some]] = ends[some] - 1  # a ring's first vertex follows its last
     nxt[ends[some] - 1] = starts[some]
     return prev, nxt
+
+
+class PackedPieces:
+    """Convex pieces stored one after another: their vertices, each vertex's ring
+    neighbours, each edge's half-plane (:func:`cspace.predicates.lower_half`), and
+    ``ok``: is the piece canonical, i.e. strictly convex (exact left turns) and CCW
+    from its lowest (then leftmost) vertex, so that its edges come in angular order.
+    The batched angular merges rely on that order; a piece that is not ``ok``
+    (including points and segments, stored as a dummy triangle) must go elsewhere.
+
+    >>> PackedPieces([np.array([[0., 0], [1, 0], [0, 1]]), np.array([[1., 1], [0, 0], [1, 0]])]).ok.tolist()
+    [True, False]
+    """
+
+    def __init__(self, pieces: list):
+        self.sizes = np.array([len(p) for p in pieces])
+        self.ok = self.sizes >= 3
+        if not self.ok.all():  # points, segments, malformed: a dummy triangle, not ok
+            pieces = [p if len(p) >= 3 else np.zeros((3, 2)) for p in pieces]
+            self.sizes = np.array([len(p) for p in pieces])
+        self.pts = np.concatenate(pieces).reshape(-1, 2)
+        self.starts = np.cumsum(self.sizes) - self.sizes
+        self.piece = np.repeat(np.arange(len(pieces)), self.sizes)
+        self.local = np.arange(len(self.pts)) - self.starts[self.piece]
+        self.prv, self.nxt = ring_neighbours(self.sizes)
+        e = self.pts[self.nxt] - self.pts
+        self.half = lower_half(e[:, 0], e[:, 1])
+        # Canonical: strictly convex (exact left turns), lowest-then-leftmost first, and
+        # the halves read upper...lower once (winding once).
+        V = self.pts
+        bad = orient2d_many(V[self.prv], V, V[self.nxt]) <= 0
+        bad |= (V[:, 1] < V[self.starts[self.piece], 1]) | (
+            (V[:, 1] == V[self.starts[self.piece], 1]) & (V[:, 0] < V[self.starts[self.piece], 0]))
+        bad |= (self.local > 0) & (self.half < self.half[self.prv])
+        self.ok &= np.bincount(self.piece[bad], minlength=len(pieces)) == 0
 
 
 def lowest_first(p: np.ndarray) -> np.ndarray:

@@ -99,6 +99,14 @@ def test_convolution_route_equals_the_pieces_route(A, B):
     assert shapely.symmetric_difference(got, ref).area <= 1e-9 * ref.area
 
 
+def test_a_piece_out_of_angular_order_is_refused():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    L = normalize(np.array([[0.0, 0.0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]))
+    for bad in (np.roll(sq, 1, axis=0), sq[::-1], np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [1.0, 1.0]])):
+        with pytest.raises(ValueError, match="piece 1"):
+            convolution_cycles([sq, bad], L)
+
+
 def test_one_region_per_piece_is_the_piece_sum_union():
     A, Q = normalize(comb(6)), normalize(comb(3, w=0.5, gap=1.0))
     pieces = convex_decompose(A)
