@@ -105,6 +105,9 @@ def test_a_piece_out_of_angular_order_is_refused():
     for bad in (np.roll(sq, 1, axis=0), sq[::-1], np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [1.0, 1.0]])):
         with pytest.raises(ValueError, match="piece 1"):
             convolution_cycles([sq, bad], L)
+    for bad_q in (L[::-1], np.insert(L, 2, L[2], axis=0)):  # clockwise; a repeated vertex
+        with pytest.raises(ValueError, match="Q must be"):
+            convolution_cycles([sq], bad_q)
 
 
 def test_one_region_per_piece_is_the_piece_sum_union():
