@@ -174,23 +174,32 @@ def cross_diff_cols(ax, ay, bx, by, cx, cy, dx, dy) -> np.ndarray:
         right = uy * vx
         det = left - right
         detsum = np.abs(left) + np.abs(right)
-        errbound = CCW_ERRBOUND_A * detsum
-        ok = (detsum > _UNDERFLOW_GUARD) & (detsum < _INF)
-        sign = (ok & (det > errbound)).astype(np.int8) - (ok & (-det > errbound)).astype(np.int8)
-        certain = sign != 0
-        certain |= (detsum == 0.0) & ((ux == 0.0) | (vy == 0.0)) & ((uy == 0.0) | (vx == 0.0))
-    if not certain.all():
-        if np.ndim(certain) == 0:  # all scalars: the scalar exact route
-            return np.array(cross_diff_sign(ax, ay, bx, by, cx, cy, dx, dy), dtype=np.int8)
-        cols = np.broadcast_arrays(ax, ay, bx, by, cx, cy, dx, dy, sign)
-        sign = np.array(cols[-1], dtype=np.int8)
-        doubt = np.nonzero(~np.broadcast_to(certain, sign.shape))
-        picked = [np.asarray(col[doubt], dtype=np.float64) for col in cols[:8]]
-        ef = error_free_cross_sign(*picked)
-        sign[doubt] = ef  # 2 marks the entries still undecided, fixed just below
-        for k in np.flatnonzero(ef == 2).tolist():
-            idx = tuple(d[k] for d in doubt)
-            sign[idx] = cross_diff_exact(*(float(col[k]) for col in picked))
+        # Certain: |det| above the stage-A bound, detsum clear of underflow. An infinite
+        # detsum makes the bound infinite and a NaN compares False: both stay in doubt.
+        certain = np.abs(det) > CCW_ERRBOUND_A * detsum
+        certain &= detsum > _UNDERFLOW_GUARD
+        sign = np.sign(det).astype(np.int8)  # read only where certain
+    if certain.all():
+        return sign
+    # Exact zeros: both products zero because a factor is (float differences are zero
+    # exactly when the coordinates are equal), not by underflow. Touching contacts on
+    # integer input are mostly these.
+    with np.errstate(invalid="ignore"):
+        zero = (detsum == 0.0) & ((ux == 0.0) | (vy == 0.0)) & ((uy == 0.0) | (vx == 0.0))
+    certain |= zero
+    if certain.all():
+        return np.where(zero, np.int8(0), sign)
+    if np.ndim(certain) == 0:  # all scalars: the scalar exact route
+        return np.array(cross_diff_sign(ax, ay, bx, by, cx, cy, dx, dy), dtype=np.int8)
+    cols = np.broadcast_arrays(ax, ay, bx, by, cx, cy, dx, dy, np.where(zero, np.int8(0), sign))
+    sign = np.array(cols[-1], dtype=np.int8)
+    doubt = np.nonzero(~np.broadcast_to(certain, sign.shape))
+    picked = [np.asarray(col[doubt], dtype=np.float64) for col in cols[:8]]
+    ef = error_free_cross_sign(*picked)
+    sign[doubt] = ef  # 2 marks the entries still undecided, fixed just below
+    for k in np.flatnonzero(ef == 2).tolist():
+        idx = tuple(d[k] for d in doubt)
+        sign[idx] = cross_diff_exact(*(float(col[k]) for col in picked))
     return sign
 
 
