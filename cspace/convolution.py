@@ -58,8 +58,8 @@ def convolution_cycles(pieces: list, Q) -> tuple[np.ndarray, np.ndarray]:
         bad = int(np.flatnonzero(~packed.ok)[0])
         raise ValueError(f"convolution_cycles: piece {bad} is not strictly convex, CCW from its lowest vertex")
     pts, sizes, starts, nxt = packed.pts, packed.sizes, packed.starts, packed.nxt
-    Q1 = np.roll(Q, -1, axis=0)
-    if len(Q) < 3 or (Q1 == Q).all(axis=1).any() or signed_area(Q) <= 0.0:
+    Q1 = np.concatenate((Q[1:], Q[:1]))  # each edge's head
+    if len(Q) < 3 or ((Q1[:, 0] == Q[:, 0]) & (Q1[:, 1] == Q[:, 1])).any() or signed_area(Q) <= 0.0:
         raise ValueError("convolution_cycles: Q must be a CCW polygon without repeated vertices")
     # pos[t, i]: how many edges of piece i come strictly before edge t of Q in angle,
     # counted from the +x direction. Piece i's edges are in that order already, so
@@ -83,9 +83,9 @@ def convolution_cycles(pieces: list, Q) -> tuple[np.ndarray, np.ndarray]:
     # At Q's vertex t + 1 the walk turns from edge t to edge t + 1: left (convex)
     # through the piece's edges pos_t .. pos_{t+1} - 1, right (reflex) back through
     # them, straight through none.
-    turn = orient2d_many(Q, Q1, np.roll(Q, -2, axis=0))[:, None]
+    turn = orient2d_many(Q, Q1, np.concatenate((Q1[1:], Q1[:1])))[:, None]
     n = sizes[None, :]
-    later = np.roll(pos, -1, axis=0)
+    later = np.concatenate((pos[1:], pos[:1]))
     steps = np.where(turn > 0, (later - pos) % n, -((pos - later) % n))
     # Cycle i, piece-major: at each vertex of Q, the chain of piece vertices from
     # the one serving edge t to the one serving edge t + 1 (|steps| + 1 of them).

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from .polygon import as_array, drop_collinear, is_convex, normalize, ring_neighbours
-from .predicates import orient2d_many, orient2d_xy
+from .predicates import CCW_ERRBOUND_A, orient2d_many, orient2d_xy
 
 
 def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
@@ -163,7 +163,13 @@ def _merge(p: list, q: list, u: int, v: int, xy: list, owner: dict) -> list | No
     straight = []
     for k in (n - len(q) + 1, 0):  # the positions of u and v
         (ax, ay), (bx, by), (cx, cy) = xy[merged[k - 1]], xy[merged[k]], xy[merged[(k + 1) % n]]
-        turn = orient2d_xy(ax, ay, bx, by, cx, cy)
+        # orient2d's stage-A filter inline (most corners are decided here), else exact.
+        left = (ax - cx) * (by - cy)
+        right = (ay - cy) * (bx - cx)
+        bound = CCW_ERRBOUND_A * (abs(left) + abs(right))
+        if left - right > bound > 1e-280:
+            continue
+        turn = -1 if right - left > bound > 1e-280 else orient2d_xy(ax, ay, bx, by, cx, cy)
         if turn < 0:
             return None
         if turn == 0:
@@ -194,9 +200,11 @@ def _finish(pts: np.ndarray, cycles: list) -> list[np.ndarray]:
     bad[owner[turn <= 0]] = True
     # lowest-then-leftmost vertex of each cycle: lexsort by (piece, y, x), first of each piece
     first = np.lexsort((V[:, 0], V[:, 1], owner))[starts]
-    out = []
-    for c in range(len(cycles)):
-        s, e, f = starts[c], ends[c], first[c]
-        piece = np.concatenate([V[f:e], V[s:f]])
-        out.append(normalize(drop_collinear(piece)) if bad[c] else piece)
+    # Rotate every cycle to its first vertex with one gather, then cut.
+    shift = np.repeat(first - starts, sizes)
+    local = np.arange(len(V)) - np.repeat(starts, sizes)
+    V = V[np.repeat(starts, sizes) + (local + shift) % np.repeat(sizes, sizes)]
+    out = [V[s:e] for s, e in zip(starts.tolist(), ends.tolist())]
+    for c in np.flatnonzero(bad).tolist():
+        out[c] = normalize(drop_collinear(out[c]))
     return out

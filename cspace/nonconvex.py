@@ -93,8 +93,8 @@ def _convolution_roles(A, holes_a, B, holes_b):
 def _turning(P: np.ndarray) -> float:
     """Total absolute turning of a polygon's boundary, in full turns (a float
     estimate: it only ranks the operands)."""
-    u = P - np.roll(P, 1, axis=0)
-    v = np.roll(u, -1, axis=0)
+    u = P - np.concatenate((P[-1:], P[:-1]))  # edge into each vertex
+    v = np.concatenate((u[1:], u[:1]))  # edge out of it
     angle = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))
     return float(np.abs(angle).sum() / (2 * np.pi))
 

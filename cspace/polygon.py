@@ -47,12 +47,22 @@ def signed_area(polygon) -> float:
     >>> signed_area([[0, 0], [2, 0], [0, 2]])
     2.0
     """
-    p = as_array(polygon)
+    return _shoelace(as_array(polygon, copy=False))
+
+
+def _shoelace(p: np.ndarray) -> float:
+    """:func:`signed_area` of an (N, 2) float64 array, about its first vertex."""
     if len(p) < 3:
         return 0.0
-    q = p - p[0]
-    x, y = q[:, 0], q[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    x = p[:, 0] - p[0, 0]
+    y = p[:, 1] - p[0, 1]
+    # Sum of x_i y_{i+1} - y_i x_{i+1}; the wrap-around term is zero (x_0 = y_0 = 0).
+    return 0.5 * float((x[:-1] * y[1:]).sum() - (y[:-1] * x[1:]).sum())
+
+
+def _prev_next(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each vertex's predecessor and successor rows (cyclically), as new arrays."""
+    return np.concatenate((p[-1:], p[:-1])), np.concatenate((p[1:], p[:1]))
 
 
 def is_ccw(polygon) -> bool:
@@ -72,7 +82,10 @@ def drop_repeats(p: np.ndarray) -> np.ndarray:
     """
     if len(p) < 2:
         return p
-    keep = np.any(p != np.roll(p, 1, axis=0), axis=1)
+    prev = np.concatenate((p[-1:], p[:-1]))
+    keep = (p[:, 0] != prev[:, 0]) | (p[:, 1] != prev[:, 1])
+    if keep.all():
+        return p
     if not keep.any():  # all the same point
         return p[:1]
     return p[keep]
@@ -88,7 +101,8 @@ def drop_collinear(p: np.ndarray) -> np.ndarray:
     [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]
     """
     while len(p) >= 3:
-        turn = orient2d_many(np.roll(p, 1, axis=0), p, np.roll(p, -1, axis=0))
+        prev, nxt = _prev_next(p)
+        turn = orient2d_many(prev, p, nxt)
         keep = turn != 0
         if keep.all():
             break
@@ -117,7 +131,7 @@ def normalize(polygon, *, ccw: bool = True) -> np.ndarray:
     [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]]
     """
     p = drop_collinear(drop_repeats(as_array(polygon)))
-    if len(p) >= 3 and (signed_area(p) > 0.0) != ccw:
+    if len(p) >= 3 and (_shoelace(p) > 0.0) != ccw:
         p = p[::-1].copy()
     return lowest_first(p)
 
@@ -183,8 +197,13 @@ def lowest_first(p: np.ndarray) -> np.ndarray:
     """
     if len(p) == 0:
         return p
-    i = int(np.lexsort((p[:, 0], p[:, 1]))[0])
-    return np.roll(p, -i, axis=0) if i else p
+    y = p[:, 1]
+    low = np.flatnonzero(y == y.min())
+    if len(low) != 1:  # ties (then leftmost), or NaN coordinates (sorted last)
+        i = int(low[np.argmin(p[low, 0])]) if len(low) else int(np.lexsort((p[:, 0], p[:, 1]))[0])
+    else:
+        i = int(low[0])
+    return np.concatenate((p[i:], p[:i])) if i else p
 
 
 def is_convex(polygon, *, strict: bool = False) -> bool:
@@ -198,10 +217,11 @@ def is_convex(polygon, *, strict: bool = False) -> bool:
     >>> is_convex([[0, 0], [2, 0], [1, 1], [2, 2], [0, 2]])
     False
     """
-    p = drop_repeats(as_array(polygon))
+    p = drop_repeats(as_array(polygon, copy=False))
     if len(p) < 3:
         return not strict
-    turn = orient2d_many(np.roll(p, 1, axis=0), p, np.roll(p, -1, axis=0))
+    prev, nxt = _prev_next(p)
+    turn = orient2d_many(prev, p, nxt)
     if strict and (turn == 0).any():
         return False
     if (turn > 0).any() and (turn < 0).any():
@@ -209,7 +229,7 @@ def is_convex(polygon, *, strict: bool = False) -> bool:
     if not turn.any():
         return not strict  # all collinear: a segment, convex but degenerate
     # Same-sign turns can still wind twice (a pentagram): total turning must be 2 pi.
-    e = np.roll(p, -1, axis=0) - p
+    e = nxt - p
     ang = np.arctan2(e[:, 1], e[:, 0])
     d = np.diff(np.append(ang, ang[0]))
     d = (d + math.pi) % (2 * math.pi) - math.pi
