@@ -136,14 +136,16 @@ def _hertel_mehlhorn(tris: np.ndarray, pts: np.ndarray, diagonals: list) -> list
         a, b = owner.get((u, v)), owner.get((v, u))
         if a is None or b is None or a == b:
             continue
-        merged = _merge(pieces[a], pieces[b], u, v, xy, owner)
+        q = pieces[b]
+        merged = _merge(pieces[a], q, u, v, xy, owner)
         if merged is None:
             continue
         del pieces[b]
         pieces[a] = merged
-        n = len(merged)
-        for i in range(n):
-            owner[(merged[i], merged[(i + 1) % n])] = a
+        # Only b's edges change hands (those _merge dropped, and the diagonal, are gone).
+        for e in zip(q, q[1:] + q[:1]):
+            if owner.get(e) == b:
+                owner[e] = a
         owner.pop((u, v), None)
         owner.pop((v, u), None)
     return list(pieces.values())
