@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
+from .polygon import as_array, drop_collinear, drop_repeats, lowest_first, lowest_index
 from .predicates import (CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, error_free_cross_sign, lower_half,
                          orient2d_xy, sum_error)
 
@@ -163,11 +163,26 @@ def _extremes(pts: list) -> list:
     return [lo] if lo == hi else [lo, hi]
 
 
-def _lowest_index(p: np.ndarray) -> int:
-    """Index of the lowest-then-leftmost vertex (no full lexsort)."""
+def _lowest_index_convex(p: np.ndarray) -> int:
+    """:func:`cspace.polygon.lowest_index` of a convex polygon, in one pass.
+
+    A convex polygon's lowest vertices are consecutive (one vertex, or the run along
+    its bottom edge), so the leftmost of them is found next to the first one. On a
+    non-convex polygon the answer may be another vertex; callers certify convexity.
+    """
     y = p[:, 1]
-    cand = np.flatnonzero(y == y.min())
-    return int(cand[np.argmin(p[cand, 0])]) if len(cand) > 1 else int(cand[0])
+    n = len(p)
+    k = int(np.argmin(y))
+    ymin = y[k]
+    if y[k - 1] != ymin and y[(k + 1) % n] != ymin:
+        return k
+    run = [k]
+    for step in (-1, 1):
+        j = (k + step) % n
+        while y[j] == ymin and j != k and len(run) < n:
+            run.append(j)
+            j = (j + step) % n
+    return min(run, key=lambda j: p[j, 0])
 
 
 def _clean_convex(p: np.ndarray) -> np.ndarray:
@@ -192,7 +207,7 @@ def _clean_convex(p: np.ndarray) -> np.ndarray:
         raise ValueError("minkowski_sum: operand is not convex")
     if not pos:
         p = p[::-1]
-    k = _lowest_index(p)
+    k = lowest_index(p)
     if k:
         p = np.roll(p, -k, axis=0)
     return np.ascontiguousarray(p)
@@ -359,7 +374,7 @@ def _prep_fast(p: np.ndarray) -> tuple[np.ndarray, int] | None:
     the caller then takes the full clean, which raises for non-convex input).
     """
     n = len(p)
-    k = _lowest_index(p)
+    k = _lowest_index_convex(p)
     a, b, c = p[k - 1], p[k], p[(k + 1) % n]
     t = orient2d_xy(a[0], a[1], b[0], b[1], c[0], c[1])
     if t == 0:
@@ -520,8 +535,7 @@ def _integral(polys: list, k: int, scratch: np.ndarray) -> bool:
         if not (p.max() < lim and -p.min() < lim):
             return False
     for p in polys:
-        f = np.floor(p, out=scratch[:len(p)])
-        if not np.equal(f, p, out=f).all():  # 1.0 where integral
+        if not np.array_equal(np.floor(p, out=scratch[:len(p)]), p):
             return False
     return True
 
@@ -664,12 +678,12 @@ def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
 
     if len(out) < 3 or _winds_more_than_once(out):
         return convex_hull(out)
-    k = _lowest_index(out)
+    k = lowest_index(out)
     return np.roll(out, -k, axis=0) if k else out
 
 
 def _winds_more_than_once(p: np.ndarray) -> bool:
-    p = np.roll(p, -_lowest_index(p), axis=0)
+    p = np.roll(p, -lowest_index(p), axis=0)
     e = np.roll(p, -1, axis=0) - p
     h = lower_half(e[:, 0], e[:, 1])
     return bool((h[:-1] > h[1:]).any())

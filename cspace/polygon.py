@@ -197,13 +197,23 @@ def lowest_first(p: np.ndarray) -> np.ndarray:
     """
     if len(p) == 0:
         return p
+    i = lowest_index(p)
+    return np.concatenate((p[i:], p[:i])) if i else p
+
+
+def lowest_index(p: np.ndarray) -> int:
+    """Index of the lowest (then leftmost) vertex of a non-empty ``(N, 2)`` array.
+
+    >>> lowest_index(np.array([[1., 0], [2, 1], [0, 0]]))
+    2
+    """
     y = p[:, 1]
     low = np.flatnonzero(y == y.min())
-    if len(low) != 1:  # ties (then leftmost), or NaN coordinates (sorted last)
-        i = int(low[np.argmin(p[low, 0])]) if len(low) else int(np.lexsort((p[:, 0], p[:, 1]))[0])
-    else:
-        i = int(low[0])
-    return np.concatenate((p[i:], p[:i])) if i else p
+    if len(low) == 1:
+        return int(low[0])
+    if len(low):  # ties: the leftmost
+        return int(low[np.argmin(p[low, 0])])
+    return int(np.lexsort((p[:, 0], p[:, 1]))[0])  # NaN coordinates: sorted last
 
 
 def is_convex(polygon, *, strict: bool = False) -> bool:
