@@ -302,3 +302,21 @@ def test_vectorised_route_is_independent_of_start_vertex_and_orientation(seed, r
     assert S.tolist() == want.tolist() == [list(v) for v in _scalar_reference(*polys)]
     if integer and k == 2 and len(polys[0]) * len(polys[1]) <= 20000:  # the Fraction hull is O(nm)
         assert as_fr(S) == exact_sum(*polys)
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+@pytest.mark.parametrize("shift", [0, 1, 2, -1])
+def test_vectorised_route_finds_the_leftmost_of_a_flat_bottom(reverse, shift):
+    # A horizontal bottom edge gives two lowest vertices; the fast path must start from
+    # the left one wherever the pair sits in the array, including split across its end.
+    t = np.linspace(0, np.pi, 151)
+    top = np.c_[np.cos(t), np.sin(t)] * 2**20  # the upper half disc: (2^20, 0) ... (-2^20, 0)
+    P = np.round(top)  # CCW from the bottom-right vertex; the bottom edge closes the ring
+    Q = np.round(np.c_[np.cos(t * 2 + 0.1), np.sin(t * 2 + 0.1)] * 2**19)
+    Q = convex_hull(Q)
+    ccw = np.roll(P, shift, axis=0)
+    S = minkowski_sum(ccw[::-1] if reverse else ccw, Q)
+    assert strictly_convex(S)
+    assert S.tolist() == [list(v) for v in _scalar_reference(P, Q)]
+    assert as_fr(S) == exact_sum(P, Q)
+    assert S[0].tolist() == (P[np.lexsort((P[:, 0], P[:, 1]))[0]] + Q[0]).tolist()
