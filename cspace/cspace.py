@@ -18,6 +18,7 @@ Only the stages a scene needs run, and each is recorded with its cost:
 from __future__ import annotations
 
 import itertools
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -241,6 +242,7 @@ class CSpace:
         mixed = self._mixed_cell_test()
         xmin, xmax, ymin, ymax = self.bounds
         count = int if tick is None else tick  # int() is a C-level no-op: no branch per query
+        floor = math.floor  # on floats about 3x cheaper than int() (a type call); equal for i >= 0
 
         def is_free_q(q) -> bool:
             count()
@@ -250,7 +252,7 @@ class CSpace:
             j = y * ih - b0
             if i >= 0.0 and j >= 0.0:  # also False for NaN
                 try:
-                    c = rows[int(j)][int(i)]
+                    c = rows[floor(j)][floor(i)]
                 except (IndexError, OverflowError):
                     return exact(x, y)  # off the grid's top or right
                 if not c:
@@ -259,7 +261,7 @@ class CSpace:
                     return False  # BLOCKED
                 if c == 1 and xmin <= x <= xmax and ymin <= y <= ymax:
                     # MIXED, inside the bounds: the inlined narrow phase
-                    return mixed(int(j) * nx + int(i), x, y)
+                    return mixed(floor(j) * nx + floor(i), x, y)
             return exact(x, y)  # the bounds' edges, the border and anything outside
 
         if state:
