@@ -127,10 +127,10 @@ class GridIndex:
         """Cells that closed convex ``p`` may meet, which of them lie inside ``p``, and for
         each the bit mask of the edges whose line passes within the margin of it."""
         m = self.margin
-        i0 = int(math.floor((p[:, 0].min() - m - self.x0) * self.inv_w))
-        i1 = int(math.floor((p[:, 0].max() + m - self.x0) * self.inv_w))
-        j0 = int(math.floor((p[:, 1].min() - m - self.y0) * self.inv_h))
-        j1 = int(math.floor((p[:, 1].max() + m - self.y0) * self.inv_h))
+        i0 = math.floor((p[:, 0].min() - m - self.x0) * self.inv_w)
+        i1 = math.floor((p[:, 0].max() + m - self.x0) * self.inv_w)
+        j0 = math.floor((p[:, 1].min() - m - self.y0) * self.inv_h)
+        j1 = math.floor((p[:, 1].max() + m - self.y0) * self.inv_h)
         i0, j0 = max(i0, 0), max(j0, 0)
         i1, j1 = min(i1, self.nx - 1), min(j1, self.ny - 1)
         if i0 > i1 or j0 > j1:
@@ -180,8 +180,8 @@ class GridIndex:
 
     def cell_of(self, x: float, y: float) -> int:
         """Flat index of the cell holding (x, y) (clamped to the grid)."""
-        i = int((x - self.x0) * self.inv_w)
-        j = int((y - self.y0) * self.inv_h)
+        i = math.floor((x - self.x0) * self.inv_w)
+        j = math.floor((y - self.y0) * self.inv_h)
         i = 0 if i < 0 else (self.nx - 1 if i >= self.nx else i)
         j = 0 if j < 0 else (self.ny - 1 if j >= self.ny else j)
         return j * self.nx + i
@@ -225,10 +225,10 @@ class GridIndex:
         stack = [(ax, ay, bx, by)]
         while stack:
             px, py, qx, qy = stack.pop()
-            i0 = int(math.floor(((px if px < qx else qx) - m - x0) * iw))
-            i1 = int(math.floor(((qx if px < qx else px) + m - x0) * iw))
-            j0 = int(math.floor(((py if py < qy else qy) - m - y0) * ih))
-            j1 = int(math.floor(((qy if py < qy else py) + m - y0) * ih))
+            i0 = math.floor(((px if px < qx else qx) - m - x0) * iw)
+            i1 = math.floor(((qx if px < qx else px) + m - x0) * iw)
+            j0 = math.floor(((py if py < qy else qy) - m - y0) * ih)
+            j1 = math.floor(((qy if py < qy else py) + m - y0) * ih)
             i0 = 0 if i0 < 0 else i0
             j0 = 0 if j0 < 0 else j0
             i1 = nx1 if i1 > nx1 else i1
@@ -271,8 +271,8 @@ class GridIndex:
         """
         m = self.margin
         xlo, xhi = min(ax, bx), max(ax, bx)
-        i0 = max(int(math.floor((xlo - m - self.x0) * self.inv_w)), 0)
-        i1 = min(int(math.floor((xhi + m - self.x0) * self.inv_w)), self.nx - 1)
+        i0 = max(math.floor((xlo - m - self.x0) * self.inv_w), 0)
+        i1 = min(math.floor((xhi + m - self.x0) * self.inv_w), self.nx - 1)
         if i1 < i0:
             return np.zeros(0, dtype=np.int64)
         cols = np.arange(i0, i1 + 1)
