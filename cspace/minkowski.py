@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polygon import as_array, drop_collinear, drop_repeats, lowest_first, lowest_index
+from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
 from .predicates import (CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, error_free_cross_sign, lower_half,
                          orient2d_xy, sum_error)
 
@@ -207,10 +207,7 @@ def _clean_convex(p: np.ndarray) -> np.ndarray:
         raise ValueError("minkowski_sum: operand is not convex")
     if not pos:
         p = p[::-1]
-    k = lowest_index(p)
-    if k:
-        p = np.roll(p, -k, axis=0)
-    return np.ascontiguousarray(p)
+    return np.ascontiguousarray(lowest_first(p))
 
 
 def _turns_cols(ux, uy, vx, vy, a, b, c, d) -> np.ndarray:
@@ -678,12 +675,11 @@ def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
 
     if len(out) < 3 or _winds_more_than_once(out):
         return convex_hull(out)
-    k = lowest_index(out)
-    return np.roll(out, -k, axis=0) if k else out
+    return lowest_first(out)
 
 
 def _winds_more_than_once(p: np.ndarray) -> bool:
-    p = np.roll(p, -lowest_index(p), axis=0)
+    p = lowest_first(p)
     e = np.roll(p, -1, axis=0) - p
     h = lower_half(e[:, 0], e[:, 1])
     return bool((h[:-1] > h[1:]).any())

@@ -25,7 +25,7 @@ import numpy as np
 from .convolution import convex_sums_with
 from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
-from .polygon import as_array, is_convex, normalize
+from .polygon import as_array, is_convex, normalize, prev_next
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -93,8 +93,8 @@ def _convolution_roles(A, holes_a, B, holes_b):
 def _turning(P: np.ndarray) -> float:
     """Total absolute turning of a polygon's boundary, in full turns (a float
     estimate: it only ranks the operands)."""
-    u = P - np.concatenate((P[-1:], P[:-1]))  # edge into each vertex
-    v = np.concatenate((u[1:], u[:1]))  # edge out of it
+    prev, nxt = prev_next(P)
+    u, v = P - prev, nxt - P  # the edges into and out of each vertex
     angle = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))
     return float(np.abs(angle).sum() / (2 * np.pi))
 

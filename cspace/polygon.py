@@ -60,8 +60,12 @@ def _shoelace(p: np.ndarray) -> float:
     return 0.5 * float((x[:-1] * y[1:]).sum() - (y[:-1] * x[1:]).sum())
 
 
-def _prev_next(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each vertex's predecessor and successor rows (cyclically), as new arrays."""
+def prev_next(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each vertex's predecessor and successor rows along the ring, as new arrays.
+
+    >>> [a.tolist() for a in prev_next(np.array([[0., 0], [1, 0], [0, 1]]))]
+    [[[0.0, 1.0], [0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]]
+    """
     return np.concatenate((p[-1:], p[:-1])), np.concatenate((p[1:], p[:1]))
 
 
@@ -101,7 +105,7 @@ def drop_collinear(p: np.ndarray) -> np.ndarray:
     [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]
     """
     while len(p) >= 3:
-        prev, nxt = _prev_next(p)
+        prev, nxt = prev_next(p)
         turn = orient2d_many(prev, p, nxt)
         keep = turn != 0
         if keep.all():
@@ -230,7 +234,7 @@ def is_convex(polygon, *, strict: bool = False) -> bool:
     p = drop_repeats(as_array(polygon, copy=False))
     if len(p) < 3:
         return not strict
-    prev, nxt = _prev_next(p)
+    prev, nxt = prev_next(p)
     turn = orient2d_many(prev, p, nxt)
     if strict and (turn == 0).any():
         return False
