@@ -441,7 +441,9 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
     slower exact route.
     """
     rot = rot or [0] * len(polys)
-    start = np.sum([p[k] for p, k in zip(polys, rot)], axis=0)
+    start = polys[0][rot[0]].copy()
+    for p, k in zip(polys[1:], rot[1:]):
+        start += p[k]
     rot = [k for p, k in zip(polys, rot) if len(p) >= 2]
     edged = [p for p in polys if len(p) >= 2]
     if not edged:
@@ -478,6 +480,8 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
     keep = np.flatnonzero(~fused) if fused.any() else _iota(len(fused))
     out = buf[:len(keep) + 1]  # all of buf unless edges fused
     out[0] = start
+    if integral:  # exact: vertex after edge t = start + the sum of the edges up to t
+        return _running_sums(ux, uy, start, keep, ints[:2 * total], ws[:2 * total], out)  # order, g, ex, ey: spent
     if len(edged) == 2 and len(polys) == 2:
         # Two operands: after merged edge t, taken from operand P (size n) as its
         # local edge l, P has given l + 1 edges and Q the other t - l, and vice versa.
@@ -502,12 +506,7 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
         np.take(P, cp, axis=0, out=a, mode="wrap")
         np.take(Q, cq, axis=0, out=b, mode="wrap")
         np.add(a, b, out=out[1:])
-        return out if integral else _certify_cols(out, exact=False)
-    if integral:  # exact: vertex after edge t = start + the sum of the edges up to t
-        out[1:, 0] = np.cumsum(ux, out=ux)[keep]
-        out[1:, 1] = np.cumsum(uy, out=uy)[keep]
-        out[1:] += start
-        return out
+        return _certify_cols(out, exact=False)
     # Float input: each vertex is the sum of one input vertex per operand, rounded
     # once per addition; the count of an operand's edges taken so far is its index.
     vx = np.zeros(len(keep))
@@ -522,6 +521,27 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
     return _certify_cols(out, exact=False)
 
 
+def _running_sums(ux, uy, start, keep, acc, spare, out) -> np.ndarray:
+    """``out[1:]``: start + the running sums of the merged edges (ux, uy), at ``keep``.
+
+    For integer input. Every partial sum is a vertex of the sum, an integer below 2^51
+    in magnitude, so int64 sums are exact and so is their conversion back. One
+    accumulate of (x, y) rows costs less than two of columns. ``acc`` and ``spare``
+    are scratch blocks of 2 * len(ux) int64 and float64.
+    """
+    n = len(ux)
+    acc = acc.reshape(n, 2)
+    np.copyto(acc[:, 0], ux, casting="unsafe")
+    np.copyto(acc[:, 1], uy, casting="unsafe")
+    acc[0] += start.astype(np.int64)
+    np.cumsum(acc, axis=0, out=acc)
+    k = len(keep)
+    if k < n - 1:  # fused edges leave no vertex: gather the rest
+        acc = np.take(acc, keep, axis=0, out=spare[:2 * k].view(np.int64).reshape(k, 2))
+    out[1:] = acc[:k]
+    return out
+
+
 def _integral(polys: list, k: int, scratch: np.ndarray) -> bool:
     """Every coordinate an integer small enough that all sums of k of them are exact.
 
@@ -529,7 +549,7 @@ def _integral(polys: list, k: int, scratch: np.ndarray) -> bool:
     """
     lim = 2.0**51 / max(k, 1)
     for p in polys:
-        if not (p.max() < lim and -p.min() < lim):
+        if not _max_abs(p) < lim:
             return False
     for p in polys:
         if not np.array_equal(np.floor(p, out=scratch[:len(p)]), p):
@@ -547,9 +567,9 @@ def _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, w1, w2) ->
     same = half[:-1] == half[1:]
     left = np.multiply(ux[:-1], uy[1:], out=w1[:-1])  # w1, w2: scratch
     right = np.multiply(uy[:-1], ux[1:], out=w2[:-1])
-    if integral and _max_abs(ux) * _max_abs(uy) < 2.0**53:
-        # Integer products below 2^53 are exact and so is their difference's sign:
-        # the largest |ux| * |uy| bounds every product, so all are sure at once.
+    if integral and max(_max_abs(left), _max_abs(right)) < 2.0**53:
+        # Integer products below 2^53 are exact (a true product of 2^53 or more cannot
+        # round below 2^53) and so is their difference's sign: all are sure at once.
         det = np.subtract(left, right, out=left)
         if (same & (det < 0)).any():
             return None
@@ -589,7 +609,8 @@ def _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, w1, w2) ->
 
 
 def _max_abs(u: np.ndarray) -> float:
-    return max(float(u.max()), -float(u.min()))
+    # The ufunc reductions themselves: ndarray.max() adds a Python-level wrapper.
+    return max(float(np.maximum.reduce(u, axis=None)), -float(np.minimum.reduce(u, axis=None)))
 
 
 def _error_free_signs(ux: np.ndarray, uy: np.ndarray, doubt: np.ndarray) -> np.ndarray:
