@@ -351,9 +351,10 @@ def _pseudo_angle(dx: np.ndarray, dy: np.ndarray, key: np.ndarray, scratch: np.n
     (dy must carry no -0.0). A zero vector gives NaN. The key is only a pre-sort,
     certified afterwards exactly. Written into ``key``; ``scratch`` is overwritten.
     """
-    np.abs(dx, out=key)
-    key += np.abs(dy, out=scratch)
-    np.divide(dx, key, out=key)  # t
+    with np.errstate(invalid="ignore", over="ignore"):  # NaN and inf are read by the caller
+        np.abs(dx, out=key)
+        key += np.abs(dy, out=scratch)
+        np.divide(dx, key, out=key)  # t
     key += 1.0
     np.copysign(key, dy, out=key)
     np.subtract(2.0, key, out=key)

@@ -1,4 +1,5 @@
 """The convex kernel: hull, angular-merge sums, half-planes, erosion, against exact references."""
+import warnings
 from fractions import Fraction
 
 import numpy as np
@@ -250,6 +251,22 @@ def test_vectorised_route_cleans_cw_collinear_and_repeated_operands():
     S = minkowski_sum(messy, Q)
     assert S.tolist() == minkowski_sum(P, Q).tolist()
     assert strictly_convex(S) and len(S) <= len(P) + len(Q)
+
+
+def test_vectorised_route_repeated_vertex_is_silent():
+    # A repeated vertex away from the lowest one passes the fast path's orientation
+    # test and reaches the pseudo-angle as a zero edge (0 / 0): the merge must fall
+    # back to the clean route without a RuntimeWarning reaching the caller.
+    rng = np.random.default_rng(11)
+    P = _random_convex(rng, 150, 2.0**20, integer=True)
+    Q = _random_convex(rng, 150, 2.0**20, integer=True)
+    lo = int(np.lexsort((P[:, 0], P[:, 1]))[0])
+    j = (lo + len(P) // 2) % len(P)
+    doubled = np.insert(P, j, P[j], axis=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        S = minkowski_sum(doubled, Q)
+    assert S.tolist() == minkowski_sum(P, Q).tolist()
 
 
 def test_vectorised_route_rejects_non_convex_operands():
