@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polygon import PackedPieces, signed_area
+from .polygon import PackedPieces, orientation
 from .predicates import cross_diff_cols, lower_half, orient2d_many
 
 # Most (Q edge, piece edge) comparisons in one vectorised block.
@@ -59,7 +59,7 @@ def convolution_cycles(pieces: list, Q) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"convolution_cycles: piece {bad} is not strictly convex, CCW from its lowest vertex")
     pts, sizes, starts, nxt = packed.pts, packed.sizes, packed.starts, packed.nxt
     Q1 = np.concatenate((Q[1:], Q[:1]))  # each edge's head
-    if len(Q) < 3 or ((Q1[:, 0] == Q[:, 0]) & (Q1[:, 1] == Q[:, 1])).any() or signed_area(Q) <= 0.0:
+    if len(Q) < 3 or ((Q1[:, 0] == Q[:, 0]) & (Q1[:, 1] == Q[:, 1])).any() or orientation(Q) <= 0:
         raise ValueError("convolution_cycles: Q must be a CCW polygon without repeated vertices")
     # pos[t, i]: how many edges of piece i come strictly before edge t of Q in angle,
     # counted from the +x direction. Piece i's edges are in that order already, so

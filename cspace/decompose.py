@@ -24,6 +24,7 @@ import numpy as np
 
 from .polygon import as_array, drop_collinear, is_convex, normalize, ring_neighbours
 from .predicates import CCW_ERRBOUND_A, orient2d_many, orient2d_xy
+from .scaling import ldexp_exact, rescale_exponent
 
 
 def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
@@ -81,7 +82,17 @@ def _triangulate(rings: list, pts: np.ndarray) -> np.ndarray:
     """CCW index triangles ``(T, 3)`` of the polygon, over the array of its vertices."""
     import shapely
 
-    tri = shapely.constrained_delaunay_triangles(shapely.Polygon(rings[0], rings[1:]))
+    # GEOS's in-circle tests multiply four coordinates: far from 1 in magnitude, a
+    # power-of-two copy (exact) is triangulated and its corners looked up instead.
+    mag = float(np.abs(pts).max())
+    k = rescale_exponent(mag, mag)
+    scaled = ldexp_exact(pts, k) if k else None
+    if scaled is not None:
+        pts, rings = scaled, [np.ldexp(r, k) for r in rings]
+    try:
+        tri = shapely.constrained_delaunay_triangles(shapely.Polygon(rings[0], rings[1:]))
+    except shapely.errors.GEOSException as e:
+        raise ValueError(f"convex_decompose: GEOS could not triangulate the polygon ({e})") from None
     corners = shapely.get_coordinates(tri).reshape(-1, 4, 2)[:, :3].reshape(-1, 2)
     # Each corner's vertex index: look the (x, y) pairs up as complex numbers, which
     # numpy sorts by x, then y.

@@ -9,7 +9,9 @@ point in the direction of the origin.
 
 Robustness, per the known failure modes of published GJK code:
 - all work is in a local frame (both sets shifted by a vertex of A), so sets far
-  from the origin (1e8) keep their precision;
+  from the origin (1e8) keep their precision; a frame whose coordinates are so small
+  or large that their products under- or overflow is first rescaled by a power of
+  two (:mod:`cspace.scaling`), exactly;
 - a support pair already in the simplex ends the loop (no cycling), as does no
   progress (v·v − v·w ≤ 1e-14 · v·v), and an iteration cap;
 - degenerate simplices (repeated or collinear points) are reduced, never inverted:
@@ -29,6 +31,7 @@ import numpy as np
 
 from .polygon import as_array
 from .predicates import orient2d_cols, orient2d_xy
+from .scaling import ldexp_exact, rescale_exponent
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -62,14 +65,24 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
     a = as_array(A)
     b = as_array(B)
     origin = a[0].copy()
-    al = (a - origin).tolist()
-    bl = (b - origin).tolist()
+    with np.errstate(over="ignore", invalid="ignore"):
+        al = (a - origin).tolist()
+        bl = (b - origin).tolist()
+    extent = _scale(al, bl)
+    k = rescale_exponent(extent, extent if math.isfinite(extent) else max(np.abs(a).max(), np.abs(b).max()))
+    if k:  # products of the local coordinates would under- or overflow: work at 2^k scale
+        sa, sb = ldexp_exact(a, k), ldexp_exact(b, k)
+        if sa is not None and sb is not None:
+            d = gjk_distance(sa, sb, max_iterations)
+            with np.errstate(over="ignore"):  # a distance beyond the double range is inf
+                return Distance(float(np.ldexp(d.distance, -k)), np.ldexp(d.point_a, -k), np.ldexp(d.point_b, -k),
+                                d.iterations, d.status)
     dist, pa, pb, it, inside, simplex = _gjk(al, bl, max_iterations)
     ox, oy = origin.tolist()
     if inside == "deep":
         p = np.array((pa[0] + ox, pa[1] + oy))
         return Distance(0.0, p, p.copy(), it, "overlapping")
-    if inside or dist <= EXACT_BAND * _scale(al, bl):
+    if inside or dist <= EXACT_BAND * extent:
         status = _contact_relation(a.tolist(), b.tolist(), simplex) or exact_relation(a, b)
         if status != "separated":
             p = np.array((pa[0] + ox, pa[1] + oy))

@@ -70,7 +70,10 @@ def erode(A, B) -> np.ndarray:
     verts = erode_exact(A, B)
     if not verts:
         return np.zeros((0, 2))
-    out = np.array([[float(x), float(y)] for x, y in verts], dtype=np.float64)
+    try:
+        out = np.array([[float(x), float(y)] for x, y in verts], dtype=np.float64)
+    except OverflowError:  # the exact vertex is beyond the double range
+        raise ValueError("erode: the result's coordinates overflow the double range") from None
     return normalize(out) if len(out) >= 3 else out
 
 

@@ -57,6 +57,14 @@ def minkowski_sum(P, Q, *more) -> np.ndarray:
     [[0.0, 0.0], [3.0, 0.0], [3.0, 1.0], [1.0, 3.0], [0.0, 3.0]]
     """
     ops = [as_array(x, copy=False) for x in (P, Q) + more]  # only read
+    try:
+        return _minkowski_sum(ops)
+    except OverflowError:  # an exact step met inf: a vertex of the sum is beyond the double range
+        raise ValueError("minkowski_sum: the sum's coordinates overflow the double range") from None
+
+
+def _minkowski_sum(ops: list) -> np.ndarray:
+    """:func:`minkowski_sum` of operands already converted to arrays."""
     if sum(len(o) for o in ops) <= _SCALAR_MAX:
         if len(ops) == 2:
             (P, EP), (Q, EQ) = _clean_edges_small(ops[0].tolist()), _clean_edges_small(ops[1].tolist())
@@ -373,8 +381,8 @@ def _prep_fast(p: np.ndarray) -> tuple[np.ndarray, int] | None:
     """
     n = len(p)
     k = _lowest_index_convex(p)
-    a, b, c = p[k - 1], p[k], p[(k + 1) % n]
-    t = orient2d_xy(a[0], a[1], b[0], b[1], c[0], c[1])
+    (ax, ay), (bx, by), (cx, cy) = p[k - 1].tolist(), p[k].tolist(), p[(k + 1) % n].tolist()
+    t = orient2d_xy(ax, ay, bx, by, cx, cy)
     if t == 0:
         return None
     if t < 0:
@@ -474,7 +482,8 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
     # At most one output vertex per edge: the output's buffer is scratch until then.
     buf = np.empty((total, 2))
     integral = _integral(edged, len(polys), buf)
-    fused = _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, ex, ey)  # ex, ey: spent
+    with np.errstate(over="ignore", invalid="ignore"):  # inf and NaN products go to the exact tests
+        fused = _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, ex, ey)  # ex, ey: spent
     if fused is None:
         return None
     # The vertex after merged edge t, t < last, unless t and t + 1 fuse.

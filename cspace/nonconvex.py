@@ -26,6 +26,7 @@ from .convolution import convex_sums_with
 from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
 from .polygon import as_array, is_convex, normalize, prev_next
+from .scaling import ldexp_exact, rescale_exponent
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -53,6 +54,19 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
     import shapely
 
     (A, holes_a), (B, holes_b) = _operand(A, holes_a), _operand(B, holes_b)
+    # GEOS's overlay multiplies coordinates: far from 1 in magnitude, sum a power-of-two
+    # copy of the operands (exact) and scale the region back.
+    mag = max(float(np.abs(p).max()) for p in [A, B] + holes_a + holes_b if len(p))
+    k = rescale_exponent(mag, mag)
+    scaled = [ldexp_exact(p, k) for p in [A, B] + holes_a + holes_b] if k else [None]
+    if all(p is not None for p in scaled):
+        region = minkowski_sum_nonconvex(scaled[0], scaled[1], scaled[2:2 + len(holes_a)],
+                                         scaled[2 + len(holes_a):])
+        with np.errstate(over="ignore"):
+            region = shapely.transform(region, lambda c: np.ldexp(c, -k))
+        if not np.isfinite(shapely.get_coordinates(region)).all():
+            raise ValueError("minkowski_sum_nonconvex: the sum's coordinates overflow the double range")
+        return region
     route = _convolution_roles(A, holes_a, B, holes_b)
     if route is not None:
         X, holes_x, x_convex, Q = route

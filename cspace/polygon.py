@@ -70,12 +70,46 @@ def prev_next(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def is_ccw(polygon) -> bool:
-    """True when the polygon's signed area is positive.
+    """True when the polygon runs counter-clockwise, decided exactly (:func:`orientation`).
 
     >>> is_ccw([[0, 0], [0, 1], [1, 0]])
     False
     """
-    return signed_area(polygon) > 0.0
+    return orientation(as_array(polygon, copy=False)) > 0
+
+
+def orientation(p: np.ndarray) -> int:
+    """Exact orientation of a simple polygon: +1 CCW, -1 CW, 0 for no area.
+
+    The turn at the lowest (then leftmost) vertex, taken between its nearest
+    neighbours that differ from it and are not collinear with it: that vertex is an
+    extreme point, so the turn there is the orientation of the whole boundary. One
+    exact predicate, right at every scale, where the shoelace sum underflows to 0
+    (coordinates near 1e-160), overflows to inf or NaN (near 1e160) or rounds to the
+    wrong sign (a sliver).
+
+    >>> orientation(np.array([[0., 0], [2, 0], [0, 1]])), orientation(np.array([[0., 0], [0, 1], [2, 0]]))
+    (1, -1)
+    >>> orientation(np.array([[0., 0], [2, 0], [0, 1]]) * 1e-200)
+    1
+    """
+    n = len(p)
+    if n < 3:
+        return 0
+    k = lowest_index(p)
+    bx, by = p[k].tolist()
+    for step in range(1, n):  # the next vertex along the ring that is not v itself
+        cx, cy = p[(k + step) % n].tolist()
+        if cx != bx or cy != by:
+            break
+    else:
+        return 0
+    for back in range(1, n):  # the previous one, not v and not collinear with v -> c
+        ax, ay = p[(k - back) % n].tolist()
+        t = orient2d_xy(ax, ay, bx, by, cx, cy)
+        if t:
+            return t
+    return 0
 
 
 def drop_repeats(p: np.ndarray) -> np.ndarray:
@@ -135,7 +169,7 @@ def normalize(polygon, *, ccw: bool = True) -> np.ndarray:
     [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]]
     """
     p = drop_collinear(drop_repeats(as_array(polygon)))
-    if len(p) >= 3 and (_shoelace(p) > 0.0) != ccw:
+    if len(p) >= 3 and (orientation(p) > 0) != ccw:
         p = p[::-1].copy()
     return lowest_first(p)
 
@@ -261,8 +295,8 @@ def is_simple(polygon) -> bool:
     p = as_array(polygon)
     if len(p) < 3:
         return False
-    poly = shapely.Polygon(p)
-    return bool(poly.is_valid) and poly.area > 0.0
+    # Area decided exactly (a float area underflows to 0 for coordinates near 1e-160).
+    return bool(shapely.Polygon(p).is_valid) and len(normalize(p)) >= 3
 
 
 def point_in_convex(p: np.ndarray, x: float, y: float) -> int:

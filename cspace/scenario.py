@@ -267,11 +267,10 @@ class _Validator:
             shell = shapely.Polygon(ext)
             if not shell.is_valid:
                 raise self.err(f"{field}.polygon", f"not a simple polygon ({shapely.is_valid_reason(shell)})")
-            if not shell.area > 0.0:
+            if len(normalize(ext)) < 3:  # exact: a float area underflows near 1e-160
                 raise self.err(f"{field}.polygon", "has zero area")
             for i, h in enumerate(holes):
-                hp = shapely.Polygon(h)
-                if not hp.is_valid or not hp.area > 0.0:
+                if not shapely.Polygon(h).is_valid or len(normalize(h)) < 3:
                     raise self.err(f"{field}.holes[{i}]", "not a simple polygon of non-zero area")
             if holes:
                 whole = shapely.Polygon(ext, holes)

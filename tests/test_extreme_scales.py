@@ -1,0 +1,97 @@
+"""Tiny and huge coordinates: every answer at scale 2^k is the scale-1 answer times 2^k.
+
+Multiplying all coordinates by a power of two is exact, so this is an oracle for
+every function: exact ones must agree bit for bit, float ones to their own
+tolerance. Before the rescaling of :mod:`cspace.scaling` and the exact orientation
+of :func:`cspace.polygon.orientation`, GJK and EPA answered wrongly from 2^-400 and
+2^700 on, GEOS's triangulation raised from 2^±700, and normalize turned a CCW
+polygon clockwise at 2^-600 (its shoelace area underflowed to 0).
+"""
+import warnings
+
+import numpy as np
+import pytest
+import shapely
+
+import cspace as C
+from cspace.polygon import normalize, orientation
+
+SCALES = [-1000, -700, -400, 400, 700, 1000]
+
+
+def _convex(rng, n, offset=(0.0, 0.0)):
+    a = np.sort(rng.uniform(0, 2 * np.pi, n))
+    return np.c_[rng.uniform(0.3, 1.0) * np.cos(a), np.sin(a)] + offset
+
+
+def _star(rng, n):
+    a = np.sort(rng.uniform(0, 2 * np.pi, n))
+    r = rng.uniform(0.3, 1.0, n)
+    return np.c_[r * np.cos(a), r * np.sin(a)]
+
+
+@pytest.fixture(autouse=True)
+def _no_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # an overflow warning leaking out is a failure too
+        yield
+
+
+@pytest.mark.parametrize("k", SCALES + [-1070])
+def test_normalize_keeps_orientation_at_every_scale(k):
+    T = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]])
+    want = np.ldexp(normalize(T), k)
+    assert np.array_equal(normalize(np.ldexp(T, k)), want)
+    assert np.array_equal(normalize(np.ldexp(T[::-1], k)), want)
+    assert orientation(np.ldexp(T, k)) == 1 and C.is_simple(np.ldexp(T, k))
+
+
+def test_orientation_of_a_sliver_is_exact():
+    # Nearly collinear (the last y one ulp up): the shoelace sum rounds to 0.0 here.
+    p = np.array([[0.1, 0.3], [589.3624923188806, 196.72083077296023], [941.6651814089914, 314.15506046966385]])
+    assert C.signed_area(p) == 0.0
+    assert orientation(p) == 1 and orientation(p[::-1]) == -1
+    assert np.array_equal(normalize(p), p)  # CCW already, lowest first: kept as it is
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_gjk_and_epa_scale_exactly(seed):
+    rng = np.random.default_rng(seed)
+    P = _convex(rng, int(rng.integers(3, 10)))
+    Q = _convex(rng, int(rng.integers(3, 10)), rng.uniform(-2.5, 2.5, 2))
+    d0, p0 = C.gjk_distance(P, Q), C.epa_penetration(P, Q)
+    for k in SCALES:
+        d = C.gjk_distance(np.ldexp(P, k), np.ldexp(Q, k))
+        assert d.status == d0.status
+        assert np.ldexp(d.distance, -k) == pytest.approx(d0.distance, rel=1e-12, abs=1e-15)
+        assert np.allclose(np.ldexp(d.point_a, -k), d0.point_a, rtol=0, atol=1e-12)
+        p = C.epa_penetration(np.ldexp(P, k), np.ldexp(Q, k))
+        assert p.status == p0.status
+        assert np.ldexp(p.depth, -k) == pytest.approx(p0.depth, rel=1e-9, abs=1e-15)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_decompose_erode_and_sums_scale_exactly(seed):
+    rng = np.random.default_rng(100 + seed)
+    S, L = _star(rng, int(rng.integers(6, 25))), _star(rng, int(rng.integers(5, 12)))
+    P, Q = _convex(rng, 8) * 3, _convex(rng, 5) * 0.2
+    pieces0, eroded0 = C.convex_decompose(S), C.erode(P, Q)
+    region0 = C.minkowski_sum_nonconvex(S, L)
+    for k in SCALES:
+        pieces = C.convex_decompose(np.ldexp(S, k))
+        assert len(pieces) == len(pieces0)
+        assert all(np.array_equal(a, np.ldexp(b, k)) for a, b in zip(pieces, pieces0))
+        assert np.array_equal(C.erode(np.ldexp(P, k), np.ldexp(Q, k)), np.ldexp(eroded0, k))
+        assert np.array_equal(C.minkowski_sum(np.ldexp(P, k), np.ldexp(Q, k)), np.ldexp(C.minkowski_sum(P, Q), k))
+        region = shapely.transform(C.minkowski_sum_nonconvex(np.ldexp(S, k), np.ldexp(L, k)),
+                                   lambda c: np.ldexp(c, -k))
+        assert region.symmetric_difference(region0).area <= 1e-12 * region0.area
+
+
+def test_sums_beyond_the_double_range_raise_value_error():
+    P = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]) * 1.5e308
+    with pytest.raises(ValueError, match="overflow the double range"):
+        C.minkowski_sum(P, P)
+    L = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]]) * 5e307
+    with pytest.raises(ValueError, match="overflow the double range"):
+        C.minkowski_sum_nonconvex(L, L)
