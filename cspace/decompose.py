@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polygon import as_array, drop_collinear, is_convex, normalize, ring_neighbours
+from .polygon import as_array, collinear_extent, drop_collinear, is_convex, normalize, ring_neighbours
 from .predicates import CCW_ERRBOUND_A, orient2d_many, orient2d_xy
 from .scaling import ldexp_exact, rescale_exponent
 
@@ -33,7 +33,9 @@ def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
     The pieces' union is the polygon, their interiors are disjoint, and every
     piece vertex is an input vertex. Each piece is strictly convex (no collinear
     vertex) and starts at its lowest (then leftmost) vertex. ``polygon`` may also
-    be a shapely Polygon (its interiors are then the holes).
+    be a shapely Polygon (its interiors are then the holes). Collinear vertices (no
+    area) give the one point or segment they span; a polygon with no area that is
+    not such a set raises ``ValueError``.
 
     >>> pieces = convex_decompose([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]])
     >>> len(pieces), sorted(len(p) for p in pieces)
@@ -44,6 +46,8 @@ def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
     if hasattr(polygon, "geom_type") and polygon.geom_type == "Polygon" and holes is None:
         holes = [as_array(r) for r in polygon.interiors]
     shell = normalize(polygon)
+    if len(shell) < 3:  # no area: the point or segment it spans, a convex piece itself
+        return [collinear_extent(as_array(polygon))]
     hole_list = [normalize(h, ccw=False) for h in (holes or [])]
     if not hole_list and is_convex(shell):
         return [shell]

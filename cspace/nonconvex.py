@@ -25,7 +25,7 @@ import numpy as np
 from .convolution import convex_sums_with
 from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
-from .polygon import as_array, is_convex, normalize, prev_next
+from .polygon import as_array, collinear_extent, is_convex, normalize, prev_next
 from .scaling import ldexp_exact, rescale_exponent
 
 
@@ -43,7 +43,8 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
     """A ⊕ B for simple polygons with holes, as a shapely Polygon or MultiPolygon.
 
     ``A`` and ``B`` are vertex arrays (either orientation) or shapely Polygons
-    (whose interiors are their holes).
+    (whose interiors are their holes). An operand whose vertices are collinear is
+    the point or segment they span (a segment sweeps the other operand).
 
     >>> L = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
     >>> minkowski_sum_nonconvex(L, [[0, 0], [1, 0], [1, 1], [0, 1]]).area
@@ -81,7 +82,10 @@ def _operand(P, holes):
     if hasattr(P, "geom_type") and P.geom_type == "Polygon" and holes is None:
         holes = [as_array(r) for r in P.interiors]
     holes = [normalize(h, ccw=False) for h in (holes or [])]
-    return normalize(P), [h for h in holes if len(h) >= 3]
+    shell = normalize(P)
+    if len(shell) < 3:  # no area: the point or segment it spans (swept along the other operand)
+        shell = collinear_extent(as_array(P))
+    return shell, [h for h in holes if len(h) >= 3]
 
 
 def _convolution_roles(A, holes_a, B, holes_b):

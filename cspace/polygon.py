@@ -174,6 +174,29 @@ def normalize(polygon, *, ccw: bool = True) -> np.ndarray:
     return lowest_first(p)
 
 
+def collinear_extent(points) -> np.ndarray:
+    """The point or segment that collinear points span: its one or two extreme
+    points, lowest (then leftmost) first. ``ValueError`` if they are not collinear
+    (exact test): a "polygon" of zero area that is not a point or a segment is not
+    simple.
+
+    >>> collinear_extent([[2, 2], [0, 0], [1, 1], [0, 0]]).tolist()
+    [[0.0, 0.0], [2.0, 2.0]]
+    >>> collinear_extent([[1, 1], [1, 1]]).tolist()
+    [[1.0, 1.0]]
+    """
+    p = as_array(points)
+    if len(p) == 0:
+        return p
+    order = np.lexsort((p[:, 0], p[:, 1]))  # by y, then x: along any line, its two ends
+    lo, hi = p[order[0]], p[order[-1]]
+    if (lo == hi).all():
+        return lo.reshape(1, 2)
+    if (orient2d_many(lo, hi, p) != 0).any():
+        raise ValueError("not a simple polygon: no area, yet its vertices are not collinear")
+    return np.array([lo, hi])
+
+
 def ring_neighbours(sizes) -> tuple[np.ndarray, np.ndarray]:
     """For rings of the given sizes stored one after another, each vertex's
     predecessor and successor along its own ring (indices into the concatenation).

@@ -95,3 +95,20 @@ def test_sums_beyond_the_double_range_raise_value_error():
     L = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]]) * 5e307
     with pytest.raises(ValueError, match="overflow the double range"):
         C.minkowski_sum_nonconvex(L, L)
+
+
+def test_nonconvex_sum_with_a_segment_or_a_point():
+    # A segment operand sweeps the polygon: the union of its two end copies and of the
+    # parallelograms its edges sweep (an independent construction).
+    L = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]])
+    seg = np.array([[0.0, 0.0], [1.0, 0.5], [3.0, 1.5], [1.0, 0.5]])  # collinear, folded back
+    v = np.array([3.0, 1.5])
+    swept = [shapely.Polygon(L), shapely.Polygon(L + v)] + [
+        shapely.Polygon([L[i], L[i - 1], L[i - 1] + v, L[i] + v]).buffer(0) for i in range(len(L))]
+    want = shapely.union_all(swept)
+    got = C.minkowski_sum_nonconvex(L, seg)
+    assert got.symmetric_difference(want).area <= 1e-12 * want.area
+    assert [p.tolist() for p in C.convex_decompose(seg)] == [[[0.0, 0.0], [3.0, 1.5]]]
+    assert C.minkowski_sum_nonconvex(L, [[5.0, 5.0]]).equals(shapely.Polygon(L + 5.0))
+    with pytest.raises(ValueError, match="not collinear"):
+        C.convex_decompose([[0, 0], [1, 0], [0, 0], [0, 1]])  # two arms: no area, not a segment
