@@ -721,7 +721,14 @@ def _plan_case(robot_w: float, slack: float, offset: float, planner: str, expect
 # ---------------------------------------------------------------- the catalogue
 
 
-SCALES = (1e-9, 1e-3, 1.0, 1e3, 1e9)
+# 2^±700 (about 1e±211): products of four coordinates leave the double range there.
+SCALES = (2.0**-700, 1e-9, 1e-3, 1.0, 1e3, 1e9, 2.0**700)
+
+
+def _scale_name(s: float) -> str:
+    """'1e-09' as :g would print it, or '2^700' for the powers of two at the range's ends."""
+    m, e = math.frexp(s)
+    return f"2^{e - 1}" if m == 0.5 and abs(e - 1) > 64 else f"{s:g}"
 
 
 def catalogue() -> list[Case]:
@@ -735,7 +742,7 @@ def catalogue() -> list[Case]:
 
     # predicate
     for s in SCALES:
-        add(f"pred_scale_{s:g}", "predicate", _pred_case(_pred_near_line(s, 0.0, seed=1)), "near-collinear triples")
+        add(f"pred_scale_{_scale_name(s)}", "predicate", _pred_case(_pred_near_line(s, 0.0, seed=1)), "near-collinear triples")
     add("pred_offset_1e8", "predicate", _pred_case(_pred_near_line(1.0, 1e8, seed=2)))
     add("pred_near_parallel", "predicate", _pred_case(_near_parallel_triples()), "u=(1e6,1), v=(2e6,2+d), d ~ ulps")
     add("pred_int_2^52", "predicate", _pred_case(_pred_near_line(2.0 ** 51, 0.0, seed=3)
@@ -743,7 +750,7 @@ def catalogue() -> list[Case]:
 
     # hull
     for s in SCALES:
-        add(f"hull_scale_{s:g}", "hull", _hull_case(_square_with_extras(s, 0.0)), "collinear, repeated, 1-ulp bumps")
+        add(f"hull_scale_{_scale_name(s)}", "hull", _hull_case(_square_with_extras(s, 0.0)), "collinear, repeated, 1-ulp bumps")
     add("hull_offset_1e8", "hull", _hull_case(_square_with_extras(1.0, 1e8)))
     add("hull_sliver_1e9", "hull", _hull_case(_sliver(1e9)))
     add("hull_circle_100k", "hull", _hull_case(_circle(100_000), limit_s=3.0), "100 000 vertices, < 3 s")
@@ -752,7 +759,7 @@ def catalogue() -> list[Case]:
 
     # sum
     for s in SCALES:
-        add(f"sum_scale_{s:g}", "sum", _sum_case(_random_convex(rng, 40, s), _random_convex(rng, 40, s / 3), False))
+        add(f"sum_scale_{_scale_name(s)}", "sum", _sum_case(_random_convex(rng, 40, s), _random_convex(rng, 40, s / 3), False))
     add("sum_offset_1e8", "sum", _sum_case(_random_convex(rng, 40, 1.0, 1e8), _random_convex(rng, 40, 1.0, 1e8), False))
     for name, y in (("sum_near_parallel_1e-9", 2 + 1e-9), ("sum_near_parallel_ulp", _up(2.0)),
                     ("sum_near_parallel_-ulp", _down(2.0))):
@@ -771,7 +778,7 @@ def catalogue() -> list[Case]:
 
     # erosion
     for s in SCALES:
-        add(f"erode_scale_{s:g}", "erosion", _erode_case(_random_convex(rng, 30, s), _random_convex(rng, 8, s / 5)))
+        add(f"erode_scale_{_scale_name(s)}", "erosion", _erode_case(_random_convex(rng, 30, s), _random_convex(rng, 8, s / 5)))
     add("erode_offset_1e8", "erosion", _erode_case(_random_convex(rng, 30, 1.0, 1e8), _random_convex(rng, 8, 0.2, 1e8)))
     add("erode_exact_fit", "erosion", _erode_case(sq(1.0, 0.3), sq(1.0, 0.7)), "B exactly as big as A: a point")
     add("erode_exact_fit_offset_1e8", "erosion", _erode_case(_box(1e8, 1e8, 1e8 + 1, 1e8 + 3), sq(1.0)),
@@ -781,7 +788,7 @@ def catalogue() -> list[Case]:
 
     # decomposition
     for s in SCALES:
-        add(f"decomp_L_scale_{s:g}", "decomposition", _decomp_case(_l_shape(s, 0.0)))
+        add(f"decomp_L_scale_{_scale_name(s)}", "decomposition", _decomp_case(_l_shape(s, 0.0)))
     add("decomp_L_offset_1e8", "decomposition", _decomp_case(_l_shape(1.0, 1e8)))
     add("decomp_collinear_repeated", "decomposition", _decomp_case(
         [[0, 0], [1, 0], [2, 0], [2, 0], [2, 1], [1.5, 1], [1, 1], [1, 2], [0, 2], [0, 1]]))
@@ -793,8 +800,8 @@ def catalogue() -> list[Case]:
     # GJK and EPA
     for s in SCALES:
         a = _random_convex(rng, 20, s)
-        add(f"gjk_separated_scale_{s:g}", "gjk", _gjk_case(a, a + [3 * s, s / 7], "separated"))
-        add(f"epa_overlap_scale_{s:g}", "epa", _epa_case(a, a + [s / 3, s / 5], "overlapping"))
+        add(f"gjk_separated_scale_{_scale_name(s)}", "gjk", _gjk_case(a, a + [3 * s, s / 7], "separated"))
+        add(f"epa_overlap_scale_{_scale_name(s)}", "epa", _epa_case(a, a + [s / 3, s / 5], "overlapping"))
     a, b = _random_convex(rng, 20, 1.0, 1e8), _random_convex(rng, 20, 1.0, 1e8)
     add("gjk_offset_1e8", "gjk", _gjk_case(a, b + [2.5, 0.0], "separated"))
     add("epa_offset_1e8", "epa", _epa_case(a, b + [0.3, 0.1], "overlapping"))
