@@ -207,7 +207,7 @@ def run_one(task: dict) -> dict:
     from cspace.cspace import CSpace
     from cspace.scenario import load_scenario
 
-    from .ompl_glue import make_setup, ompl, path_states, set_query, termination
+    from .ompl_glue import frame_exponent, make_setup, ompl, path_states, set_query, termination
     from .plan import _snap, _verify, path_length
 
     if task.get("abort"):
@@ -217,8 +217,9 @@ def run_one(task: dict) -> dict:
     cs = CSpace.from_scenario(sc)
     q = sc.all_queries()[0]
     planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
-    ss, space, _checker, _validator = make_setup(cs, planner, int(task["seed"]))
-    set_query(ss, space, q.start, q.goal)
+    k = frame_exponent(cs.bounds)
+    ss, space, _checker, _validator = make_setup(cs, planner, int(task["seed"]), k)
+    set_query(ss, space, q.start, q.goal, k)
     p0, m0 = cs.point_count(), cs.checks["segments"]
     first, progress = None, []
     t0 = time.perf_counter()
@@ -244,12 +245,12 @@ def run_one(task: dict) -> dict:
     solve_s = time.perf_counter() - t0
     checks = cs.point_count() - p0, cs.checks["segments"] - m0
     found = ss.haveExactSolutionPath()
-    raw = _snap(path_states(ss.getSolutionPath()), q) if found else None
+    raw = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
     t1 = time.perf_counter()
     if found:
         ss.simplifySolution()
     simplify_s = time.perf_counter() - t1 if found else 0.0
-    path = _snap(path_states(ss.getSolutionPath()), q) if found else None
+    path = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
     ok, message = _verify(cs, path, q) if found else (False, "no exact solution within the budget")
     opt = task["optimum"]
     length = path_length(path) if ok else None

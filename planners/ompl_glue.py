@@ -8,6 +8,7 @@ obstacle cannot be tunnelled through), and the clearance goes through GJK.
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import sys
 
@@ -74,8 +75,28 @@ def planner_name(name: str | None, source: str = "<options>", field: str = "plan
     return canon
 
 
-def make_setup(cspace, planner: str, seed: int):
-    """A configured ``SimpleSetup`` over ``cspace`` with the named planner, seeded.
+def frame_exponent(bounds) -> int:
+    """The power of two k OMPL's states are scaled by: 0 for scenes of ordinary size.
+
+    OMPL has absolute thresholds (a longest valid segment must exceed machine epsilon,
+    the goal is reached within ``GOAL_THRESHOLD``), so a scene 1e-17 across cannot be
+    planned as it is. Scenes whose extent leaves [2^-20, 2^100] are planned in a frame
+    scaled by 2^k to an extent near 1: exact, so the C-space's answers, and so the
+    path (scaled back), are the same. The hot path pays nothing when k is 0.
+
+    >>> frame_exponent((0.0, 10.0, 0.0, 10.0)), frame_exponent((0.0, 1e-17, 0.0, 1e-17))
+    (0, 56)
+    """
+    xmin, xmax, ymin, ymax = map(float, bounds)
+    extent = max(xmax - xmin, ymax - ymin)
+    if not (0.0 < extent < math.inf) or 2.0**-20 <= extent <= 2.0**100:
+        return 0
+    return -math.frexp(extent)[1]
+
+
+def make_setup(cspace, planner: str, seed: int, k: int = 0):
+    """A configured ``SimpleSetup`` over ``cspace`` with the named planner, seeded,
+    its states scaled by 2^k (:func:`frame_exponent`).
 
     Returns ``(setup, space, checker, validator)``; keep the last two alive as long
     as the setup is used (OMPL holds them by reference).
@@ -86,7 +107,7 @@ def make_setup(cspace, planner: str, seed: int):
     with _quiet_fd(2):
         ou.RNG.setSeed(int(seed) + 1)
     space = ob.RealVectorStateSpace(2)
-    xmin, xmax, ymin, ymax = cspace.bounds
+    xmin, xmax, ymin, ymax = (math.ldexp(float(v), k) for v in cspace.bounds)
     bounds = ob.RealVectorBounds(2)
     bounds.setLow(0, xmin)
     bounds.setHigh(0, xmax)
@@ -95,9 +116,9 @@ def make_setup(cspace, planner: str, seed: int):
     space.setBounds(bounds)
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
-    checker = validity_function(cspace)
+    checker = validity_function(cspace, k)
     ss.setStateValidityChecker(checker)
-    validator = _validator_class()(si, cspace)
+    validator = _validator_class()(si, cspace, k)
     si.setMotionValidator(validator)
     ss.setPlanner(getattr(og, planner)(si))
     return ss, space, checker, validator
@@ -106,13 +127,16 @@ def make_setup(cspace, planner: str, seed: int):
 _classes: dict = {}
 
 
-def validity_function(cspace):
+def validity_function(cspace, k: int = 0):
     """The state validity checker: a plain function, the cheapest callback OMPL can call.
 
     (A ``StateValidityChecker`` subclass costs about 0.15 us more per state from Python;
     :func:`clearance_checker` provides one, with ``clearance``, for the planners that
-    ask for it.)
+    ask for it.) States scaled by 2^k are scaled back first.
     """
+    if k:
+        test = cspace.point_test(cspace._points.__next__)
+        return lambda s: test(math.ldexp(s[0], -k), math.ldexp(s[1], -k))
     # The test reads ``state[0], state[1]`` itself: one Python frame per state, not two.
     return cspace.point_test(cspace._points.__next__, state=True)
 
@@ -147,12 +171,18 @@ def _validator_class():
         class ExactMotionValidator(ob.MotionValidator):
             """A motion is valid iff the closed segment lies in the free C-space (exact)."""
 
-            def __init__(self, si, cspace):
+            def __init__(self, si, cspace, k: int = 0):
                 super().__init__(si)
                 self.segment_free = cspace.segment_free
+                self.k = k
 
             def checkMotion(self, s1, s2, *rest):
-                ok = self.segment_free((s1[0], s1[1]), (s2[0], s2[1]))
+                if self.k:  # states scaled by 2^k (exactly): back to the C-space's frame
+                    k = -self.k
+                    ok = self.segment_free((math.ldexp(s1[0], k), math.ldexp(s1[1], k)),
+                                           (math.ldexp(s2[0], k), math.ldexp(s2[1], k)))
+                else:
+                    ok = self.segment_free((s1[0], s1[1]), (s2[0], s2[1]))
                 if rest and not ok:  # the (s1, s2, lastValid) form: report no progress
                     with contextlib.suppress(Exception):
                         rest[0].second = 0.0
@@ -165,12 +195,13 @@ def _validator_class():
 GOAL_THRESHOLD = 1e-9
 
 
-def set_query(ss, space, start, goal) -> None:
-    """Set the start and goal states (goal reached only exactly: threshold 0)."""
+def set_query(ss, space, start, goal, k: int = 0) -> None:
+    """Set the start and goal states, scaled by 2^k, the goal reached within
+    ``GOAL_THRESHOLD`` (the rest of the way is appended and verified exactly)."""
     s = space.allocState()
-    s[0], s[1] = float(start[0]), float(start[1])
+    s[0], s[1] = math.ldexp(float(start[0]), k), math.ldexp(float(start[1]), k)
     g = space.allocState()
-    g[0], g[1] = float(goal[0]), float(goal[1])
+    g[0], g[1] = math.ldexp(float(goal[0]), k), math.ldexp(float(goal[1]), k)
     ss.setStartAndGoalStates(s, g, GOAL_THRESHOLD)
 
 
@@ -194,6 +225,8 @@ def termination(time_limit: float, iterations: int | None = None):
     return ob.plannerOrTerminationCondition(timed, it), it
 
 
-def path_states(path) -> list[tuple[float, float]]:
-    """States of an OMPL PathGeometric as (x, y) tuples."""
+def path_states(path, k: int = 0) -> list[tuple[float, float]]:
+    """States of an OMPL PathGeometric as (x, y) tuples, scaled back by 2^-k."""
+    if k:
+        return [(math.ldexp(s[0], -k), math.ldexp(s[1], -k)) for s in path.getStates()]
     return [(s[0], s[1]) for s in path.getStates()]

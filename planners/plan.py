@@ -155,10 +155,11 @@ def _now() -> float:
 
 
 def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> list[PlanResult]:
-    from .ompl_glue import ANYTIME, make_setup, path_states, set_query, termination
+    from .ompl_glue import ANYTIME, frame_exponent, make_setup, path_states, set_query, termination
 
     t0 = _now()
-    ss, space, checker, validator = make_setup(cspace, name, seed)
+    k = frame_exponent(cspace.bounds)
+    ss, space, checker, validator = make_setup(cspace, name, seed, k)
     setup_s = _now() - t0
     planner = ss.getPlanner()
     multi = name.lower() in ("prm", "prmstar")
@@ -169,20 +170,20 @@ def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> l
                 planner.clearQuery()  # keep the roadmap, drop the old start and goal
             else:
                 ss.clear()
-        set_query(ss, space, q.start, q.goal)
+        set_query(ss, space, q.start, q.goal, k)
         before = {"points": cspace.point_count(), "segments": cspace.checks["segments"]}
         t1 = _now()
         ptc, _keep = termination(tlim, iterations)
         status = ss.solve(ptc)
         solve_s = _now() - t1
         exact_sol = bool(status) and ss.haveExactSolutionPath()
-        raw = _snap(path_states(ss.getSolutionPath()), q) if exact_sol else np.zeros((0, 2))
+        raw = _snap(path_states(ss.getSolutionPath(), k), q) if exact_sol else np.zeros((0, 2))
         length_raw = path_length(raw) if exact_sol else None
         t2 = _now()
         if exact_sol and simplify:
             ss.simplifySolution()
         simp_s = _now() - t2 if exact_sol and simplify else 0.0
-        path = _snap(path_states(ss.getSolutionPath()), q) if exact_sol else np.zeros((0, 2))
+        path = _snap(path_states(ss.getSolutionPath(), k), q) if exact_sol else np.zeros((0, 2))
         t3 = _now()
         verified, message = _verify(cspace, path, q) if exact_sol else (False, str(status))
         verify_s = _now() - t3

@@ -112,3 +112,39 @@ def test_nonconvex_sum_with_a_segment_or_a_point():
     assert C.minkowski_sum_nonconvex(L, [[5.0, 5.0]]).equals(shapely.Polygon(L + 5.0))
     with pytest.raises(ValueError, match="not collinear"):
         C.convex_decompose([[0, 0], [1, 0], [0, 0], [0, 1]])  # two arms: no area, not a segment
+
+
+def _scaled_doc(doc, k):
+    """A scenario document with every length multiplied by 2^k (exact)."""
+    keep = {"time", "seed", "theta", "disk_tolerance", "name", "expect", "simplify"}
+
+    def sc(v, key=None):
+        if key in keep:
+            return v
+        if isinstance(v, dict):
+            return {kk: sc(vv, kk) for kk, vv in v.items()}
+        if isinstance(v, list):
+            return [sc(x) for x in v]
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            return np.ldexp(float(v), k).item()
+        return v
+    return sc(doc)
+
+
+@pytest.mark.parametrize("name", ["basic", "u_robot"])
+def test_plans_are_the_same_path_at_every_supported_scale(name):
+    # Scaling a scene by 2^k changes no exact decision, so the path must be the same,
+    # scaled. At 2^-60 the scene is ~1e-17 across: OMPL's absolute thresholds refused
+    # it ("longest valid segment must be positive") until it planned in a 2^k frame.
+    import pathlib
+    import tomllib
+
+    from cspace import scenario_from_dict
+    from planners import plan
+
+    doc = tomllib.loads((pathlib.Path(__file__).parents[1] / "scenarios" / f"{name}.toml").read_text())
+    base = plan(scenario_from_dict(doc, name), planner="RRTConnect", time=5.0, seed=3)
+    assert base.solved
+    for k in (-300, -60, 60, 300):
+        r = plan(scenario_from_dict(_scaled_doc(doc, k), name), planner="RRTConnect", time=5.0, seed=3)
+        assert r.solved and np.array_equal(np.ldexp(r.path, -k), base.path), k
