@@ -141,6 +141,14 @@ def load_scenario(path) -> Scenario:
     return scenario_from_dict(data, path)
 
 
+# The scenes the C-space supports: products of two coordinates (or of two extents)
+# stay far inside the double range. Within it, plans are the same at every scale: a
+# scene scaled by a power of two gives the same path, scaled (tested from 2^-300 to
+# 2^300). The geometry functions themselves take any finite doubles.
+MAX_MAGNITUDE = 2.0**400
+MIN_EXTENT = 2.0**-400
+
+
 def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
     """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`."""
     v = _Validator(path)
@@ -164,6 +172,9 @@ def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
         raise v.err("bounds", f"xmin ({xmin}) must be less than xmax ({xmax})")
     if not ymin < ymax:
         raise v.err("bounds", f"ymin ({ymin}) must be less than ymax ({ymax})")
+    if max(xmax - xmin, ymax - ymin) < MIN_EXTENT:
+        raise v.err("bounds", f"the scene's extent {max(xmax - xmin, ymax - ymin):.3g} is below the supported "
+                              f"2^-400 (about {MIN_EXTENT:.2g})")
     bounds = (xmin, xmax, ymin, ymax)
 
     start_t = v.table(data, "start", required=True)
@@ -228,6 +239,8 @@ class _Validator:
             raise self.err(field, f"{x} is too large for a double") from None
         if not math.isfinite(xf):
             raise self.err(field, f"must be finite, got {x}")
+        if abs(xf) > MAX_MAGNITUDE:
+            raise self.err(field, f"{x} is beyond the supported magnitude 2^400 (about {MAX_MAGNITUDE:.2g})")
         if positive and not xf > 0.0:
             raise self.err(field, f"must be positive, got {x}")
         return xf

@@ -119,6 +119,10 @@ def test_peer_scenarios_load():
         (lambda t: t + "[[obstacles]]\npolygon = [[2, 2], [8, 2], [8, 8], [2, 8]]\n"
                        "holes = [[[1, 1], [3, 1], [3, 3], [1, 3]]]\n", "obstacles[0].holes"),
         (lambda t: t.replace("[bounds]", "[bounds\n"), "toml"),
+        (lambda t: t.replace("xmax = 10", "xmax = 1e121"), "bounds.xmax"),  # beyond 2^400
+        (lambda t: t + "[[obstacles]]\ncenter = [5, 5]\nradius = 3e120\n", "obstacles[0].radius"),
+        (lambda t: t.replace("xmin = 0", "xmin = 1e-300").replace("xmax = 10", "xmax = 2e-300")
+                    .replace("ymin = 0", "ymin = 1e-300").replace("ymax = 10", "ymax = 2e-300"), "bounds"),
     ],
 )
 def test_each_fault_names_the_file_and_the_field(write_toml, edit, field):
