@@ -28,7 +28,7 @@ import numpy as np
 from .broadphase import BLOCKED, FREE, GridIndex
 from .pieces import PieceSet
 from .predicates import orient2d_many
-from .scenario import Scenario, load_scenario
+from .scenario import MAX_MAGNITUDE, MIN_EXTENT, Scenario, load_scenario
 
 
 @dataclass
@@ -43,6 +43,19 @@ class Stage:
 
     def as_dict(self) -> dict:
         return {"stage": self.name, "ran": self.ran, "seconds": self.seconds, **self.counts, "note": self.note}
+
+
+def _check_range(bounds: tuple, shapes: list) -> None:
+    """ValueError unless the scene lies in the range the C-space supports (its
+    classification multiplies two coordinates): see :data:`cspace.scenario.MAX_MAGNITUDE`."""
+    xmin, xmax, ymin, ymax = bounds
+    if not (xmin < xmax and ymin < ymax):
+        raise ValueError(f"CSpace: bounds {bounds} are empty (need xmin < xmax and ymin < ymax)")
+    big = max([abs(v) for v in bounds] + [float(np.abs(p).max()) for p in shapes if len(p)])
+    if not big <= MAX_MAGNITUDE:
+        raise ValueError(f"CSpace: a coordinate of magnitude {big:.3g} is beyond the supported 2^400")
+    if max(xmax - xmin, ymax - ymin) < MIN_EXTENT:
+        raise ValueError(f"CSpace: the bounds' extent {max(xmax - xmin, ymax - ymin):.3g} is below the supported 2^-400")
 
 
 class CSpace:
@@ -67,6 +80,7 @@ class CSpace:
         self.bounds = tuple(float(v) for v in bounds)
         self.stages: list[Stage] = []
         obstacles = obstacles or []
+        _check_range(self.bounds, obstacles + (robot or []))
         holes = obstacle_holes or [[] for _ in obstacles]
         self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes)
         self.robot_pieces = self._decompose_robot(robot or [], robot_is_disk)

@@ -148,3 +148,12 @@ def test_plans_are_the_same_path_at_every_supported_scale(name):
     for k in (-300, -60, 60, 300):
         r = plan(scenario_from_dict(_scaled_doc(doc, k), name), planner="RRTConnect", time=5.0, seed=3)
         assert r.solved and np.array_equal(np.ldexp(r.path, -k), base.path), k
+
+
+def test_cspace_outside_its_range_is_a_value_error():
+    sq = np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]])
+    assert not C.CSpace((0, 10, 0, 10), [sq]).is_free((5, 5))
+    for bounds, shapes, fault in (((0, 10, 0, 10), [sq * 1e121], "beyond"), ((0, 1e-300, 0, 1e-300), [], "below"),
+                                  ((0, 0, 0, 1), [], "empty")):
+        with pytest.raises(ValueError, match=fault):
+            C.CSpace(bounds, shapes)
