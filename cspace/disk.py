@@ -30,7 +30,10 @@ def disk_sides(radius: float, max_error: float | None = None) -> int:
         return MIN_SIDES
     tol = DEFAULT_RELATIVE_ERROR * radius if max_error is None else max_error
     # r (sec(pi/N) - 1) <= tol  <=>  cos(pi/N) >= r / (r + tol)
-    n = math.ceil(math.pi / math.acos(radius / (radius + tol)))
+    half_step = math.acos(min(radius / (radius + tol), 1.0))
+    if half_step == 0.0:  # a tolerance too small to show against r (or one that underflowed)
+        return MAX_SIDES
+    n = math.ceil(math.pi / half_step)
     return int(min(max(n, MIN_SIDES), MAX_SIDES))
 
 

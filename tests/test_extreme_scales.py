@@ -157,3 +157,13 @@ def test_cspace_outside_its_range_is_a_value_error():
                                   ((0, 0, 0, 1), [], "empty")):
         with pytest.raises(ValueError, match=fault):
             C.CSpace(bounds, shapes)
+
+
+def test_disk_sides_with_a_tolerance_too_small_to_show():
+    # radius 5e-324: its relative tolerance underflows to 0, and 1 - 1e-300 rounds to 1;
+    # both divided by acos(1) = 0 before. The finest polygon is the answer.
+    from cspace.disk import MAX_SIDES, disk_sides
+
+    assert disk_sides(5e-324) == MAX_SIDES
+    assert disk_sides(1.0, 1e-300) == MAX_SIDES
+    assert disk_sides(1.0, 1e-3) == 71  # ordinary radii unchanged
