@@ -87,6 +87,8 @@ def erode_exact(A, B) -> list[tuple[Fraction, Fraction]]:
     b = as_array(B)
     if len(a) < 3 or len(b) == 0:
         raise ValueError("erode: A must be a proper convex polygon and B non-empty")
+    if not np.isfinite(b).all():  # (A's coordinates went through the exact predicate in normalize)
+        raise ValueError("erode: coordinates must be finite")
     fa = [(Fraction(x), Fraction(y)) for x, y in a.tolist()]
     fb = [(Fraction(x), Fraction(y)) for x, y in b.tolist()]
     # Start from A − b0 (c + b0 ∈ A is necessary), then clip by every shifted half-plane.

@@ -26,8 +26,8 @@ from __future__ import annotations
 import numpy as np
 
 from .polygon import as_array, drop_collinear, drop_repeats, lowest_first
-from .predicates import (CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, error_free_cross_sign, lower_half,
-                         orient2d_xy, sum_error)
+from .predicates import (CCW_ERRBOUND_A, NonFiniteError, cross_diff_cols, cross_diff_sign, error_free_cross_sign,
+                         lower_half, orient2d_xy, sum_error)
 
 # Up to this many vertices in total the scalar merge is faster than numpy's overhead.
 _SCALAR_MAX = 96
@@ -59,7 +59,9 @@ def minkowski_sum(P, Q, *more) -> np.ndarray:
     ops = [as_array(x, copy=False) for x in (P, Q) + more]  # only read
     try:
         return _minkowski_sum(ops)
-    except OverflowError:  # an exact step met inf: a vertex of the sum is beyond the double range
+    except (OverflowError, NonFiniteError):  # an exact step met a NaN or an infinity
+        if not all(np.isfinite(o).all() for o in ops):
+            raise ValueError("minkowski_sum: coordinates must be finite") from None
         raise ValueError("minkowski_sum: the sum's coordinates overflow the double range") from None
 
 

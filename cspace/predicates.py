@@ -25,6 +25,17 @@ _UNDERFLOW_GUARD = 1e-280
 _INF = float("inf")
 
 
+class NonFiniteError(ValueError):
+    """A NaN or an infinity reached an exact predicate: it has no rational value.
+
+    Non-finite input always ends here (the float filter certifies no sign from it),
+    so the check costs nothing on finite input.
+    """
+
+    def __init__(self):
+        super().__init__("coordinates must be finite (a NaN or an infinity reached the exact predicate)")
+
+
 def orient2d_exact(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> int:
     """Sign of the orientation of (a, b, c) in exact rational arithmetic.
 
@@ -33,8 +44,11 @@ def orient2d_exact(ax: float, ay: float, bx: float, by: float, cx: float, cy: fl
     >>> orient2d_exact(0.0, 0.0, 1.0, 0.0, 0.5, 1e-300)
     1
     """
-    fax, fay = Fraction(ax), Fraction(ay)
-    det = (Fraction(bx) - fax) * (Fraction(cy) - fay) - (Fraction(by) - fay) * (Fraction(cx) - fax)
+    try:
+        fax, fay = Fraction(ax), Fraction(ay)
+        det = (Fraction(bx) - fax) * (Fraction(cy) - fay) - (Fraction(by) - fay) * (Fraction(cx) - fax)
+    except (ValueError, OverflowError):  # Fraction(nan), Fraction(inf)
+        raise NonFiniteError() from None
     return (det > 0) - (det < 0)
 
 
@@ -119,7 +133,10 @@ def cross_diff_exact(ax, ay, bx, by, cx, cy, dx, dy) -> int:
     0
     """
     F = Fraction
-    det = (F(bx) - F(ax)) * (F(dy) - F(cy)) - (F(by) - F(ay)) * (F(dx) - F(cx))
+    try:
+        det = (F(bx) - F(ax)) * (F(dy) - F(cy)) - (F(by) - F(ay)) * (F(dx) - F(cx))
+    except (ValueError, OverflowError):  # Fraction(nan), Fraction(inf)
+        raise NonFiniteError() from None
     return (det > 0) - (det < 0)
 
 

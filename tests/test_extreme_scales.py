@@ -167,3 +167,33 @@ def test_disk_sides_with_a_tolerance_too_small_to_show():
     assert disk_sides(5e-324) == MAX_SIDES
     assert disk_sides(1.0, 1e-300) == MAX_SIDES
     assert disk_sides(1.0, 1e-3) == 71  # ordinary radii unchanged
+
+
+_TRI = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+_CALLS = {
+    "convex_hull": lambda q: C.convex_hull(q),
+    "minkowski_sum": lambda q: C.minkowski_sum(q, _TRI),
+    "minkowski_sum (vectorised)": lambda q: C.minkowski_sum(np.tile(q, (40, 1)), _TRI),
+    "erode A": lambda q: C.erode(q, _TRI * 0.1),
+    "erode B": lambda q: C.erode(_TRI, q * 0.1),
+    "gjk_distance": lambda q: C.gjk_distance(q, _TRI),
+    "epa_penetration": lambda q: C.epa_penetration(q, _TRI),
+    "convex_decompose": lambda q: C.convex_decompose(q),
+    "minkowski_sum_nonconvex": lambda q: C.minkowski_sum_nonconvex(q, _TRI),
+    "normalize": lambda q: C.normalize(q),
+    "is_convex": lambda q: C.is_convex(q),
+    "halfplanes": lambda q: C.halfplanes(q),
+    "CSpace": lambda q: C.CSpace((0, 10, 0, 10), [q + 3.0]),
+}
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+@pytest.mark.parametrize("name", sorted(_CALLS))
+def test_non_finite_coordinates_are_a_clear_value_error(name, bad):
+    # Before: "cannot convert NaN to integer ratio", an OverflowError for inf, or (for
+    # minkowski_sum) a claim that the sum overflowed.
+    q = _TRI.copy()
+    q[1, 0] = bad
+    with pytest.raises(ValueError, match="finite|beyond the supported") as exc:
+        _CALLS[name](q)
+    assert "integer ratio" not in str(exc.value)
