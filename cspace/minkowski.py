@@ -223,12 +223,16 @@ def _clean_convex(p: np.ndarray) -> np.ndarray:
 def _turns_cols(ux, uy, vx, vy, a, b, c, d) -> np.ndarray:
     """Vectorised :func:`_turn`: exact signs of u x v for float edges u = b - a, v = d - c."""
     with np.errstate(over="ignore", invalid="ignore", under="ignore"):
-        left = ux * vy
-        right = uy * vx
-        det = left - right
-        bound = CCW_ERRBOUND_A * (np.abs(left) + np.abs(right))
+        # Three fresh arrays, the rest in place: at 10^4 vertices and more, each fresh
+        # array costs more in page faults than its arithmetic.
+        left = np.multiply(ux, vy)
+        right = np.multiply(uy, vx)
+        det = np.subtract(left, right)
+        bound = np.abs(left, out=left)
+        bound += np.abs(right, out=right)
+        bound *= CCW_ERRBOUND_A
         ok = (bound > 1e-280) & (bound < np.inf)
-        sign = (ok & (det > bound)).astype(np.int8) - (ok & (-det > bound)).astype(np.int8)
+        sign = (ok & (det > bound)).astype(np.int8) - (ok & (np.negative(det, out=right) > bound)).astype(np.int8)
     doubt = np.flatnonzero(sign == 0)
     if len(doubt):
         sign[doubt] = cross_diff_cols(a[doubt, 0], a[doubt, 1], b[doubt, 0], b[doubt, 1],
@@ -593,10 +597,12 @@ def _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, w1, w2) ->
         big = 2.0**53
         sure = (left < big) & (left > -big) & (right < big) & (right > -big)
         det = np.subtract(left, right, out=left)
-    else:
-        det = left - right
-        bound = CCW_ERRBOUND_A * (np.abs(left) + np.abs(right))
-        sure = (bound > 1e-280) & (bound < np.inf) & (np.abs(det) > bound)
+    else:  # the stage-A bound, computed in place over the products (one fresh array)
+        det = np.subtract(left, right)
+        bound = np.abs(left, out=left)
+        bound += np.abs(right, out=right)
+        bound *= CCW_ERRBOUND_A
+        sure = (bound > 1e-280) & (bound < np.inf) & (np.abs(det, out=right) > bound)
     if (same & sure & (det < 0)).any():
         return None
     fused = same & (~sure | (det == 0))  # parallel, or in doubt: decided exactly below
@@ -677,6 +683,18 @@ def _certify_small(out: list) -> list:
     return out
 
 
+class _Cyclic:
+    """``p`` shifted cyclically by ``k`` rows, read only at the indices asked for
+    (the exact fallback of :func:`_turns_cols` reads a few): no shifted copy is made."""
+
+    def __init__(self, p: np.ndarray, k: int):
+        self.p, self.k = p, k
+
+    def __getitem__(self, key):
+        rows, col = key
+        return self.p[(rows + self.k) % len(self.p), col]
+
+
 def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
     """Vectorised :func:`_certify_small`; skipped when the sums were exact integers.
 
@@ -689,14 +707,19 @@ def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
     if exact or len(out) < 3:
         return out
     for _ in range(len(out)):
-        nxt = np.roll(out, -1, axis=0)
-        e = nxt - out
-        ep = np.roll(e, 1, axis=0)
-        prev = np.roll(out, 1, axis=0)
-        turn = _turns_cols(ep[:, 0], ep[:, 1], e[:, 0], e[:, 1], prev, out, out, nxt)
+        n = len(out)
+        e = np.empty((n + 1, 2))  # e[i]: the edge into vertex i; e[i + 1]: the edge out of it
+        np.subtract(out[1:], out[:-1], out=e[1:n])
+        e[0] = e[n] = out[0] - out[-1]
+        turn = _turns_cols(e[:-1, 0], e[:-1, 1], e[1:, 0], e[1:, 1], _Cyclic(out, -1), out, out, _Cyclic(out, 1))
         bad = turn <= 0
         if not bad.any():
-            break
+            # Every turn is left, so the edge directions sweep 2 pi once per winding and
+            # cross from the lower half-plane into the upper one once per winding.
+            h = lower_half(e[1:, 0], e[1:, 1])
+            if np.count_nonzero(h[:-1] & ~h[1:]) + bool(h[-1] and not h[0]) == 1:
+                return lowest_first(out)
+            break  # it winds more than once: the hull of its vertices
         drop = bad.copy()
         drop[1:] &= ~bad[:-1]  # keep a bad vertex whose predecessor is being removed
         if drop[0] and drop[-1]:
@@ -706,13 +729,4 @@ def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
             break
     from .hull import convex_hull
 
-    if len(out) < 3 or _winds_more_than_once(out):
-        return convex_hull(out)
-    return lowest_first(out)
-
-
-def _winds_more_than_once(p: np.ndarray) -> bool:
-    p = lowest_first(p)
-    e = np.roll(p, -1, axis=0) - p
-    h = lower_half(e[:, 0], e[:, 1])
-    return bool((h[:-1] > h[1:]).any())
+    return convex_hull(out)
