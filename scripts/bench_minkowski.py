@@ -53,6 +53,14 @@ def main():
         # Exactness on integer input: the area agrees with the all-pairs hull where that runs.
         print(f"{n:>6} {ours * 1e6:>9.1f}us {clip * 1e6:>9.1f}us {pairs * 1e6:>9.1f}us {srt * 1e6:>9.1f}us "
               f"{ours / clip:>9.3f} {ours / srt:>9.2f}")
+    # Float input: the vertices are rounded sums, certified strictly convex afterwards.
+    n = max(map(int, args.sizes.split(",")))
+    P, Q = (random_convex(n, rng) * 0.1 + 0.05 for _ in range(2))  # no longer integers
+    e = np.concatenate([np.roll(P, -1, 0) - P, np.roll(Q, -1, 0) - Q])
+    ang = np.arctan2(e[:, 1], e[:, 0])
+    reps = args.reps or max(20, min(2000, 2000000 // n))
+    flt, srt = median_time(lambda: minkowski_sum(P, Q), reps), median_time(lambda: np.argsort(ang), reps)
+    print(f"float input, n = m = {n}: {flt * 1e6:.1f}us, one argsort {srt * 1e6:.1f}us, ratio {flt / srt:.2f}")
     # k-way: one merge of k polygons against one sort of all their edges.
     k, n = 8, 2048
     polys = [random_convex(n, rng) for _ in range(k)]
