@@ -38,6 +38,8 @@ def run(args) -> int:
         raise InputError(src, "--time", f"must be a positive number of seconds, got {args.time}")
     if args.seed is not None and args.seed < 0:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
+    if args.iterations is not None and args.iterations < 1:
+        raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS) if args.plot else None
     if args.json:
         check_output(args.json, "--json")

@@ -21,6 +21,8 @@ import math
 
 import numpy as np
 
+from .errors import InputError
+
 KINDS = ("random", "maze", "narrow", "disks", "office")
 
 
@@ -40,6 +42,10 @@ def run(args) -> int:
     from .output import check_output, write_text
 
     check_output(args.out, "--out", {".toml": "toml"})
+    if args.size is not None and args.size < 1:
+        raise InputError("generate", "--size", f"must be a positive integer, got {args.size}")
+    if not (args.ratio > 0.0 and math.isfinite(args.ratio)):
+        raise InputError("generate", "--ratio", f"must be a positive number, got {args.ratio}")
     text = generate(args.kind, seed=args.seed, size=args.size, ratio=args.ratio)
     write_text(args.out, text)
     print(f"wrote {args.out}")

@@ -82,7 +82,7 @@ def path_length(path: np.ndarray) -> float:
     return float(np.hypot(*np.diff(path, axis=0).T).sum())
 
 
-def _resolve(scenario, planner, time_limit, seed):
+def _resolve(scenario, planner, time_limit, seed, iterations=None):
     """Scenario object plus the effective planner, time and seed (arguments over file defaults)."""
     from .ompl_glue import planner_name
 
@@ -97,6 +97,8 @@ def _resolve(scenario, planner, time_limit, seed):
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
         raise ScenarioError(src, "time", f"must be a positive number of seconds, got {t!r}")
     s = seed if seed is not None else opts.get("seed", 0)
+    if iterations is not None and (isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1):
+        raise ScenarioError(src, "iterations", f"must be a positive integer, got {iterations!r}")
     if isinstance(s, bool) or not isinstance(s, int) or s < 0:
         raise ScenarioError(src, "seed", f"must be a non-negative integer, got {s!r}")
     return sc, name, float(t), int(s), load_s
@@ -114,7 +116,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     the result then carries ``queries``, one result per query, and the top-level
     fields describe the first one.
     """
-    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed)
+    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations)
     wall0 = _now()
     if cspace is None:
         t0 = _now()

@@ -138,6 +138,8 @@ def test_bad_input_exits_2_with_one_line(write_toml, tmp_path, name, text, field
     (["--time", "-2"], "--time"),
     (["--plot", "x.gif"], "--plot"),
     (["--json", "/no/such/dir/r.json"], "--json"),
+    (["--iterations", "-3"], "--iterations"),  # was a silent 'not solved' (exit 1)
+    (["--iterations", "0"], "--iterations"),
 ])
 def test_bad_options_exit_2_with_one_line(write_toml, args, field):
     r = cspace("plan", write_toml(BASIC), *args)

@@ -42,3 +42,7 @@ def test_cli_writes_the_file(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "planners.cli", "generate", "maze", "--out", str(tmp_path / "x.txt")],
                          capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "--out" in bad.stderr
+    for args in (["--size", "0"], ["--size", "-5"], ["--ratio", "-1"]):  # were IndexError, ValueError, ...
+        bad = subprocess.run([sys.executable, "-m", "planners.cli", "generate", "narrow" if "--ratio" in args else "maze",
+                              *args, "--out", str(out)], capture_output=True, text=True, timeout=120)
+        assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and f": {args[0]}: " in bad.stderr, bad.stderr

@@ -78,6 +78,14 @@ def test_scenario_object_and_planner_names_are_case_insensitive(write_toml):
     assert res.planner == "RRT" and res.solved
 
 
+@pytest.mark.parametrize("iterations", [0, -3, 2.5, True])
+def test_iterations_must_be_a_positive_integer(write_toml, iterations):
+    from cspace import ScenarioError
+
+    with pytest.raises(ScenarioError, match="iterations: must be a positive integer"):
+        planners.plan(write_toml(U_ROBOT), iterations=iterations)
+
+
 def test_unsolvable_returns_not_solved_within_the_limit(write_toml):
     import time
 
