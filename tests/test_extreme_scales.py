@@ -12,6 +12,8 @@ import warnings
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import cspace as C
 from cspace.polygon import normalize, orientation
@@ -197,3 +199,23 @@ def test_non_finite_coordinates_are_a_clear_value_error(name, bad):
     with pytest.raises(ValueError, match="finite|beyond the supported") as exc:
         _CALLS[name](q)
     assert "integer ratio" not in str(exc.value)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.integers(-50, 50), st.integers(-50, 50)), min_size=3, max_size=12, unique=True),
+       st.sampled_from([1.0, 2.0**-600, 2.0**600, 1e-7]), st.floats(-1e8, 1e8))
+def test_orientation_is_the_sign_of_the_exact_area(pts, scale, offset):
+    # Oracle: the shoelace sum in Fractions. Star-shaped (sorted by angle about the
+    # centroid), so the polygon is simple; scaled and offset in floats, so the area is
+    # tiny, huge or rounded next to the coordinates.
+    from fractions import Fraction
+
+    p = np.array(pts, dtype=np.float64)
+    c = p.mean(axis=0)
+    p = p[np.argsort(np.arctan2(p[:, 1] - c[1], p[:, 0] - c[0]), kind="stable")] * scale + offset * scale
+    if not C.is_simple(p):
+        return
+    F = [(Fraction(x), Fraction(y)) for x, y in p.tolist()]
+    area2 = sum(F[i][0] * F[i - 1][1] - F[i - 1][0] * F[i][1] for i in range(len(F)))
+    want = (area2 < 0) - (area2 > 0)  # (x_i y_{i-1} - x_{i-1} y_i) sums to -2 area
+    assert orientation(p) == want and orientation(p[::-1]) == -want
