@@ -31,7 +31,7 @@ import numpy as np
 
 from .polygon import as_array
 from .predicates import orient2d_cols, orient2d_xy
-from .scaling import ldexp_exact, rescale_exponent
+from .scaling import SAFE_MAX, SAFE_MIN, ldexp_exact, rescale_exponent
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -65,20 +65,25 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
     a = as_array(A)
     b = as_array(B)
     origin = a[0].copy()
-    with np.errstate(over="ignore", invalid="ignore"):
-        al = (a - origin).tolist()
-        bl = (b - origin).tolist()
-    extent = _scale(al, bl)
-    k = rescale_exponent(extent, extent if math.isfinite(extent) else max(np.abs(a).max(), np.abs(b).max()))
-    if k:  # products of the local coordinates would under- or overflow: work at 2^k scale
-        sa, sb = ldexp_exact(a, k), ldexp_exact(b, k)
+    ox, oy = origin.tolist()
+    if len(a) + len(b) <= 80:  # Python floats (an overflow is inf, silently): cheaper when small
+        al = [(x - ox, y - oy) for x, y in a.tolist()]
+        bl = [(x - ox, y - oy) for x, y in b.tolist()]
+        extent = _scale(al, bl)
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):
+            la, lb = a - origin, b - origin
+            extent = max(float(np.abs(la).max()), float(np.abs(lb).max())) or 1.0  # as _scale
+        al, bl = la.tolist(), lb.tolist()
+    if not SAFE_MIN <= extent < SAFE_MAX:  # products would under- or overflow: work at 2^k scale
+        k = rescale_exponent(extent, extent if math.isfinite(extent) else max(np.abs(a).max(), np.abs(b).max()))
+        sa, sb = (ldexp_exact(a, k), ldexp_exact(b, k)) if k else (None, None)
         if sa is not None and sb is not None:
             d = gjk_distance(sa, sb, max_iterations)
             with np.errstate(over="ignore"):  # a distance beyond the double range is inf
                 return Distance(float(np.ldexp(d.distance, -k)), np.ldexp(d.point_a, -k), np.ldexp(d.point_b, -k),
                                 d.iterations, d.status)
     dist, pa, pb, it, inside, simplex = _gjk(al, bl, max_iterations)
-    ox, oy = origin.tolist()
     if inside == "deep":
         p = np.array((pa[0] + ox, pa[1] + oy))
         return Distance(0.0, p, p.copy(), it, "overlapping")

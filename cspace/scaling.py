@@ -16,6 +16,8 @@ import numpy as np
 # Magnitudes within [2^-SAFE_EXPONENT, 2^SAFE_EXPONENT] are used as they are: fourth
 # powers stay within 2^±400, far from the double range's ends (2^±1022).
 SAFE_EXPONENT = 100
+# rescale_exponent(x) is 0 exactly for SAFE_MIN <= x < SAFE_MAX (a test for hot paths).
+SAFE_MIN, SAFE_MAX = 2.0 ** -(SAFE_EXPONENT + 1), 2.0**SAFE_EXPONENT
 
 
 def rescale_exponent(extent: float, magnitude: float) -> int:
