@@ -120,6 +120,37 @@ def test_one_region_per_piece_is_the_piece_sum_union():
         assert shapely.symmetric_difference(region, ref).area <= 1e-12 * ref.area
 
 
+@pytest.mark.parametrize("threads", ["2", "3", "8"])
+def test_threads_give_the_very_same_regions(monkeypatch, threads):
+    # The cycles are buffered in chunks on several threads (GEOS releases the GIL):
+    # every region must be identical, vertex for vertex, to the one-thread result.
+    A, Q = normalize(comb(20)), normalize(comb(10, w=0.5, gap=1.0))
+    pieces = convex_decompose(A)
+    monkeypatch.setenv("CSPACE_THREADS", "1")
+    one = convex_sums_with(pieces, Q)
+    monkeypatch.setenv("CSPACE_THREADS", threads)
+    many = convex_sums_with(pieces, Q)
+    assert len(one) == len(many) == len(pieces)
+    assert all(a.equals_exact(b, 0.0) for a, b in zip(one, many))
+
+
+def test_a_failure_on_a_worker_thread_reaches_the_caller(monkeypatch):
+    import cspace.convolution as cv
+
+    calls = []
+
+    def failing(polys, distance):
+        calls.append(len(polys))
+        if len(calls) > 1:
+            raise RuntimeError("worker failed")
+        return shapely.buffer(polys, distance)
+
+    monkeypatch.setenv("CSPACE_THREADS", "2")
+    monkeypatch.setattr(shapely, "buffer", failing)
+    with pytest.raises(RuntimeError, match="worker failed"):
+        cv._buffer_zero(np.array([shapely.box(0, 0, 1, 1)] * 300), np.full(300, 5))
+
+
 @pytest.mark.parametrize("angle", [0.0, 30.0, 90.0])
 def test_comb_sum_through_the_convolution_matches_the_triangle_pairs(angle):
     t = np.radians(angle)
