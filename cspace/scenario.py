@@ -280,19 +280,18 @@ class _Validator:
             shell = shapely.Polygon(ext)
             if not shell.is_valid:
                 raise self.err(f"{field}.polygon", f"not a simple polygon ({shapely.is_valid_reason(shell)})")
-            if len(normalize(ext)) < 3:  # exact: a float area underflows near 1e-160
+            ext_n = normalize(ext, ccw=True)
+            if len(ext_n) < 3:  # exact: a float area underflows near 1e-160
                 raise self.err(f"{field}.polygon", "has zero area")
+            holes_n = []
             for i, h in enumerate(holes):
-                if not shapely.Polygon(h).is_valid or len(normalize(h)) < 3:
+                holes_n.append(normalize(h, ccw=False))
+                if not shapely.Polygon(h).is_valid or len(holes_n[-1]) < 3:
                     raise self.err(f"{field}.holes[{i}]", "not a simple polygon of non-zero area")
             if holes:
                 whole = shapely.Polygon(ext, holes)
                 if not whole.is_valid:
                     raise self.err(f"{field}.holes", f"holes do not fit the polygon ({shapely.is_valid_reason(whole)})")
-            ext_n = normalize(ext, ccw=True)
-            holes_n = [normalize(h, ccw=False) for h in holes]
-            if len(ext_n) < 3:
-                raise self.err(f"{field}.polygon", "has zero area")
             return Shape(ext_n, holes_n, None, convex=not holes_n and is_convex(ext_n))
         if "radius" in t:
             self.no_extra(t, field, {"center", "radius"})
