@@ -24,7 +24,7 @@ import numpy as np
 
 from .polygon import as_array, collinear_extent, drop_collinear, is_convex, normalize, ring_neighbours
 from .predicates import CCW_ERRBOUND_A, orient2d_many, orient2d_xy
-from .scaling import ldexp_exact, rescale_exponent
+from .scaling import scaled_copies
 
 
 def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
@@ -88,11 +88,10 @@ def _triangulate(rings: list, pts: np.ndarray) -> np.ndarray:
 
     # GEOS's in-circle tests multiply four coordinates: far from 1 in magnitude, a
     # power-of-two copy (exact) is triangulated and its corners looked up instead.
-    mag = float(np.abs(pts).max())
-    k = rescale_exponent(mag, mag)
-    scaled = ldexp_exact(pts, k) if k else None
-    if scaled is not None:
-        pts, rings = scaled, [np.ldexp(r, k) for r in rings]
+    rescaled = scaled_copies(rings, float(np.abs(pts).max()))
+    if rescaled:
+        rings = rescaled[1]
+        pts = np.concatenate(rings) if len(rings) > 1 else rings[0]
     try:
         tri = shapely.constrained_delaunay_triangles(shapely.Polygon(rings[0], rings[1:]))
     except shapely.errors.GEOSException as e:

@@ -20,7 +20,7 @@ import numpy as np
 
 from .gjk import gjk_distance
 from .polygon import as_array
-from .scaling import ldexp_exact, rescale_exponent
+from .scaling import scaled_copies
 
 # Support progress below this times the local scale ends the expansion.
 EPA_TOL = 1e-12
@@ -46,13 +46,12 @@ def epa_penetration(A, B) -> Penetration:
     b = as_array(B)
     with np.errstate(over="ignore", invalid="ignore"):
         extent = max(float(np.abs(a - a[0]).max()), float(np.abs(b - a[0]).max()))
-    k = rescale_exponent(extent, extent if math.isfinite(extent) else max(np.abs(a).max(), np.abs(b).max()))
-    if k:  # products would under- or overflow: the same sets at 2^k scale (exact)
-        sa, sb = ldexp_exact(a, k), ldexp_exact(b, k)
-        if sa is not None and sb is not None:
-            p = epa_penetration(sa, sb)
-            with np.errstate(over="ignore"):
-                return Penetration(float(np.ldexp(p.depth, -k)), p.normal, p.iterations, p.status)
+    rescaled = scaled_copies([a, b], extent)
+    if rescaled:  # products would under- or overflow: the same sets at 2^k scale (exact)
+        k, (sa, sb) = rescaled
+        p = epa_penetration(sa, sb)
+        with np.errstate(over="ignore"):
+            return Penetration(float(np.ldexp(p.depth, -k)), p.normal, p.iterations, p.status)
     d = gjk_distance(a, b)
     if d.status == "separated":
         # The closest points are rounded in the global frame: normalise their difference

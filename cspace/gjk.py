@@ -31,7 +31,7 @@ import numpy as np
 
 from .polygon import as_array
 from .predicates import orient2d_cols, orient2d_xy
-from .scaling import SAFE_MAX, SAFE_MIN, ldexp_exact, rescale_exponent
+from .scaling import SAFE_MAX, SAFE_MIN, scaled_copies
 
 MAX_ITERATIONS = 64
 # Relative progress below which the distance has converged (GJK's usual test).
@@ -75,14 +75,12 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
             la, lb = a - origin, b - origin
             extent = max(float(np.abs(la).max()), float(np.abs(lb).max())) or 1.0  # as _scale
         al, bl = la.tolist(), lb.tolist()
-    if not SAFE_MIN <= extent < SAFE_MAX:  # products would under- or overflow: work at 2^k scale
-        k = rescale_exponent(extent, extent if math.isfinite(extent) else max(np.abs(a).max(), np.abs(b).max()))
-        sa, sb = (ldexp_exact(a, k), ldexp_exact(b, k)) if k else (None, None)
-        if sa is not None and sb is not None:
-            d = gjk_distance(sa, sb, max_iterations)
-            with np.errstate(over="ignore"):  # a distance beyond the double range is inf
-                return Distance(float(np.ldexp(d.distance, -k)), np.ldexp(d.point_a, -k), np.ldexp(d.point_b, -k),
-                                d.iterations, d.status)
+    if not SAFE_MIN <= extent < SAFE_MAX and (rescaled := scaled_copies([a, b], extent)):
+        k, (sa, sb) = rescaled  # products would under- or overflow: the same sets at 2^k scale
+        d = gjk_distance(sa, sb, max_iterations)
+        with np.errstate(over="ignore"):  # a distance beyond the double range is inf
+            return Distance(float(np.ldexp(d.distance, -k)), np.ldexp(d.point_a, -k), np.ldexp(d.point_b, -k),
+                            d.iterations, d.status)
     dist, pa, pb, it, inside, simplex = _gjk(al, bl, max_iterations)
     if inside == "deep":
         p = np.array((pa[0] + ox, pa[1] + oy))

@@ -26,7 +26,7 @@ from .convolution import convex_sums_with
 from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
 from .polygon import as_array, collinear_extent, is_convex, normalize, prev_next
-from .scaling import ldexp_exact, rescale_exponent
+from .scaling import scaled_copies
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -57,10 +57,10 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
     (A, holes_a), (B, holes_b) = _operand(A, holes_a), _operand(B, holes_b)
     # GEOS's overlay multiplies coordinates: far from 1 in magnitude, sum a power-of-two
     # copy of the operands (exact) and scale the region back.
-    mag = max(float(np.abs(p).max()) for p in [A, B] + holes_a + holes_b if len(p))
-    k = rescale_exponent(mag, mag)
-    scaled = [ldexp_exact(p, k) for p in [A, B] + holes_a + holes_b] if k else [None]
-    if all(p is not None for p in scaled):
+    rings = [A, B] + holes_a + holes_b
+    rescaled = scaled_copies(rings, max(float(np.abs(p).max()) for p in rings if len(p)))
+    if rescaled:
+        k, scaled = rescaled
         region = minkowski_sum_nonconvex(scaled[0], scaled[1], scaled[2:2 + len(holes_a)],
                                          scaled[2 + len(holes_a):])
         with np.errstate(over="ignore"):

@@ -50,3 +50,26 @@ def ldexp_exact(x: np.ndarray, k: int) -> np.ndarray | None:
     with np.errstate(over="ignore", under="ignore"):
         y = np.ldexp(x, k)
     return y if np.array_equal(np.ldexp(y, -k), x) else None
+
+
+def scaled_copies(arrays: list, extent: float) -> tuple[int, list] | None:
+    """``(k, [x * 2**k for x in arrays])`` when ``extent`` (the size the float work sees)
+    leaves the safe range and every copy is exact; None when the arrays are fine as
+    they are or cannot be rescaled exactly. An infinite extent (differences that
+    overflowed) is rescaled by the arrays' largest magnitude instead.
+
+    >>> k, (a,) = scaled_copies([np.array([1e-200, 3e-200])], 3e-200)
+    >>> k, a.tolist() == np.ldexp([1e-200, 3e-200], k).tolist()
+    (662, True)
+    >>> scaled_copies([np.array([1.0, 3.0])], 3.0) is None
+    True
+    """
+    if SAFE_MIN <= extent < SAFE_MAX:
+        return None
+    magnitude = extent if math.isfinite(extent) else max(float(np.abs(x).max()) for x in arrays if len(x))
+    k = rescale_exponent(extent, magnitude)
+    if not k:
+        return None
+    copies = [ldexp_exact(x, k) for x in arrays]
+    return None if any(c is None for c in copies) else (k, copies)
+
