@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
-from conftest import PEER
+from conftest import OMPL_SCENES
 
 BASIC = """
 name = "cli"
@@ -149,13 +149,13 @@ def test_bad_options_exit_2_with_one_line(write_toml, args, field):
 
 
 def test_non_numeric_option_is_one_line():
-    r = cspace("plan", os.path.join(PEER, "env1.toml"), "--time", "abc")
+    r = cspace("plan", os.path.join(OMPL_SCENES, "env1.toml"), "--time", "abc")
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
 
 
 def test_show_prints_the_stages(tmp_path):
     out = tmp_path / "scene.png"
-    r = cspace("show", os.path.join(PEER, "circles.toml"), "--plot", out)
+    r = cspace("show", os.path.join(OMPL_SCENES, "circles.toml"), "--plot", out)
     assert r.returncode == 0, r.stderr
     assert "minkowski" in r.stdout and "skipped" in r.stdout
     assert out.exists()

@@ -86,11 +86,11 @@ goal = {x = 7, y = 7}
 
 
 def test_peer_scenarios_load():
-    from conftest import PEER
+    from conftest import OMPL_SCENES
 
-    for f in sorted(os.listdir(PEER)):
+    for f in sorted(os.listdir(OMPL_SCENES)):
         if f.endswith(".toml"):
-            sc = load_scenario(os.path.join(PEER, f))
+            sc = load_scenario(os.path.join(OMPL_SCENES, f))
             assert sc.is_point_robot
 
 
