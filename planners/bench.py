@@ -38,11 +38,6 @@ DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
 # C-space build, simplification and verification all fit many times over).
 HARD_FACTOR = 2.0
 HARD_MARGIN = 30.0
-# Anytime planners are solved in slices (MIN_SLICE s, doubling up to budget / SLICES) to
-# time their first solution and record the best raw cost along the run.
-SLICES = 20
-MIN_SLICE = 0.002
-SLICED = {"rrtstar", "informedrrtstar", "sorrtstar", "bitstar", "prm", "prmstar"}  # not AORRTC: it crashes
 # Fields of a row, in CSV order. Times in seconds; lengths in scenario units.
 FIELDS = (
     "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
@@ -198,71 +193,37 @@ def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None)
 
 # ---------------------------------------------------------------- one run (in the child)
 
-def run_one(task: dict) -> dict:
+def run_one(task: dict, scenario=None, cspace=None) -> dict:
     """Plan one seeded run in this process and return its row (status ``ok``).
 
-    The path is simplified and verified exactly as ``cspace plan`` does; a run is
-    solved only if the final path passes the exact segment test.
+    The run goes through :func:`planners.plan.plan`, the routine of ``cspace plan``
+    (anytime planners solved in slices to time the first solution): the path is
+    simplified and verified exactly, and a run is solved only if it passes.
+    ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space.
     """
-    from cspace.cspace import CSpace
     from cspace.scenario import load_scenario
 
-    from .ompl_glue import frame_exponent, make_setup, ompl, path_states, set_query, termination
-    from .plan import _snap, _verify, path_length
+    from .plan import plan
 
     if task.get("abort"):
         os.abort()
-    ob = ompl()[0]
-    sc = load_scenario(task["file"])
-    cs = CSpace.from_scenario(sc)
-    q = sc.all_queries()[0]
+    sc = scenario if scenario is not None else load_scenario(task["file"])
     planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
-    k = frame_exponent(cs.bounds)
-    ss, space, _checker, _validator = make_setup(cs, planner, int(task["seed"]), k)
-    set_query(ss, space, q.start, q.goal, k)
-    p0, m0 = cs.point_count(), cs.checks["segments"]
-    first, progress = None, []
-    t0 = time.perf_counter()
-    if planner.lower() in SLICED and not iters:
-        # Continue the same search slice by slice: same total budget, plus the time
-        # of the first solution (to within one slice) and the best cost along the run.
-        # Slices double from MIN_SLICE up to budget / SLICES, so an early first
-        # solution is timed finely and a long run still takes few slices.
-        step, k = max(budget / SLICES, MIN_SLICE), 0
-        while (left := budget - (time.perf_counter() - t0)) > 0:
-            ss.solve(ob.timedPlannerTerminationCondition(min(step, MIN_SLICE * 2 ** k, left)))
-            k += 1
-            if ss.haveExactSolutionPath():
-                t = time.perf_counter() - t0
-                first = t if first is None else first
-                progress.append([t, ss.getSolutionPath().length()])
-    else:
-        ptc, _keep = termination(budget, iters)
-        ss.solve(ptc)
-        if ss.haveExactSolutionPath():
-            first = time.perf_counter() - t0
-            progress.append([first, ss.getSolutionPath().length()])
-    solve_s = time.perf_counter() - t0
-    checks = cs.point_count() - p0, cs.checks["segments"] - m0
-    found = ss.haveExactSolutionPath()
-    raw = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
-    t1 = time.perf_counter()
-    if found:
-        ss.simplifySolution()
-    simplify_s = time.perf_counter() - t1 if found else 0.0
-    path = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
-    ok, message = _verify(cs, path, q) if found else (False, "no exact solution within the budget")
+    res = plan(sc, planner=planner, time=budget, seed=int(task["seed"]), iterations=iters,
+               cspace=cspace, slices=True)
+    ok = bool(res.solved)
     opt = task["optimum"]
-    length = path_length(path) if ok else None
-    raw_len = path_length(raw) if ok else None
+    length = float(res.length) if ok else None
+    raw_len = res.length_unsimplified if ok else None
     return {
         "scenario": task["scenario"], "file": task["file"], "planner": planner, "time_budget": budget,
-        "seed": int(task["seed"]), "status": "ok", "solved": bool(ok),
+        "seed": int(task["seed"]), "status": "ok", "solved": ok,
         "length": length, "length_unsimplified": raw_len, "optimum": opt,
         "error": _error(length, opt), "error_unsimplified": _error(raw_len, opt),
-        "first_solution_s": first if ok else None, "solve_s": solve_s, "simplify_s": simplify_s,
-        "state_checks": int(checks[0]), "motion_checks": int(checks[1]), "wall_s": None,
-        "message": message, "progress": progress,
+        "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings["solve"],
+        "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
+        "motion_checks": int(res.checks["motions"]), "wall_s": None,
+        "message": res.message, "progress": res.progress,
     }
 
 
