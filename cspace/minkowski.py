@@ -57,6 +57,8 @@ def minkowski_sum(P, Q, *more) -> np.ndarray:
     [[0.0, 0.0], [3.0, 0.0], [3.0, 1.0], [1.0, 3.0], [0.0, 3.0]]
     """
     ops = [as_array(x, copy=False) for x in (P, Q) + more]  # only read
+    if any(len(o) == 0 for o in ops):
+        raise ValueError("minkowski_sum: an operand has no vertices")
     try:
         return _minkowski_sum(ops)
     except (OverflowError, NonFiniteError):  # an exact step met a NaN or an infinity

@@ -122,6 +122,8 @@ def _operand(P, holes, name: str = "operand"):
     if hasattr(P, "geom_type") and P.geom_type == "Polygon" and holes is None:
         holes = [as_array(r) for r in P.interiors]
     holes = [normalize(h, ccw=False) for h in (holes or [])]
+    if len(as_array(P, copy=False)) == 0:
+        raise ValueError(f"minkowski_sum_nonconvex: {name} has no vertices")
     shell = normalize(P)  # non-finite coordinates raise here, before GEOS sees them
     if len(shell) < 3:  # no area: the point or segment it spans (swept along the other operand)
         return collinear_extent(as_array(P)), []

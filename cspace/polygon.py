@@ -29,6 +29,8 @@ def as_array(polygon, copy: bool = True) -> np.ndarray:
         geom = polygon
         if geom.geom_type == "Polygon":
             geom = geom.exterior
+        elif geom.geom_type not in ("LinearRing", "LineString", "Point"):  # not one sequence of points
+            raise ValueError(f"expected one polygon, got a {geom.geom_type} (pass its parts, .geoms, one by one)")
         pts = np.array(geom.coords, dtype=np.float64)[:, :2]
     else:
         pts = np.array(polygon, dtype=np.float64, copy=True if copy else None)
@@ -316,7 +318,7 @@ def is_simple(polygon) -> bool:
     import shapely
 
     p = as_array(polygon)
-    if len(p) < 3:
+    if len(p) < 3 or not np.isfinite(p).all():  # GEOS would warn about NaN; not simple anyway
         return False
     # Area decided exactly (a float area underflows to 0 for coordinates near 1e-160).
     return bool(shapely.Polygon(p).is_valid) and len(normalize(p)) >= 3
