@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polygon import as_array, normalize
+from .polygon import as_array, invalid_reason, normalize
 
 
 def _is_geometry(x) -> bool:
@@ -34,8 +34,6 @@ def _polygons_of(item, what: str) -> list:
 
 def _shell_and_holes(shell, holes: list, what: str) -> tuple[np.ndarray, list[np.ndarray]]:
     """Normalised shell (CCW) and holes (CW), checked finite and simple."""
-    import shapely
-
     ext = as_array(shell)
     hs = [as_array(h) for h in holes]
     if not all(np.isfinite(p).all() for p in [ext] + hs):
@@ -45,9 +43,9 @@ def _shell_and_holes(shell, holes: list, what: str) -> tuple[np.ndarray, list[np
     ext_n = normalize(ext, ccw=True)
     if len(ext_n) < 3:
         raise ValueError(f"{what}: the polygon has zero area")
-    geom = shapely.Polygon(ext, hs)
-    if not shapely.is_valid(geom):
-        raise ValueError(f"{what}: not a simple polygon ({shapely.is_valid_reason(geom)})")
+    reason = invalid_reason(ext, hs)
+    if reason:
+        raise ValueError(f"{what}: not a simple polygon ({reason})")
     return ext_n, [normalize(h, ccw=False) for h in hs]
 
 
