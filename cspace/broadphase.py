@@ -141,7 +141,11 @@ class GridIndex:
         # Edge half-planes of p: n . x <= c, n the outward unit normal.
         e = np.roll(q, -1, axis=0) - q
         nrm = np.column_stack([e[:, 1], -e[:, 0]])
-        nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
+        # A piece that rounded to a point (a disk of radius 1e-200 at (5, 5)) has zero-length
+        # edges: their NaN normals make every comparison below False, so no cell is called
+        # inside or separated by them and the exact narrow phase decides (quietly).
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
         c = np.einsum("ij,ij->i", nrm, q)
         inside = np.empty(ii.size, dtype=bool)
         separated = np.empty(ii.size, dtype=bool)

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
-from .polygon import is_convex, normalize
+from .polygon import invalid_reason, is_convex, normalize
 
 try:  # Python >= 3.11
     import tomllib
@@ -295,8 +295,6 @@ class _Validator:
         return arr
 
     def shape(self, t: dict, field: str, tol: float, allow_holes: bool) -> Shape:
-        import shapely
-
         if not isinstance(t, dict):
             raise self.err(field, "must be a table")
         if field == "robot":  # the robot table's forms are checked by robot()
@@ -310,28 +308,34 @@ class _Validator:
             if not isinstance(holes_raw, list):
                 raise self.err(f"{field}.holes", "must be a list of polygons")
             holes = [self.polygon(h, f"{field}.holes[{i}]") for i, h in enumerate(holes_raw)]
-            shell = shapely.Polygon(ext)
-            if not shell.is_valid:
-                raise self.err(f"{field}.polygon", f"not a simple polygon ({shapely.is_valid_reason(shell)})")
+            reason = invalid_reason(ext)  # GEOS's check, on a copy near 1 at extreme scales
+            if reason:
+                raise self.err(f"{field}.polygon", f"not a simple polygon ({reason})")
             ext_n = normalize(ext, ccw=True)
             if len(ext_n) < 3:  # exact: a float area underflows near 1e-160
                 raise self.err(f"{field}.polygon", "has zero area")
             holes_n = []
             for i, h in enumerate(holes):
                 holes_n.append(normalize(h, ccw=False))
-                if not shapely.Polygon(h).is_valid or len(holes_n[-1]) < 3:
+                if invalid_reason(h) or len(holes_n[-1]) < 3:
                     raise self.err(f"{field}.holes[{i}]", "not a simple polygon of non-zero area")
             if holes:
-                whole = shapely.Polygon(ext, holes)
-                if not whole.is_valid:
-                    raise self.err(f"{field}.holes", f"holes do not fit the polygon ({shapely.is_valid_reason(whole)})")
+                reason = invalid_reason(ext, holes)
+                if reason:
+                    raise self.err(f"{field}.holes", f"holes do not fit the polygon ({reason})")
             return Shape(ext_n, holes_n, None, convex=not holes_n and is_convex(ext_n))
         if "radius" in t:
             if field != "robot" and "center" not in t:
                 raise self.err(f"{field}.center", "missing (a disk needs center = [x, y] with its radius)")
             r = self.number(t.get("radius"), f"{field}.radius", positive=True)
             c = self.point(t.get("center", [0.0, 0.0] if field == "robot" else None), f"{field}.center")
-            return Shape(disk_polygon(c, r, max_error=tol * r), [], (c[0], c[1], r), convex=True)
+            poly = disk_polygon(c, r, max_error=tol * r)
+            # A disk far below the spacing of doubles at its centre rounds to a point or a
+            # segment, which the C-space cannot represent: refuse it rather than misplace it.
+            if r < 1e-6 * max(abs(c[0]), abs(c[1])) and len(normalize(poly)) < 3:
+                raise self.err(f"{field}.radius", f"{r} is too small for a disk centred at ({c[0]}, {c[1]}): "
+                                                  f"its polygon rounds to a point or a segment in doubles")
+            return Shape(poly, [], (c[0], c[1], r), convex=True)
         raise self.err(field, "needs polygon = [[x, y], ...] or center = [x, y] with radius = r")
 
     def robot(self, t, theta: float, tol: float) -> tuple[list[Shape], str]:
