@@ -129,8 +129,13 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
 
 
 def run(args) -> int:
+    from .ompl_glue import OMPL_HINT, ompl_available
+
     planners = parse_planners(args.planners)
     times = parse_times(args.times)
+    if not ompl_available():
+        raise InputError("bench", "--planners", f"the bench runs OMPL's planners, and OMPL is not installed "
+                                                f"({OMPL_HINT})")
     if args.runs < 1:
         raise InputError("bench", "--runs", f"must be at least 1, got {args.runs}")
     if args.workers < 1:
