@@ -33,7 +33,7 @@ def as_array(polygon, copy: bool = True) -> np.ndarray:
             raise ValueError(f"expected one polygon, got a {geom.geom_type} (pass its parts, .geoms, one by one)")
         pts = np.array(geom.coords, dtype=np.float64)[:, :2]
     else:
-        pts = np.array(polygon, dtype=np.float64, copy=True if copy else None)
+        pts = np.array(polygon, dtype=np.float64) if copy else np.asarray(polygon, dtype=np.float64)
     if pts.ndim == 1 and pts.size == 2:
         pts = pts.reshape(1, 2)
     if pts.ndim != 2 or pts.shape[1] != 2:

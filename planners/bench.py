@@ -129,8 +129,13 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
 
 
 def run(args) -> int:
+    from .ompl_glue import OMPL_HINT, ompl_available
+
     planners = parse_planners(args.planners)
     times = parse_times(args.times)
+    if not ompl_available():
+        raise InputError("bench", "--planners", f"the bench runs OMPL's planners, and OMPL is not installed "
+                                                f"({OMPL_HINT})")
     if args.runs < 1:
         raise InputError("bench", "--runs", f"must be at least 1, got {args.runs}")
     if args.workers < 1:
@@ -623,17 +628,32 @@ def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
                 for r in prs:
                     lines.append("".join(f"{t!r},{c!r},;" for t, c in (r.get("progress") or [])))
             lines.append(".")
-        out[f"{_token(scen)}_t{budget:g}.log"] = "\n".join(lines) + "\n"
+        fname = f"{_token(scen)}_t{budget:g}.log"
+        n = 2
+        while fname in out:  # two labels that differ only in characters a file name cannot keep
+            fname = f"{_token(scen)}-{n}_t{budget:g}.log"
+            n += 1
+        out[fname] = "\n".join(lines) + "\n"
     return out
 
 
+TOKEN_MAX = 80  # characters of a scenario's name kept in log and experiment names
+
+
 def _token(name: str) -> str:
-    """A name safe as one whitespace-free token and file name.
+    """A name safe as one whitespace-free token and file name (long names: cut, plus a hash).
 
     >>> _token("maze 8x8/a")
     'maze_8x8_a'
+    >>> len(_token("x" * 300)) <= TOKEN_MAX + 9
+    True
     """
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name)) or "scenario"
+    import hashlib
+
+    tok = "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name)) or "scenario"
+    if len(tok) > TOKEN_MAX:
+        tok = tok[:TOKEN_MAX] + "-" + hashlib.sha256(str(name).encode()).hexdigest()[:8]
+    return tok
 
 
 # ---------------------------------------------------------------- statistics and the figure

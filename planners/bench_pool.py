@@ -1,4 +1,5 @@
-"""Running bench tasks isolated: one forked child per run, of a process that holds the C-spaces.
+"""Forked children: bench runs isolated from the process that holds the C-spaces, and
+planners run under a wall-clock guard (:func:`call_in_child`).
 
 A run must not take the sweep down (a planner may segfault, abort or hang), so each
 run is a child process. Starting a fresh interpreter and rebuilding the C-space cost
@@ -22,6 +23,7 @@ fresh process per run (:func:`planners.bench.isolated_run`).
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import select
@@ -169,3 +171,55 @@ def _die_with_parent(life_r: int, parent: int) -> None:  # pragma: no cover - th
         os._exit(1)
 
     threading.Thread(target=watch, daemon=True).start()
+
+
+def call_in_child(fn, limit: float):
+    """``fn()`` in a forked child, killed past ``limit`` seconds of wall clock.
+
+    Returns ``(True, result)`` (the result pickled back), ``(False, "timeout")``, or
+    ``(False, reason)`` if the child died or raised. KeyboardInterrupt in the parent
+    kills the child and propagates (the child ignores SIGINT).
+    """
+    import pickle
+
+    out_r, out_w = os.pipe()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        try:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            os.close(out_r)
+            try:
+                data = pickle.dumps((True, fn()))
+            except Exception as exc:
+                data = pickle.dumps((False, f"{type(exc).__name__}: {exc}"))
+            while data:
+                data = data[os.write(out_w, data):]
+        finally:
+            os._exit(0)
+    os.close(out_w)
+    buf, deadline = b"", time.perf_counter() + limit
+    try:
+        while True:
+            left = deadline - time.perf_counter()
+            if left <= 0:
+                _kill(pid)
+                return False, "timeout"
+            ready, _, _ = select.select([out_r], [], [], min(left, 0.5))
+            if ready:
+                chunk = os.read(out_r, 65536)
+                if not chunk:
+                    break
+                buf += chunk
+        _, status = os.waitpid(pid, 0)
+    except BaseException:
+        _kill(pid)
+        raise
+    finally:
+        os.close(out_r)
+    if buf:
+        with contextlib.suppress(Exception):
+            return pickle.loads(buf)
+    how = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else f"exit code {os.WEXITSTATUS(status)}"
+    return False, f"child died ({how})"

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import sys
 
+from .ompl_glue import OMPL_HINT, ompl_available
 from .output import PLOT_FORMATS, check_output, write_json
 
 
@@ -40,12 +41,27 @@ def run(args) -> int:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
+    from .ompl_glue import MAX_TIME, SEED_LIMIT, planner_name
+
+    if args.time is not None and args.time > MAX_TIME:
+        raise InputError(src, "--time", f"at most {MAX_TIME:g} s (OMPL's clock overflows near 8e9 s), got {args.time:g}")
+    if args.seed is not None and args.seed >= SEED_LIMIT:
+        raise InputError(src, "--seed", f"must be below 2^32 - 1 (OMPL's seeds are 32-bit), got {args.seed}")
+    if args.planner is not None:
+        args.planner = planner_name(args.planner, src, "--planner")
+        if args.planner != "exact" and not ompl_available():
+            raise InputError(src, "--planner", f"{args.planner} needs OMPL, which is not installed "
+                             f"({OMPL_HINT}); --planner exact works without it")
+    elif not ompl_available():
+        sys.stderr.write("note: OMPL is not installed: planning with the exact planner instead "
+                         f"({OMPL_HINT})\n")
+        args.planner = "exact"
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS) if args.plot else None
     if args.json:
         check_output(args.json, "--json")
     from .plan import plan
 
-    if args.verbose:
+    if args.verbose and args.planner != "exact":
         from .ompl_glue import ompl
 
         ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
@@ -63,23 +79,36 @@ def run(args) -> int:
 
 
 def summary(res, verbose: bool = False) -> str:
-    """A short human summary of a plan."""
+    """A short human summary of a plan.
+
+    With several queries: one line per query (with its own stage times), then the
+    count, then the whole run's total on a line of its own.
+    """
     lines = []
     results = res.queries or [res]
     for i, r in enumerate(results):
         tag = f"{r.scenario}" + (f" query {i}" if res.queries else "")
+        by = "exact" if r.planner == "exact" else f"{r.planner} (seed {r.seed})"
         if r.solved:
-            lines.append(f"{tag}: solved by {r.planner} (seed {r.seed}): length {r.length:.6g}, "
+            lines.append(f"{tag}: solved by {by}: length {r.length:.6g}, "
                          f"{len(r.path)} waypoints, solve {r.timings.get('solve', 0.0) * 1e3:.1f} ms")
+        elif r.planner == "exact" and "proven unsolvable" in r.message:
+            lines.append(f"{tag}: proven unsolvable (start and goal are in different free components)")
+        elif r.planner == "exact":
+            lines.append(f"{tag}: NOT solved by exact: {r.message}")
         else:
-            lines.append(f"{tag}: NOT solved by {r.planner} (seed {r.seed}) within the limit: {r.message}")
+            lines.append(f"{tag}: NOT solved by {by} within the limit: {r.message}")
     if res.queries:
+        for i, r in enumerate(res.queries):
+            lines.append(f"query {i} time: " + _times(r.timings, skip=("load", "cspace", "total")))
         n = sum(r.solved for r in res.queries)
         lengths = [r.length for r in res.queries if r.solved]
-        mean = sum(lengths) / len(lengths) if lengths else float("nan")
-        lines.append(f"{n}/{len(res.queries)} queries solved, mean length {mean:.6g}")
-    t = res.timings
-    lines.append("time: " + ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in t.items()))
+        mean = f", mean length {sum(lengths) / len(lengths):.6g}" if lengths else ""
+        lines.append(f"{n}/{len(res.queries)} queries solved{mean}")
+        t = res.timings
+        lines.append("total time: " + _times({k: t[k] for k in ("load", "cspace", "total") if k in t}))
+    else:
+        lines.append("time: " + _times(res.timings))
     lines.append("stages: " + " -> ".join(res.stages))
     if verbose and res.cspace_report:
         rep = res.cspace_report
@@ -92,3 +121,12 @@ def summary(res, verbose: bool = False) -> str:
             lines.append(f"  {s['stage']:<20} {state:<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
         lines.append(f"checks: {res.checks}")
     return "\n".join(lines)
+
+
+def _times(t: dict, skip=()) -> str:
+    """``name 1.2 ms, ...`` for a timings dict.
+
+    >>> _times({"solve": 0.0012, "total": 0.5}, skip=("total",))
+    'solve 1.2 ms'
+    """
+    return ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in t.items() if k not in skip)

@@ -29,7 +29,7 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None) -> PlanResult
     if sp.solved:
         message = "exact shortest path (touches C-obstacle boundaries where it bends)"
     elif sp.proven_unsolvable:
-        message = "proven unsolvable: start and goal lie in different free components"
+        message = "proven unsolvable (start and goal are in different free components)"
     else:
         message = f"no path found ({sp.stats.get('reason', 'search exhausted')})"
     return PlanResult(

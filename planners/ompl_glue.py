@@ -18,14 +18,38 @@ from .spaces import frame_exponent  # noqa: F401  (re-exported: scripts use it f
 _ompl = None
 
 
+OMPL_HINT = ("OMPL 2 has wheels for Linux and macOS 15 on Python 3.10-3.13: "
+             "pip install 'ompl>=2.0.1,<3'")
+
+
+class OMPLNotInstalled(ModuleNotFoundError):
+    """A sampling planner was asked for, but the ``ompl`` package cannot be imported."""
+
+
+def ompl_available() -> bool:
+    """Whether OMPL can be imported here (the exact planner works either way)."""
+    try:
+        ompl()
+    except OMPLNotInstalled:
+        return False
+    return True
+
+
 def ompl():
-    """Import OMPL once, silence its logging, and return ``(base, geometric, util)``."""
+    """Import OMPL once, silence its logging, and return ``(base, geometric, util)``.
+
+    Without OMPL: :class:`OMPLNotInstalled`, saying how to get it.
+    """
     global _ompl
     if _ompl is None:
-        with _quiet_fd(2):
-            from ompl import base as ob
-            from ompl import geometric as og
-            from ompl import util as ou
+        try:
+            with _quiet_fd(2):
+                from ompl import base as ob
+                from ompl import geometric as og
+                from ompl import util as ou
+        except ImportError as exc:
+            raise OMPLNotInstalled(f"the sampling planners need OMPL, which is not installed ({OMPL_HINT})",
+                                   name="ompl") from exc
         ou.setLogLevel(ou.LOG_NONE)
         _ompl = (ob, og, ou)
     return _ompl
@@ -168,14 +192,37 @@ def set_query(ss, adapter, start, goal) -> None:
     ss.setStartAndGoalStates(s, g, GOAL_THRESHOLD)
 
 
-def termination(time_limit: float, iterations: int | None = None):
-    """Stop at the time limit, or after ``iterations`` planner iterations if given.
+MAX_TIME = 1e8  # seconds; OMPL's clock (int64 nanoseconds from now) overflows near 8e9 s
 
-    OMPL evaluates the condition once per planner iteration, so an iteration budget
-    is deterministic where a time budget is not (for anytime planners).
+
+def clamp_time(t: float) -> float:
+    """A time limit OMPL's clock can hold (at most ``MAX_TIME``, at least 0).
+
+    >>> clamp_time(1e10), clamp_time(-1.0), clamp_time(0.5)
+    (100000000.0, 0.0, 0.5)
+    """
+    return min(max(float(t), 0.0), MAX_TIME)
+
+
+def configure(planner, name: str, iterations: int | None) -> None:
+    """Planner settings that carry an iteration budget: FMT and BFMT sample that many states.
+
+    (See :mod:`planners.routine` for what ``iterations`` means per planner.)
+    """
+    if iterations and name.lower() in ("fmt", "bfmt"):
+        planner.setNumSamples(int(iterations))
+
+
+def termination(time_limit: float, iterations: int | None = None):
+    """Stop at the time limit, or after ``iterations`` evaluations of the condition if given.
+
+    Most planners evaluate the condition once per iteration of their main loop, so an
+    iteration budget is deterministic where a time budget is not. The counting
+    condition is a Python function: never hand it to a planner that evaluates it on
+    a thread of its own (PRM's solution thread: deadlock on the interpreter lock).
     """
     ob = ompl()[0]
-    timed = ob.timedPlannerTerminationCondition(float(time_limit))
+    timed = ob.timedPlannerTerminationCondition(clamp_time(time_limit))
     if not iterations:
         return timed, None
     count = [0]

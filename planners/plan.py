@@ -1,15 +1,12 @@
 """Planning a path: scenario -> C-space -> OMPL -> simplified, exactly verified path.
 
-This module owns :func:`plan`, :class:`PlanResult` and :func:`run_planner`, the one
-routine that sets up, queries, solves, simplifies and verifies with OMPL. ``cspace
-plan``, ``planners.plan()`` and every ``cspace bench`` run go through it; the bench
-only asks for anytime planners to be solved in time slices (``slices=True``) to time
-the first solution and record the best cost along the run.
-
-The routine talks to a state-space adapter (:mod:`planners.spaces`), never to the
-geometry: a path is reported solved only if OMPL found an exact solution *and* the
-adapter's exact verification accepts the final (simplified) path, from the start
-exactly to the goal exactly.
+This module owns :func:`plan` and :class:`PlanResult`: it resolves the options, builds
+the C-space, checks the queries, and hands a state-space adapter
+(:mod:`planners.spaces`) to :func:`planners.routine.run_planner`, the one routine
+that drives OMPL. ``cspace plan``, ``planners.plan()`` and every ``cspace bench``
+run go through it. A path is reported solved only if OMPL found an exact solution
+*and* the adapter's exact verification accepts the final (simplified) path, from
+the start exactly to the goal exactly.
 """
 from __future__ import annotations
 
@@ -177,6 +174,8 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
 
         results = [exact_plan(sc, cspace, q, time_limit=tlim) for q in queries]
     else:
+        from .routine import run_planner
+
         results = run_planner(space, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
                               slices=slices, on_progress=on_progress, scenario=sc.name)
     for r in results:
@@ -197,149 +196,8 @@ def _now() -> float:
     return time.perf_counter()
 
 
-# Anytime planners solved in slices (``slices=True``): MIN_SLICE s, doubling up to
-# budget / SLICES. Calling solve() again continues the same search in these planners
-# (not in AORRTC, which crashed under repeated solves).
-SLICES = 20
-MIN_SLICE = 0.002
-SLICED = {"rrtstar", "informedrrtstar", "sorrtstar", "bitstar", "prm", "prmstar"}
-ROADMAP = {"prm", "prmstar"}  # multi-query: the roadmap is kept from query to query
+def run_planner(*args, **kwargs):
+    """See :func:`planners.routine.run_planner` (re-exported here)."""
+    from .routine import run_planner as run
 
-
-def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *,
-                iterations: int | None = None, simplify: bool = True, slices: bool = False,
-                on_progress=None, scenario: str = "") -> list[PlanResult]:
-    """THE planning routine: one OMPL planner over a state-space adapter, for each query.
-
-    ``space`` is an adapter of :mod:`planners.spaces`; ``queries`` is a list of
-    ``(start, goal)`` poses of its dimension, already checked to be free. Per query:
-    set up (seeded with the query's own stream; PRM-family planners keep their
-    roadmap from query to query), set the query, solve within ``time_limit`` seconds
-    (and ``iterations`` if given), simplify, snap the last step to the exact goal,
-    and verify exactly through the adapter.
-
-    With ``slices``, anytime planners are solved in slices of the same total budget
-    so that the time of the first solution (to within one slice) and the best raw
-    length along the run are recorded in ``first_solution`` and ``progress``;
-    ``on_progress(t, length)`` is called at each recorded point.
-    """
-    from .ompl_glue import make_setup, set_query
-
-    out = []
-    ss = None
-    key = name.lower()
-    for i, (start, goal) in enumerate(queries):
-        t0 = _now()
-        if tuple(start) == tuple(goal):  # nothing to plan: the one-point path
-            out.append(_trivial(space, name, seed, scenario, start, goal))
-            continue
-        if ss is None or key not in ROADMAP:
-            ss, _ospace, _checker, _validator = make_setup(space, name, seed, query=i)
-        else:
-            ss.getPlanner().clearQuery()  # keep the roadmap, drop the old start and goal
-        set_query(ss, space, start, goal)
-        setup_s = _now() - t0
-        c0 = space.counts()
-        t1 = _now()
-        first, progress = _solve(ss, space, key, time_limit, iterations, slices, on_progress)
-        solve_s = _now() - t1
-        status = ss.getLastPlannerStatus()
-        found = ss.haveExactSolutionPath()
-        raw = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
-        t2 = _now()
-        if found and simplify:
-            ss.simplifySolution()
-        simp_s = _now() - t2 if found and simplify else 0.0
-        path = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
-        t3 = _now()
-        ok, message = space.verify(path, start, goal) if found else (False, failure_message(status, space))
-        verify_s = _now() - t3
-        c1 = space.counts()
-        if ok and key in SLICED | {"aorrtc"} and iterations is None and solve_s >= 0.9 * time_limit:
-            message += " (anytime planner: ran to its time limit)"
-        out.append(PlanResult(
-            scenario=scenario, solved=ok, exact=ok, path=path if ok else np.zeros((0, space.dim)),
-            length=space.length(path) if ok else math.inf, planner=name, seed=seed,
-            timings={"setup": setup_s, "solve": solve_s, "simplify": simp_s, "verify": verify_s},
-            checks={"states": c1[0] - c0[0], "motions": c1[1] - c0[1]},
-            stages=["setup", "solve"] + (["simplify"] if found and simplify else []) + ["verify"],
-            start=tuple(start), goal=tuple(goal), message=message,
-            length_unsimplified=space.length(raw) if ok else None,
-            first_solution=first if ok else None, progress=progress,
-        ))
-    return out
-
-
-def _solve(ss, space, key, time_limit, iterations, slices, on_progress):
-    """Solve within the budget; returns (time of the first exact solution, progress)."""
-    from .ompl_glue import ompl, termination
-
-    ob = ompl()[0]
-    first, progress = None, []
-    t0 = _now()
-
-    def record():
-        nonlocal first
-        if ss.haveExactSolutionPath():
-            t = _now() - t0
-            first = t if first is None else first
-            progress.append([t, space.length(space.path_array(ss.getSolutionPath()))])
-            if on_progress is not None:
-                on_progress(*progress[-1])
-
-    if slices and key in SLICED and not iterations:
-        # Continue the same search slice by slice: same total budget. Slices double
-        # from MIN_SLICE up to budget / SLICES, so an early first solution is timed
-        # finely and a long run still takes few slices.
-        step, n = max(time_limit / SLICES, MIN_SLICE), 0
-        while (left := time_limit - (_now() - t0)) > 0:
-            ss.solve(ob.timedPlannerTerminationCondition(min(step, MIN_SLICE * 2 ** n, left)))
-            n += 1
-            record()
-    else:
-        ptc, _keep = termination(time_limit, iterations)
-        ss.solve(ptc)
-        record()
-    return first, progress
-
-
-def failure_message(status, space=None) -> str:
-    """Why a sampling planner did not solve, in plain words (OMPL's status explained).
-
-    >>> failure_message("Timeout")
-    'no path found within the budget (OMPL: Timeout)'
-    """
-    text = str(status)
-    if "Approximate" in text:
-        msg = ("no path found within the budget (OMPL's \"Approximate solution\": its best path only "
-               "comes near the goal, it does not reach it)")
-    else:
-        msg = f"no path found within the budget (OMPL: {text})"
-    hint = getattr(space, "unsolved_hint", None)
-    return msg + (f"; {hint}" if hint else "")
-
-
-def _trivial(space, name, seed, scenario, start, goal) -> PlanResult:
-    """Start equals goal: the one-point path, verified like any other."""
-    path = np.array([start], dtype=np.float64).reshape(1, space.dim)
-    ok, message = space.verify(path, start, goal)
-    return PlanResult(scenario=scenario, solved=ok, exact=ok, path=path, length=0.0, planner=name, seed=seed,
-                      timings={"setup": 0.0, "solve": 0.0, "simplify": 0.0, "verify": 0.0},
-                      checks={"states": 0, "motions": 0}, stages=["verify"], start=tuple(start), goal=tuple(goal),
-                      message=message, length_unsimplified=0.0, first_solution=0.0, progress=[[0.0, 0.0]])
-
-
-def _snap(path: np.ndarray, goal) -> np.ndarray:
-    """The planner's path, ending exactly at the goal.
-
-    OMPL reports the goal reached within ``GOAL_THRESHOLD`` (1e-9; a threshold of 0
-    makes RRT miss a goal it has sampled); the last little step to the exact goal is
-    appended and, like every segment, verified exactly afterwards.
-
-    >>> _snap(np.array([[0., 0], [1, 1 - 1e-12]]), (1, 1)).tolist()
-    [[0.0, 0.0], [1.0, 0.999999999999], [1.0, 1.0]]
-    """
-    goal = np.array(goal, dtype=np.float64)
-    if len(path) and not (path[-1] == goal).all():
-        path = np.vstack([path, goal])
-    return path
+    return run(*args, **kwargs)

@@ -138,3 +138,13 @@ def test_budget_beyond_the_clock_is_refused(tmp_path, capsys):
     assert main(["bench", BASIC, "--times", "8e9", "--out", str(tmp_path / "o"), "-q"]) == 2
     err = capsys.readouterr().err
     assert ": --times: " in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_300_character_scenario_name_is_fine(tmp_path):
+    f = tmp_path / "long.toml"
+    f.write_text(Path(BASIC).read_text().replace('name = "basic"', f'name = "{"n" * 300}"'))
+    out = tmp_path / "o"
+    assert main(["bench", str(f), "--planners", "RRTConnect", "--times", "0.1", "--runs", "1", "--out", str(out),
+                 "-q", "--no-plot"]) == 0
+    (log,) = os.listdir(out / "ompl")
+    assert len(log) < 120
