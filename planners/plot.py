@@ -22,7 +22,7 @@ PIECE_EDGE = "#c97c5d"
 PATH = "#1f5fbf"
 ROBOT = "#2a9d4b"
 GOAL = "#c0392b"
-FAILED = "#d4380d"
+FAILED = "#d6007a"  # magenta: apart from the goal's red and the path's blue
 BOUNDS = "#888888"
 GAP = "#7b2cbf"
 
@@ -84,7 +84,7 @@ LEGEND = {
     "along": ("robot along the path", lambda point: _robot_proxy(point, PATH, fill=False, alpha=0.4)),
     "path": ("path", lambda point: _line(color=PATH, lw=1.4)),
     "failed": ("no path found (start to goal)",
-               lambda point: _line(color=FAILED, lw=1.2, ls=":", marker="x", ms=6)),
+               lambda point: _line(color=FAILED, lw=2.0, ls="--", marker="x", ms=8, mew=2.0)),
     "gap": ("narrowest gap (zoomed)", lambda point: _line(color=GAP, lw=1.5, marker="|", ms=6)),
 }
 
@@ -165,12 +165,18 @@ def _poses(path: np.ndarray, k: int) -> np.ndarray:
 
 
 def draw_failed(ax, start, goal, label: str | None = None) -> None:
-    """A query without a path: a dotted line from start to goal, crosses at both ends."""
-    ax.plot([start[0], goal[0]], [start[1], goal[1]], ":", color=FAILED, lw=1.2, zorder=5)
-    ax.plot([start[0], goal[0]], [start[1], goal[1]], "x", color=FAILED, ms=7, mew=1.6, zorder=6)
+    """A query without a path: a dashed line from start to goal, crosses at both ends, drawn
+    on top of everything with a white halo so that it stands out among many paths."""
+    from matplotlib import patheffects
+
+    halo = [patheffects.withStroke(linewidth=4, foreground="white")]
+    xs, ys = [start[0], goal[0]], [start[1], goal[1]]
+    ax.plot(xs, ys, "--", color=FAILED, lw=2.0, zorder=7, path_effects=halo)
+    ax.plot(xs, ys, "x", color=FAILED, ms=10, mew=2.5, zorder=8, path_effects=halo)
     if label:
-        ax.annotate(label, (start[0], start[1]), xytext=(4, 4), textcoords="offset points",
-                    color=FAILED, fontsize=7, zorder=6)
+        ax.annotate(label, (start[0], start[1]), xytext=(6, 6), textcoords="offset points", color=FAILED,
+                    fontsize=8, fontweight="bold", zorder=8,
+                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": FAILED, "lw": 0.8})
 
 
 def _draw_queries(ax, sc, results: list, poses: int) -> list[str]:
@@ -284,14 +290,19 @@ def figure_result(res, scenario=None, cspace=None, poses: int = 4):
     else:
         n = sum(r.solved for r in results)
         ax.set_title(f"{sc.name}: {res.planner}, {n}/{len(results)} queries solved")
-        labels["path"] = f"paths ({n} queries)"
-        labels["failed"] = f"no path found ({len(results) - n} queries, start to goal)"
+        labels["path"] = f"paths ({_count(n, 'query', 'queries')})"
+        labels["failed"] = f"no path found ({_count(len(results) - n, 'query', 'queries')}, start to goal)"
     if gap is not None:
         draw_inset(ax, sc, cs, results, gap)
         keys.append("gap")
         labels["gap"] = f"narrowest gap, {gap.width:.3g} wide (zoomed)"
     add_legend(ax, legend_handles(keys, sc.is_point_robot, labels))
     return fig
+
+
+def _count(n: int, one: str, many: str) -> str:
+    """'1 query', '3 queries'."""
+    return f"{n} {one if n == 1 else many}"
 
 
 def plot_result(res, out: str, fmt: str | None = None, scenario=None, cspace=None, poses: int = 4) -> None:

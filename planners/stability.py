@@ -910,7 +910,12 @@ def plot(rows: list[dict], path: str) -> None:
     ax.bar(range(len(rows)), times, color=["tab:green" if r["passed"] else "tab:red" for r in rows])
     ax.set_yscale("log")
     ax.set_xticks(range(len(rows)), [r["case"] for r in rows], rotation=90, fontsize=6)
-    ax.set_ylabel("time (ms)")
+    ax.set_ylabel("time of the layer call (ms)")
+    ax.set_xlabel("case (its name begins with its layer)")
+    from matplotlib.patches import Patch
+
+    ax.legend(handles=[Patch(color="tab:green", label="guarantee holds"), Patch(color="tab:red", label="FAILED")],
+              loc="upper left", fontsize=8)
     ax.set_title(f"cspace stability: {sum(r['passed'] for r in rows)}/{len(rows)} cases pass")
     fig.tight_layout()
     with atomic_path(path) as tmp:

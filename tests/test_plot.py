@@ -110,7 +110,7 @@ def test_multi_query_picture_marks_the_failed_query(write_toml):
     fig = plot.figure_result(res)
     _labels_ok(fig)
     labels = _legend(fig)
-    assert "no path found (1 queries, start to goal)" in labels and "paths (1 queries)" in labels
+    assert "no path found (1 query, start to goal)" in labels and "paths (1 query)" in labels
     assert "query start" in labels and "query goal" in labels
     ax = fig.axes[0]
     marks = [ln for ln in ax.get_lines() if ln.get_color() == plot.FAILED and ln.get_marker() == "x"]
