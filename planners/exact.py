@@ -19,12 +19,21 @@ import numpy as np
 from .plan import PlanResult
 
 
-def exact_plan(sc, cspace, query, time_limit: float | None = None) -> PlanResult:
-    """Shortest path for one query on a built C-space (search bounded by ``time_limit``)."""
+def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: bool | None = None) -> PlanResult:
+    """Shortest path for one query on a built C-space (search bounded by ``time_limit``).
+
+    A search that lasts longer than :data:`planners.progress.DELAY` shows a bar on a terminal
+    (nodes settled, and a lower bound on the length that rises towards the answer);
+    ``progress=False`` silences it, ``None`` draws it only when stderr is a terminal.
+    """
     from cspace.shortest import shortest_path as geometric_shortest
 
+    from . import progress as pg
+
     t = time.perf_counter()
-    sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit)
+    with pg.progress(None, "exact search", enabled=progress, unit="node", delay=pg.DELAY, tick=1.0) as bar:
+        sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit,
+                                on_progress=pg.search_reporter(bar) if bar.shown else None)
     dt = time.perf_counter() - t
     if sp.solved:
         message = "exact shortest path (touches C-obstacle boundaries where it bends)"
