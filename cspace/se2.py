@@ -1,0 +1,533 @@
+"""The C-space of a robot that translates and rotates (SE(2)), sliced into angle slabs.
+
+This module owns the SE(2) queries (note se2-rotation.md, sections 1 and 2). The
+circle of angles is cut into K slabs; slab k holds, for each convex robot piece, its
+slab hull H (:func:`cspace.slab.slab_hull`, a convex superset of the piece at every
+angle of the slab), and is a plain translational :class:`CSpace` of those hulls:
+
+- a reference point free in slab k's C-space is free at EVERY angle of the slab (a
+  certificate, not a sample);
+- a reference point inside the slab's *inner* C-space (the obstacles summed with each
+  robot piece eroded by its largest displacement in the slab, 2 r sin(Δ/4) about the
+  middle angle) collides at every angle of the slab (certified blocked);
+- anything else gets the exact test at its own angle: the body-frame robot pieces
+  rotated by :func:`cspace.slab.rotate`, then exactly the translation C-space's
+  semantics (is (x, y) in the computed sum obstacle piece ⊕ −(rotated piece), closed).
+
+"The pose (x, y, θ)" always means: θ wrapped into [−π, π) as OMPL does, each robot
+piece turned by :func:`rotate_piece`, translated by (x, y). Slabs are built lazily, on
+first use, and cached. Everything is deterministic.
+
+Motions follow OMPL's SE(2) interpolation (:func:`interpolate`). A motion is split at
+slab boundaries; a sub-motion whose reference segment is free in its slab's C-space
+is free (the robot stays in segment ⊕ H). Otherwise it is refined: the sub-motion's
+own hull (over its own, smaller angle range) swept along its segment is tested
+exactly against the obstacle pieces, and halved on a hit, until an exact pose in
+collision is found (False) or a floor of size is reached (False, counted: a
+conservative answer, never a false "free").
+"""
+from __future__ import annotations
+
+import itertools
+import math
+import time
+
+import numpy as np
+
+from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
+from .gjk import exact_relation
+from .halfplane import erode
+from .minkowski import minkowski_sum, reflect
+from .pieces import PieceSet
+from .predicates import orient2d_xy
+from .scenario import Scenario, load_scenario
+from .slab import (ANGLE_SLACK, TWO_PI, rotate, rotate_piece, slab_hull, slab_of, slab_pad, slab_range,
+                   wrap_angle)
+
+# Refinement of a motion stops (answer "not free", counted) when the sub-motion's
+# sweep is smaller than this fraction of the scene's extent...
+FLOOR_REL = 1e-9
+# ... or after this many swept hulls for one motion (never a hang).
+MAX_REFINE = 2048
+
+
+def interpolate(q0, q1, t: float) -> tuple[float, float, float]:
+    """The pose at fraction t of the motion q0 -> q1, exactly as OMPL's SE2StateSpace computes it.
+
+    x and y: ``from + (to - from) * t`` (RealVectorStateSpace). θ (SO2StateSpace):
+    ``diff = to - from``; if ``|diff| <= π`` then ``from + diff * t``; otherwise along
+    the shorter arc the other way, ``from - d * t`` with ``d = 2π - diff`` (diff > 0)
+    or ``-2π - diff``, then wrapped back by one turn if it left [−π, π]. Both ends
+    must already be in [−π, π] (OMPL's states are).
+
+    >>> interpolate((0, 0, 3.0), (2, 4, -3.0), 0.75)  # through π, the shorter way
+    (1.5, 3.0, -3.0707963267948966)
+    """
+    x0, y0, a = float(q0[0]), float(q0[1]), float(q0[2])
+    x1, y1, b = float(q1[0]), float(q1[1]), float(q1[2])
+    t = float(t)
+    diff = b - a
+    if abs(diff) <= math.pi:
+        th = a + diff * t
+    else:
+        diff = TWO_PI - diff if diff > 0.0 else -TWO_PI - diff
+        th = a - diff * t
+        if th > math.pi:
+            th -= TWO_PI
+        elif th < -math.pi:
+            th += TWO_PI
+    return x0 + (x1 - x0) * t, y0 + (y1 - y0) * t, th
+
+
+def _arc(a: float, b: float) -> float:
+    """The signed angle swept by OMPL's interpolation from a to b (|result| <= π)."""
+    diff = b - a
+    if abs(diff) <= math.pi:
+        return diff
+    return diff - TWO_PI if diff > 0.0 else diff + TWO_PI
+
+
+def robot_radius(pieces: list[np.ndarray]) -> float:
+    """Largest distance of a robot vertex from the reference point (0 for a point robot).
+
+    >>> robot_radius([np.array([[0., 0], [3, 4], [0, 1]])])
+    5.0
+    """
+    return max((float(np.hypot(p[:, 0], p[:, 1]).max()) for p in pieces if len(p)), default=0.0)
+
+
+def default_slabs(robot_radius: float, extent: float, gap: float | None = None) -> tuple[int, str]:
+    """K, the number of slabs, and a one-line reason.
+
+    In a slab of width Δ = 2π/K a robot point at radius r sweeps a chord of about
+    r·Δ, so each slab C-obstacle is thicker than the C-obstacle at one angle by up
+    to about r·Δ (plus r·Δ²/4, the hull's excess over the two end poses). States
+    and motions in that band are not certified by the slab grid and take the slow
+    exact route, so the band should be a small fraction of the scene's typical gap
+    g: K is the smallest power of two with r·2π/K <= g/4. Each slab costs two
+    translational C-space builds (outer and inner), built lazily, so K is clamped
+    to [16, 64]: beyond 64 the build time grows linearly while the band is already
+    well below the gaps of the bundled scenes. ``gap`` defaults to extent / 8.
+
+    >>> default_slabs(1.0, 10.0)[0], default_slabs(0.1, 10.0)[0], default_slabs(5.0, 10.0)[0]
+    (32, 16, 64)
+    """
+    g = extent / 8.0 if gap is None or not gap > 0.0 else min(gap, extent / 8.0)
+    if robot_radius <= 0.0:
+        return 1, "K = 1: a point robot does not turn"
+    need = TWO_PI * robot_radius / (0.25 * g)
+    k = 16
+    while k < need and k < 64:
+        k *= 2
+    delta = TWO_PI / k
+    chord = 2.0 * robot_radius * math.sin(0.5 * delta)
+    excess = math.sin(0.5 * delta) ** 2 / math.cos(0.5 * delta)
+    return k, (f"K = {k}: robot radius {robot_radius:.3g}, a slab of {math.degrees(delta):.3g} deg moves its "
+               f"farthest point by {chord:.3g} ({100 * chord / g:.2g} % of the typical gap {g:.3g}); "
+               f"hull excess over the end poses <= {100 * excess:.2g} % of the radius")
+
+
+def _typical_gap(pieces: list[np.ndarray], extent: float) -> float:
+    """Median distance from an obstacle piece to its nearest other piece (shapely),
+    ignoring touching pieces (parts of one decomposed obstacle); extent / 8 if none."""
+    if len(pieces) < 2:
+        return extent / 8.0
+    import shapely
+
+    geoms = [shapely.Polygon(p) for p in pieces[:400]]
+    tree = shapely.STRtree(geoms)
+    gaps = []
+    for i, g in enumerate(geoms):
+        j, d = tree.query_nearest(g, exclusive=True, return_distance=True, all_matches=False)
+        if len(d) and d[0] > 0.0:
+            gaps.append(float(d[0]))
+    return float(np.median(gaps)) if gaps else extent / 8.0
+
+
+class SE2CSpace:
+    """C-space of a rotating polygonal robot: K lazily built angle slabs plus exact tests.
+
+    >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+    >>> bar = np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])
+    >>> cs = SE2CSpace((0, 10, 0, 10), [sq], [bar], slabs=16)
+    >>> cs.is_free((3.1, 5, 0.0)), cs.is_free((3.1, 5, math.pi / 2)), cs.is_free((5, 5, 1.0))
+    (False, True, False)
+    >>> cs.motion_free((2.5, 2, 0), (7.5, 2, 0)), cs.motion_free((3.1, 5, math.pi / 2), (3.1, 5, -math.pi / 2))
+    (True, False)
+    """
+
+    def __init__(self, bounds, obstacles: list[np.ndarray] | None = None, robot: list[np.ndarray] | None = None,
+                 *, obstacle_holes: list[list[np.ndarray]] | None = None, robot_is_disk: bool = False,
+                 slabs: int | None = None, grid_cells: int | None = None):
+        t0 = time.perf_counter()
+        self.bounds = tuple(float(v) for v in bounds)
+        obstacles = obstacles or []
+        _check_range(self.bounds, obstacles + (robot or []))
+        self.obstacle_pieces, self.obstacle_of, _ = decompose_obstacles(obstacles, obstacle_holes)
+        self.robot_pieces, _ = decompose_robot(robot or [], robot_is_disk)
+        self.grid_cells = grid_cells
+        xmin, xmax, ymin, ymax = self.bounds
+        self.extent = max(xmax - xmin, ymax - ymin)
+        self.radius = robot_radius(self.robot_pieces)
+        # Magnitude of every coordinate the slab hulls are summed with (obstacles, bounds,
+        # positions along motions): the slab pad scales with it (slab_pad).
+        self.scale = max([abs(v) for v in self.bounds]
+                         + [float(np.abs(p).max()) for p in self.obstacle_pieces if len(p)])
+        self.pad = slab_pad(self.radius * math.sqrt(2.0) + self.scale)
+        if slabs is None:
+            gap = _typical_gap(self.obstacle_pieces, self.extent)
+            self.slabs, self.slabs_reason = default_slabs(self.radius, self.extent, gap)
+        else:
+            if isinstance(slabs, bool) or not isinstance(slabs, int) or not slabs >= 4:
+                if not (slabs == 1 and not self.robot_pieces):
+                    raise ValueError(f"SE2CSpace: slabs must be an integer >= 4, got {slabs!r}")
+            self.slabs, self.slabs_reason = slabs, f"K = {slabs}: given"
+        if not self.robot_pieces:
+            self.slabs, self.slabs_reason = 1, "K = 1: a point robot does not turn"
+        K = self.slabs
+        # Each slab's angle interval, widened by ANGLE_SLACK: what its hulls are built for.
+        self._lo = [slab_range(k, K)[0] - ANGLE_SLACK for k in range(K)] if K > 1 else [-math.inf]
+        self._hi = [slab_range(k, K)[1] + ANGLE_SLACK for k in range(K)] if K > 1 else [math.inf]
+        self._outer: list = [None] * K  # slab k's CSpace (robot = slab hulls)
+        self._inner: list = [None] * K  # slab k's certified-blocked CSpace, or False if empty
+        self._tests: list = [None] * K  # (outer point test, inner point test or None)
+        self._built: list[dict] = []
+        olo = np.array([p.min(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
+        ohi = np.array([p.max(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
+        self._olo, self._ohi = olo, ohi
+        self.checks = {"states": 0, "exact_states": 0, "inner_blocked": 0, "motions": 0, "motion_collisions": 0,
+                       "motion_floor": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
+        self._states = itertools.count()
+        self._pose = self.pose_test(self._states.__next__)
+        self.setup_seconds = time.perf_counter() - t0
+
+    @classmethod
+    def from_scenario(cls, scenario, slabs: int | None = None, grid_cells: int | None = None) -> "SE2CSpace":
+        """The SE(2) C-space of a :class:`Scenario` (or a file path); ``sc.robot`` is the body frame.
+
+        >>> import os, tempfile
+        >>> f = os.path.join(tempfile.mkdtemp(), "s.toml")
+        >>> _ = open(f, "w").write("[bounds]\\nxmin=0\\nxmax=4\\nymin=0\\nymax=4\\n[start]\\nx=0.5\\ny=0.5\\n"
+        ...     "[goal]\\nx=3.5\\ny=3.5\\n[robot]\\npolygon=[[0,0],[0.2,0],[0,0.2]]\\n"
+        ...     "[[obstacles]]\\npolygon=[[1,1],[3,1],[3,3],[1,3]]\\n")
+        >>> SE2CSpace.from_scenario(f, slabs=8).is_free((2, 2, 0.3))
+        False
+        """
+        sc = scenario if isinstance(scenario, Scenario) else load_scenario(str(scenario))
+        cs = cls(sc.bounds, [o.polygon for o in sc.obstacles], [r.polygon for r in sc.robot],
+                 obstacle_holes=[o.holes for o in sc.obstacles], robot_is_disk=sc.robot_kind == "disk",
+                 slabs=slabs, grid_cells=grid_cells)
+        cs.scenario = sc
+        return cs
+
+    # -- slabs -------------------------------------------------------------------------
+
+    def slab(self, k: int) -> CSpace:
+        """Slab k's translational C-space (robot pieces = their slab hulls), built on first use."""
+        if self._outer[k] is None:
+            self._build(k)
+        return self._outer[k]
+
+    def _build(self, k: int) -> None:
+        t = time.perf_counter()
+        if self.slabs == 1:  # point robot: one C-space, the obstacles themselves
+            outer = CSpace(self.bounds, self.obstacle_pieces, [], grid_cells=self.grid_cells)
+            self._outer[k], self._inner[k] = outer, False
+            self._tests[k] = (outer.point_test(), None)
+            self._built.append({"slab": k, "seconds": time.perf_counter() - t, "pieces": len(outer.pieces),
+                                "inner_pieces": 0})
+            return
+        a, b = self._lo[k], self._hi[k]
+        hulls = [slab_hull(p, a, b, scale=self.scale) for p in self.robot_pieces]
+        outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells)
+        t_outer = time.perf_counter() - t
+        inner_pieces = self._inner_pieces(a, b)
+        inner = (CSpace(self.bounds, self.obstacle_pieces, inner_pieces, grid_cells=self.grid_cells)
+                 if inner_pieces and self.obstacle_pieces else False)
+        self._outer[k], self._inner[k] = outer, inner
+        self._tests[k] = (outer.point_test(), inner.point_test() if inner else None)
+        self._built.append({"slab": k, "seconds": time.perf_counter() - t, "outer_seconds": t_outer,
+                            "pieces": len(outer.pieces), "inner_pieces": len(inner.pieces) if inner else 0})
+
+    def _inner_pieces(self, a: float, b: float) -> list[np.ndarray]:
+        """Convex sets inside every robot piece at every angle of [a, b] (certified blocked).
+
+        A point u with |u| <= ρ moves by at most d(ρ) = 2ρ sin(h/2) when the robot turns
+        by h = (b − a)/2 about the middle angle m, and R_m u = R_θ (R_{m−θ} u). So if u
+        lies in P eroded by the disk of radius d(ρ) and |u| <= ρ, then R_m u is in R_θ P
+        for every θ of the slab: I = R_m((P ⊖ square of half-side d(ρ)) ∩ G(ρ)), G(ρ)
+        a 16-gon inside the disk of radius ρ. d is grown by a relative 2^-40 and four
+        slab pads (the rounding of the erosion, the clipping, the rotations and the
+        C-space sums). Of ρ = r, r/√2, r/2, ... the largest I is kept (a long thin
+        piece keeps its middle part: its ends sweep far).
+        """
+        import shapely
+
+        from .hull import convex_hull
+        from .slab import inscribed_polygon
+
+        half = 0.5 * (b - a)
+        m = a + half
+        out = []
+        for p in self.robot_pieces:
+            r = float(np.hypot(p[:, 0], p[:, 1]).max())
+            best, best_area = None, 0.0
+            for rho in (r, r * 0.7071, r * 0.5, r * 0.3536, r * 0.25):
+                d = 2.0 * rho * math.sin(0.5 * half) * (1.0 + 2.0**-40) + 4.0 * self.pad
+                sq = np.array([[-d, -d], [d, -d], [d, d], [-d, d]])
+                e = erode(p, sq)
+                if len(e) < 3:
+                    continue
+                if rho < r:
+                    g = shapely.Polygon(e).intersection(shapely.Polygon(inscribed_polygon(rho, 16)))
+                    if g.is_empty or g.geom_type != "Polygon" or g.area <= 0.0:
+                        continue
+                    e = convex_hull(np.asarray(g.exterior.coords)[:-1])
+                    if len(e) < 3:
+                        continue
+                area = float(shapely.Polygon(e).area)
+                if area > best_area:
+                    best, best_area = e, area
+            if best is not None:
+                out.append(rotate_piece(best, m))
+        return out
+
+    def _slab_index(self, th: float) -> int:
+        """Slab of an angle already in [−π, π)."""
+        return slab_of(th, self.slabs) if self.slabs > 1 else 0
+
+    # -- states ------------------------------------------------------------------------
+
+    def in_bounds(self, x: float, y: float) -> bool:
+        xmin, xmax, ymin, ymax = self.bounds
+        return xmin <= x <= xmax and ymin <= y <= ymax
+
+    def is_free(self, q) -> bool:
+        """Is the pose q = (x, y, θ) valid: reference point in bounds, robot touching nothing?"""
+        return self._pose(float(q[0]), float(q[1]), float(q[2]))
+
+    def pose_test(self, tick=None, state: bool = False):
+        """A fast ``(x, y, theta) -> bool`` free-pose test: the validity checker's hot path.
+
+        Slab lookup (two comparisons certify the float slab index), then the slab's
+        grid: FREE in the slab C-space is free at every angle of the slab; inside the
+        inner C-space is blocked at every angle; anything else goes to the exact test
+        at θ. ``tick`` is called once per query; with ``state`` the test takes one
+        indexable ``q`` (``q[0], q[1], q[2]``).
+
+        >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+        >>> cs = SE2CSpace((0, 10, 0, 10), [sq], [np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])], slabs=8)
+        >>> f = cs.pose_test()
+        >>> f(1.0, 1.0, 0.3), f(5.0, 5.0, -2.0), cs.pose_test(state=True)([2.9, 5.0, 1.5707963])
+        (True, False, True)
+        """
+        K = self.slabs
+        per = K / TWO_PI
+        lo, hi, tests = self._lo, self._hi, self._tests
+        build, exact = self._build, self._exact
+        pi, wrap, slab_of_ = math.pi, wrap_angle, self._slab_index
+        count = int if tick is None else tick
+        floor = math.floor
+        checks = self.checks
+
+        def free(x, y, th) -> bool:
+            count()
+            if not -pi <= th < pi:
+                th = wrap(th)
+            k = floor((th + pi) * per) if K > 1 else 0
+            if k >= K or not lo[k] <= th <= hi[k]:
+                k = slab_of_(th)
+            t = tests[k]
+            if t is None:
+                build(k)
+                t = tests[k]
+            if t[0](x, y):
+                return True  # free in the slab: free at every angle of it
+            inner = t[1]
+            if inner is not None and not inner(x, y):
+                checks["inner_blocked"] += 1
+                return False  # in the inner C-space (or out of bounds): blocked at every angle
+            return exact(x, y, th, k)
+
+        if state:
+            return lambda q: free(q[0], q[1], q[2])
+        return free
+
+    def _exact(self, x: float, y: float, th: float, k: int) -> bool:
+        """The exact test at θ (already wrapped): (x, y) against the sums obstacle piece ⊕
+        −(robot piece at θ) of the pairs whose slab piece holds (x, y)."""
+        self.checks["exact_states"] += 1
+        if not self.in_bounds(x, y):
+            return False
+        cs = self.slab(k)
+        packed = cs.packed
+        if not len(packed):
+            return True
+        near = np.flatnonzero((packed.lo[:, 0] <= x) & (packed.hi[:, 0] >= x)
+                              & (packed.lo[:, 1] <= y) & (packed.hi[:, 1] >= y))
+        pairs = set()
+        for s in near.tolist():
+            if packed.point_hits(s, x, y):
+                pairs.update(cs.piece_pairs[s])
+        if not pairs:
+            return True
+        rotated = {}
+        for i, j in sorted(pairs):
+            if j < 0:
+                piece = self.obstacle_pieces[i]
+            else:
+                if j not in rotated:
+                    rotated[j] = reflect(rotate_piece(self.robot_pieces[j], th))
+                piece = minkowski_sum(self.obstacle_pieces[i], rotated[j])
+            if _in_convex(piece, x, y):
+                return False
+        return True
+
+    def robot_at(self, q) -> list[np.ndarray]:
+        """The robot pieces at pose q (the exact test's robot: rotated, then translated).
+
+        >>> cs = SE2CSpace((0, 4, 0, 4), [], [np.array([[0., 0], [1, 0], [0, 1]])], slabs=4)
+        >>> cs.robot_at((1, 1, 0))[0].tolist()
+        [[1.0, 1.0], [2.0, 1.0], [1.0, 2.0]]
+        """
+        th = wrap_angle(float(q[2]))
+        return [rotate_piece(p, th) + np.array([float(q[0]), float(q[1])]) for p in self.robot_pieces]
+
+    # -- motions -----------------------------------------------------------------------
+
+    def motion_free(self, q0, q1) -> bool:
+        """Is every pose of OMPL's SE(2) interpolation from q0 to q1 free? Certified.
+
+        True only if every pose is free (slab certificates or exact sweeps); False on
+        an exact pose in collision, or (counted in ``checks["motion_floor"]``) when
+        refinement reaches its floor without deciding.
+        """
+        self.checks["motions"] += 1
+        x0, y0, a0 = float(q0[0]), float(q0[1]), wrap_angle(float(q0[2]))
+        x1, y1, a1 = float(q1[0]), float(q1[1]), wrap_angle(float(q1[2]))
+        if not (self._pose(x1, y1, a1) and self._pose(x0, y0, a0)):
+            self.checks["motion_collisions"] += 1
+            return False
+        D = _arc(a0, a1)
+        budget = [MAX_REFINE]
+        for ta, tb in self._split(a0, D):
+            self.checks["submotions"] += 1
+            pa = (x0, y0) if ta == 0.0 else (x0 + (x1 - x0) * ta, y0 + (y1 - y0) * ta)
+            pb = (x1, y1) if tb == 1.0 else (x0 + (x1 - x0) * tb, y0 + (y1 - y0) * tb)
+            mid = wrap_angle(a0 + D * (0.5 * (ta + tb)))
+            k = self._slab_index(mid)
+            if self.slab(k).segment_free(pa, pb):
+                self.checks["slab_certified"] += 1
+                continue
+            ok = self._refine((x0, y0, a0), (x1, y1), D, ta, tb, budget)
+            if not ok:
+                return False
+        return True
+
+    def _split(self, a0: float, D: float) -> list[tuple[float, float]]:
+        """Fractions [ta, tb] of the motion whose angles a0 + D t each stay in one slab."""
+        K = self.slabs
+        if D == 0.0 or K == 1:
+            return [(0.0, 1.0)]
+        w = TWO_PI / K
+        a1 = a0 + D
+        lo, hi = min(a0, a1), max(a0, a1)
+        j0, j1 = math.floor((lo + math.pi) / w) + 1, math.ceil((hi + math.pi) / w) - 1
+        cuts = sorted({min(max((-math.pi + j * w - a0) / D, 0.0), 1.0) for j in range(j0, j1 + 1)})
+        ts = [0.0] + [c for c in cuts if 0.0 < c < 1.0] + [1.0]
+        return list(zip(ts[:-1], ts[1:]))
+
+    def _refine(self, p0, p1, D: float, ta: float, tb: float, budget: list) -> bool:
+        """Decide the sub-motion [ta, tb] with swept hulls, halving on a hit (see module doc)."""
+        x0, y0, a0 = p0
+        x1, y1 = p1
+        self.checks["refined"] += 1
+        floor_len = FLOOR_REL * self.extent
+        stack = [(ta, tb)]
+        while stack:
+            sa, sb = stack.pop()
+            pa = (x0, y0) if sa == 0.0 else (x0 + (x1 - x0) * sa, y0 + (y1 - y0) * sa)
+            pb = (x1, y1) if sb == 1.0 else (x0 + (x1 - x0) * sb, y0 + (y1 - y0) * sb)
+            if D == 0.0:
+                if self._translation_hits(pa, pb, a0):
+                    self.checks["motion_collisions"] += 1
+                    return False  # the exact translational answer at a0
+                continue
+            fa, fb = a0 + D * sa, a0 + D * sb
+            lo, hi = min(fa, fb) - ANGLE_SLACK, max(fa, fb) + ANGLE_SLACK
+            budget[0] -= 1
+            self.checks["sweeps"] += 1
+            if not self._sweep_hits(pa, pb, lo, hi):
+                continue
+            sm = 0.5 * (sa + sb)
+            xm, ym, am = x0 + (x1 - x0) * sm, y0 + (y1 - y0) * sm, wrap_angle(a0 + D * sm)
+            if not self._pose(xm, ym, am):
+                self.checks["motion_collisions"] += 1
+                return False  # a real collision
+            size = self.radius * (hi - lo) + math.hypot(pb[0] - pa[0], pb[1] - pa[1])
+            if size <= floor_len or budget[0] <= 0 or not (sa < sm < sb):
+                self.checks["motion_floor"] += 1
+                return False  # undecided at the floor: conservative
+            stack.append((sm, sb))
+            stack.append((sa, sm))
+        return True
+
+    def _sweep_hits(self, pa, pb, lo: float, hi: float) -> bool:
+        """Does some robot piece's hull over [lo, hi], swept along pa-pb, meet an obstacle piece?
+        Exact on the computed sweep (separating axes with the exact predicate)."""
+        seg = np.array([pa, pb], dtype=np.float64)
+        for p in self.robot_pieces:
+            # The hull of a sub-range of a slab is built in unwrapped angles; the rotation
+            # by lo is the rotation by lo ± 2π up to rounding, which the pad covers.
+            sweep = minkowski_sum(slab_hull(p, lo, hi, scale=self.scale), seg)
+            smin, smax = sweep.min(axis=0), sweep.max(axis=0)
+            cand = np.flatnonzero((self._olo[:, 0] <= smax[0]) & (self._ohi[:, 0] >= smin[0])
+                                  & (self._olo[:, 1] <= smax[1]) & (self._ohi[:, 1] >= smin[1]))
+            for i in cand.tolist():
+                if exact_relation(sweep, self.obstacle_pieces[i]) != "separated":
+                    return True
+        return False
+
+    def _translation_hits(self, pa, pb, th: float) -> bool:
+        """Does the segment pa-pb meet a sum obstacle piece ⊕ −(robot piece at θ)? Exact:
+        the translation C-space's own segment semantics at the angle θ."""
+        r = self.radius * (1.0 + 2.0**-40) + self.pad  # rotated vertices may round past r
+        lo = np.minimum(pa, pb) - r
+        hi = np.maximum(pa, pb) + r
+        cand = np.flatnonzero((self._olo[:, 0] <= hi[0]) & (self._ohi[:, 0] >= lo[0])
+                              & (self._olo[:, 1] <= hi[1]) & (self._ohi[:, 1] >= lo[1]))
+        if not cand.size:
+            return False
+        neg = [reflect(rotate_piece(p, th)) for p in self.robot_pieces]
+        sums = [minkowski_sum(self.obstacle_pieces[i], n) for i in cand.tolist() for n in neg]
+        ps = PieceSet(sums)
+        return bool(ps.segment_hits_many(np.arange(len(sums)), pa, pb).any())
+
+    # -- report ------------------------------------------------------------------------
+
+    def report(self) -> dict:
+        """K and its reason, the slabs built (seconds, piece counts) and the query counters."""
+        self.checks["states"] = int(self._states.__reduce__()[1][0])
+        return {
+            "slabs": self.slabs,
+            "slabs_reason": self.slabs_reason,
+            "robot_radius": self.radius,
+            "pad": self.pad,
+            "robot_pieces": len(self.robot_pieces),
+            "obstacle_pieces": len(self.obstacle_pieces),
+            "setup_seconds": self.setup_seconds,
+            "slabs_built": sorted(self._built, key=lambda d: d["slab"]),
+            "build_seconds": sum(d["seconds"] for d in self._built),
+            "checks": dict(self.checks),
+        }
+
+
+def _in_convex(p: np.ndarray, x: float, y: float) -> bool:
+    """Is (x, y) in the closed convex CCW polygon p (at least 3 vertices)? Exact."""
+    pts = p.tolist()
+    px, py = pts[-1]
+    for qx, qy in pts:
+        if orient2d_xy(px, py, qx, qy, x, y) < 0:
+            return False
+        px, py = qx, qy
+    return True
