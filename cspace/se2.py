@@ -191,12 +191,18 @@ class SE2CSpace:
         self._outer: list = [None] * K  # slab k's CSpace (robot = slab hulls)
         self._inner: list = [None] * K  # slab k's certified-blocked CSpace, or False if empty
         self._tests: list = [None] * K  # (outer point test, inner point test or None)
+        self._grids: list = [None] * K  # the one-lookup grid of each slab (see _combined_grid)
         self._built: list[dict] = []
         olo = np.array([p.min(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         ohi = np.array([p.max(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         self._olo, self._ohi = olo, ohi
+        # Plain lists for the float filter of the exact test (see _pair_filter).
+        self.obstacle_lists = [p.tolist() for p in self.obstacle_pieces]
+        self._obstacle_edges = [_edges(p) for p in self.obstacle_pieces]
+        self._robot_lists = [p.tolist() for p in self.robot_pieces]
+        self._robot_normals = [[(nx, ny) for nx, ny, _, _ in _edges(p)] for p in self.robot_pieces]
         self.checks = {"states": 0, "exact_states": 0, "inner_blocked": 0, "motions": 0, "motion_collisions": 0,
-                       "motion_floor": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
+                       "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
         self._states = itertools.count()
         self._pose = self.pose_test(self._states.__next__)
         self.setup_seconds = time.perf_counter() - t0
@@ -234,6 +240,7 @@ class SE2CSpace:
             outer = CSpace(self.bounds, self.obstacle_pieces, [], grid_cells=self.grid_cells)
             self._outer[k], self._inner[k] = outer, False
             self._tests[k] = (outer.point_test(), None)
+            self._grids[k] = self._combined_grid(k, outer, None)
             self._built.append({"slab": k, "seconds": time.perf_counter() - t, "pieces": len(outer.pieces),
                                 "inner_pieces": 0})
             return
@@ -242,12 +249,45 @@ class SE2CSpace:
         outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells)
         t_outer = time.perf_counter() - t
         inner_pieces = self._inner_pieces(a, b)
-        inner = (CSpace(self.bounds, self.obstacle_pieces, inner_pieces, grid_cells=self.grid_cells)
+        g = outer.index
+        inner = (CSpace(self.bounds, self.obstacle_pieces, inner_pieces, grid_cells=g.nx * g.ny)
                  if inner_pieces and self.obstacle_pieces else False)
         self._outer[k], self._inner[k] = outer, inner
         self._tests[k] = (outer.point_test(), inner.point_test() if inner else None)
+        self._grids[k] = self._combined_grid(k, outer, inner)
         self._built.append({"slab": k, "seconds": time.perf_counter() - t, "outer_seconds": t_outer,
                             "pieces": len(outer.pieces), "inner_pieces": len(inner.pieces) if inner else 0})
+
+    def _combined_grid(self, k: int, outer: CSpace, inner) -> tuple:
+        """Slab k's one-lookup grid: per cell 0 (FREE in the slab C-space: free at every
+        angle), 2 (BLOCKED in the inner C-space: blocked at every angle) or 1 (ask
+        :meth:`_slow`), one bytes object per row with a border cell (3) at its end and a
+        border row after the last, as in :meth:`CSpace.point_test`. The inner grid is
+        built with the outer grid's cells; if its geometry differs, only FREE is used."""
+        from .broadphase import BLOCKED, FREE
+
+        g = outer.index
+        state = np.where(g.state == FREE, 0, 1).astype(np.uint8)
+        if inner:
+            h = inner.index
+            if (h.nx, h.ny, h.x0, h.y0, h.inv_w, h.inv_h) == (g.nx, g.ny, g.x0, g.y0, g.inv_w, g.inv_h):
+                state[(h.state == BLOCKED) & (state == 1)] = 2
+        flat = state.tobytes()
+        nx, ny = g.nx, g.ny
+        rows = [flat[r * nx:(r + 1) * nx] + b"\x03" for r in range(ny)] + [b"\x03" * (nx + 1)]
+        outer_test, inner_test = self._tests[k]
+        exact = self._exact
+        checks = self.checks
+
+        def slow(x: float, y: float, th: float) -> bool:
+            if outer_test(x, y):
+                return True  # free in the slab: free at every angle of it
+            if inner_test is not None and not inner_test(x, y):
+                checks["inner_blocked"] += 1
+                return False  # in the inner C-space (or out of bounds): blocked at every angle
+            return exact(x, y, th, k)
+
+        return rows, g.inv_w, g.x0 * g.inv_w, g.inv_h, g.y0 * g.inv_h, slow
 
     def _inner_pieces(self, a: float, b: float) -> list[np.ndarray]:
         """Convex sets inside every robot piece at every angle of [a, b] (certified blocked).
@@ -323,34 +363,46 @@ class SE2CSpace:
         """
         K = self.slabs
         per = K / TWO_PI
-        lo, hi, tests = self._lo, self._hi, self._tests
-        build, exact = self._build, self._exact
+        lo, hi, grids = self._lo, self._hi, self._grids
+        build = self._build
         pi, wrap, slab_of_ = math.pi, wrap_angle, self._slab_index
-        count = int if tick is None else tick
+        count = int if tick is None else tick  # int() is a C-level no-op
         floor = math.floor
-        checks = self.checks
 
-        def free(x, y, th) -> bool:
+        def free_q(q) -> bool:
             count()
+            x = q[0]
+            y = q[1]
+            th = q[2]
             if not -pi <= th < pi:
                 th = wrap(th)
-            k = floor((th + pi) * per) if K > 1 else 0
-            if k >= K or not lo[k] <= th <= hi[k]:
+            k = floor((th + pi) * per)
+            if k >= K or not lo[k] <= th <= hi[k]:  # the float index is certified by two comparisons
                 k = slab_of_(th)
-            t = tests[k]
-            if t is None:
+            g = grids[k]
+            if g is None:
                 build(k)
-                t = tests[k]
-            if t[0](x, y):
-                return True  # free in the slab: free at every angle of it
-            inner = t[1]
-            if inner is not None and not inner(x, y):
-                checks["inner_blocked"] += 1
-                return False  # in the inner C-space (or out of bounds): blocked at every angle
-            return exact(x, y, th, k)
+                g = grids[k]
+            rows, iw, a0, ih, b0, slow = g
+            i = x * iw - a0
+            j = y * ih - b0
+            if i >= 0.0 and j >= 0.0:  # also False for NaN
+                try:
+                    c = rows[floor(j)][floor(i)]
+                except (IndexError, OverflowError):
+                    return slow(x, y, th)  # off the grid's top or right
+                if not c:
+                    return True  # FREE in the slab C-space
+                if c == 2:
+                    return False  # BLOCKED in the inner C-space
+            return slow(x, y, th)
 
         if state:
-            return lambda q: free(q[0], q[1], q[2])
+            return free_q
+
+        def free(x: float, y: float, th: float) -> bool:
+            return free_q((x, y, th))
+
         return free
 
     def _exact(self, x: float, y: float, th: float, k: int) -> bool:
@@ -363,24 +415,41 @@ class SE2CSpace:
         packed = cs.packed
         if not len(packed):
             return True
-        near = np.flatnonzero((packed.lo[:, 0] <= x) & (packed.hi[:, 0] >= x)
-                              & (packed.lo[:, 1] <= y) & (packed.hi[:, 1] >= y))
-        pairs = set()
-        for s in near.tolist():
-            if packed.point_hits(s, x, y):
-                pairs.update(cs.piece_pairs[s])
-        if not pairs:
-            return True
-        rotated = {}
-        for i, j in sorted(pairs):
-            if j < 0:
-                piece = self.obstacle_pieces[i]
-            else:
-                if j not in rotated:
-                    rotated[j] = reflect(rotate_piece(self.robot_pieces[j], th))
-                piece = minkowski_sum(self.obstacle_pieces[i], rotated[j])
-            if _in_convex(piece, x, y):
-                return False
+        cell = cs.index.cell_of(x, y)
+        if cs.index.state_list[cell] == 1:  # MIXED: the cell's candidates are every piece meeting it
+            near = cs.index.candidates(cell).tolist()
+        else:  # BLOCKED cells keep one blocker only: every piece whose box holds (x, y)
+            near = np.flatnonzero((packed.lo[:, 0] <= x) & (packed.hi[:, 0] >= x)
+                                  & (packed.lo[:, 1] <= y) & (packed.hi[:, 1] >= y)).tolist()
+        # Every pair whose sum holds (x, y) is listed under a slab piece holding it, and
+        # that piece is among ``near``; the float filter decides almost every pair.
+        c, sn = math.cos(th), math.sin(th)
+        rotated: dict = {}
+        seen = set()
+        margin = self.pad
+        for s in near:
+            for pair in cs.piece_pairs[s]:
+                if pair in seen:
+                    continue
+                seen.add(pair)
+                i, j = pair
+                if j < 0:
+                    if _in_convex(self.obstacle_pieces[i], x, y):
+                        return False
+                    continue
+                r = rotated.get(j)
+                if r is None:  # rotate() in scalars: the same IEEE operations, the same doubles
+                    r = rotated[j] = [(vx * c - vy * sn + 0.0, vx * sn + vy * c + 0.0) for vx, vy in self._robot_lists[j]]
+                side = _pair_filter(self._obstacle_edges[i], self.obstacle_lists[i], r, self._robot_normals[j],
+                                    c, sn, x, y, margin)
+                if side < 0:
+                    return False  # inside the sum by more than its rounding: the exact answer too
+                if side > 0:
+                    continue  # outside by more than the rounding
+                self.checks["exact_sums"] += 1
+                neg = reflect(rotate_piece(self.robot_pieces[j], th))
+                if _in_convex(minkowski_sum(self.obstacle_pieces[i], neg), x, y):
+                    return False
         return True
 
     def robot_at(self, q) -> list[np.ndarray]:
@@ -531,3 +600,52 @@ def _in_convex(p: np.ndarray, x: float, y: float) -> bool:
             return False
         px, py = qx, qy
     return True
+
+
+def _edges(p: np.ndarray) -> list[tuple[float, float, float, float]]:
+    """Per edge of a CCW polygon: outward normal (dy, −dx), offset n·start, and |n|."""
+    pts = p.tolist()
+    out = []
+    px, py = pts[-1]
+    for qx, qy in pts:
+        nx, ny = qy - py, px - qx
+        out.append((nx, ny, nx * px + ny * py, math.hypot(nx, ny)))
+        px, py = qx, qy
+    return out
+
+
+def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_normals: list, c: float, s: float,
+                 x: float, y: float, margin: float) -> int:
+    """Float filter for "is (x, y) in O ⊕ −R'" (R' the robot piece at θ, rotated vertices
+    ``r_pts``, body normals ``r_normals`` turned by (c, s)): +1 outside, −1 inside, 0 unsure.
+
+    The sum's edge normals are O's and −R''s. For each such n, g(n) = n·p − h_O(n) −
+    h_{−R'}(n) > 0 puts p outside (for ANY direction n); g(n) < 0 for every edge normal
+    puts it inside. Decisions are taken only with |g| > margin·|n|, the margin (the
+    slab pad, 512 units of roundoff of the magnitudes) far above the float error of g,
+    of the turned normals, and of the rounded vertices of the computed sum, so a
+    decided answer is also the exact test's answer.
+    """
+    inside = True
+    for nx, ny, off, ln in o_edges:  # O's normals: h_{−R'}(n) = max over r of −n·r
+        h = max(-(nx * rx + ny * ry) for rx, ry in r_pts)
+        g = nx * x + ny * y - off - h
+        m = margin * ln
+        if g > m:
+            return 1
+        if g >= -m:
+            inside = False
+    k = len(r_pts)
+    for e, (bx, by) in enumerate(r_normals):
+        nx, ny = -(bx * c - by * s), -(bx * s + by * c)  # −R''s outward normal: minus R''s
+        rx, ry = r_pts[e]  # a vertex on that edge of R' (edge e ends at vertex e)
+        h_r = -(nx * rx + ny * ry)  # h_{−R'}(n) = n·(−r_e)
+        h_o = max(nx * ox + ny * oy for ox, oy in o_pts)
+        g = nx * x + ny * y - h_o - h_r
+        m = margin * math.hypot(nx, ny)
+        if g > m:
+            return 1
+        if g >= -m:
+            inside = False
+    del k
+    return -1 if inside else 0

@@ -23,7 +23,8 @@ import numpy as np
 
 from .hull import convex_hull
 from .minkowski import minkowski_sum
-from .polygon import as_array, is_convex
+from .polygon import as_array
+from .predicates import orient2d_xy
 
 TWO_PI = 2.0 * math.pi
 # Every slab's hull interval is widened by this much on both sides, so an angle within
@@ -67,7 +68,16 @@ def rotate_piece(piece: np.ndarray, theta: float) -> np.ndarray:
     [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
     """
     r = rotate(piece, theta)
-    return r if len(r) < 3 or is_convex(r, strict=True) else convex_hull(r)
+    if len(r) < 3:
+        return r
+    # A rotated convex piece winds once; strict left turns everywhere (exact predicate) keep it convex.
+    pts = r.tolist()
+    (ax, ay), (bx, by) = pts[-2], pts[-1]
+    for cx, cy in pts:
+        if orient2d_xy(ax, ay, bx, by, cx, cy) <= 0:
+            return convex_hull(r)
+        ax, ay, bx, by = bx, by, cx, cy
+    return r
 
 
 def wrap_angle(theta: float) -> float:
