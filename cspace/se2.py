@@ -488,6 +488,9 @@ class SE2CSpace:
             if self.slab(k).segment_free(pa, pb):
                 self.checks["slab_certified"] += 1
                 continue
+            if not self.robot_pieces:  # a point robot: the one slab is the exact C-space
+                self.checks["motion_collisions"] += 1
+                return False
             ok = self._refine((x0, y0, a0), (x1, y1), D, ta, tb, budget)
             if not ok:
                 return False
