@@ -34,9 +34,9 @@ import time
 
 import numpy as np
 
+from .broadphase import GridIndex
 from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
 from .gjk import exact_relation
-from .halfplane import erode
 from .minkowski import minkowski_sum, reflect
 from .pieces import PieceSet
 from .predicates import orient2d_xy
@@ -189,9 +189,10 @@ class SE2CSpace:
         self._lo = [slab_range(k, K)[0] - ANGLE_SLACK for k in range(K)] if K > 1 else [-math.inf]
         self._hi = [slab_range(k, K)[1] + ANGLE_SLACK for k in range(K)] if K > 1 else [math.inf]
         self._outer: list = [None] * K  # slab k's CSpace (robot = slab hulls)
-        self._inner: list = [None] * K  # slab k's certified-blocked CSpace, or False if empty
-        self._tests: list = [None] * K  # (outer point test, inner point test or None)
+        self._inner: list = [None] * K  # slab k's certified-blocked grid (GridIndex), or False if empty
+        self._tests: list = [None] * K  # (outer point test, None)
         self._grids: list = [None] * K  # the one-lookup grid of each slab (see _combined_grid)
+        self._pair_cache: list[dict] = [{} for _ in range(K)]  # slab -> cell -> pairs (see _cell_pairs)
         self._built: list[dict] = []
         olo = np.array([p.min(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         ohi = np.array([p.max(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
@@ -201,7 +202,7 @@ class SE2CSpace:
         self._obstacle_edges = [_edges(p) for p in self.obstacle_pieces]
         self._robot_lists = [p.tolist() for p in self.robot_pieces]
         self._robot_normals = [[(nx, ny) for nx, ny, _, _ in _edges(p)] for p in self.robot_pieces]
-        self.checks = {"states": 0, "exact_states": 0, "inner_blocked": 0, "motions": 0, "motion_collisions": 0,
+        self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
                        "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
         self._states = itertools.count()
         self._pose = self.pose_test(self._states.__next__)
@@ -250,13 +251,18 @@ class SE2CSpace:
         t_outer = time.perf_counter() - t
         inner_pieces = self._inner_pieces(a, b)
         g = outer.index
-        inner = (CSpace(self.bounds, self.obstacle_pieces, inner_pieces, grid_cells=g.nx * g.ny)
-                 if inner_pieces and self.obstacle_pieces else False)
+        inner = False
+        if inner_pieces and self.obstacle_pieces:
+            # Only the inner grid's BLOCKED cells are used (everything else goes to the
+            # exact test), so the inner set is a grid over its sums, not a whole CSpace.
+            neg = [reflect(p) for p in inner_pieces]
+            sums = [minkowski_sum(o, r) for o in self.obstacle_pieces for r in neg]
+            inner = GridIndex(sums, self.bounds, cells=g.nx * g.ny)
         self._outer[k], self._inner[k] = outer, inner
-        self._tests[k] = (outer.point_test(), inner.point_test() if inner else None)
+        self._tests[k] = (outer.point_test(), None)
         self._grids[k] = self._combined_grid(k, outer, inner)
         self._built.append({"slab": k, "seconds": time.perf_counter() - t, "outer_seconds": t_outer,
-                            "pieces": len(outer.pieces), "inner_pieces": len(inner.pieces) if inner else 0})
+                            "pieces": len(outer.pieces), "inner_pieces": len(inner_pieces)})
 
     def _combined_grid(self, k: int, outer: CSpace, inner) -> tuple:
         """Slab k's one-lookup grid: per cell 0 (FREE in the slab C-space: free at every
@@ -269,22 +275,19 @@ class SE2CSpace:
         g = outer.index
         state = np.where(g.state == FREE, 0, 1).astype(np.uint8)
         if inner:
-            h = inner.index
+            h = inner
             if (h.nx, h.ny, h.x0, h.y0, h.inv_w, h.inv_h) == (g.nx, g.ny, g.x0, g.y0, g.inv_w, g.inv_h):
                 state[(h.state == BLOCKED) & (state == 1)] = 2
         flat = state.tobytes()
         nx, ny = g.nx, g.ny
         rows = [flat[r * nx:(r + 1) * nx] + b"\x03" for r in range(ny)] + [b"\x03" * (nx + 1)]
-        outer_test, inner_test = self._tests[k]
-        exact = self._exact
-        checks = self.checks
+        outer_test = self._tests[k][0]
+        # A point robot's one slab is its exact C-space: its point test is the answer.
+        exact = self._exact if self.robot_pieces else (lambda x, y, th, k: False)
 
         def slow(x: float, y: float, th: float) -> bool:
             if outer_test(x, y):
                 return True  # free in the slab: free at every angle of it
-            if inner_test is not None and not inner_test(x, y):
-                checks["inner_blocked"] += 1
-                return False  # in the inner C-space (or out of bounds): blocked at every angle
             return exact(x, y, th, k)
 
         return rows, g.inv_w, g.x0 * g.inv_w, g.inv_h, g.y0 * g.inv_h, slow
@@ -292,44 +295,41 @@ class SE2CSpace:
     def _inner_pieces(self, a: float, b: float) -> list[np.ndarray]:
         """Convex sets inside every robot piece at every angle of [a, b] (certified blocked).
 
-        A point u with |u| <= ρ moves by at most d(ρ) = 2ρ sin(h/2) when the robot turns
-        by h = (b − a)/2 about the middle angle m, and R_m u = R_θ (R_{m−θ} u). So if u
-        lies in P eroded by the disk of radius d(ρ) and |u| <= ρ, then R_m u is in R_θ P
-        for every θ of the slab: I = R_m((P ⊖ square of half-side d(ρ)) ∩ G(ρ)), G(ρ)
-        a 16-gon inside the disk of radius ρ. d is grown by a relative 2^-40 and four
-        slab pads (the rounding of the erosion, the clipping, the rotations and the
-        C-space sums). Of ρ = r, r/√2, r/2, ... the largest I is kept (a long thin
-        piece keeps its middle part: its ends sweep far).
+        Write θ = m + φ, |φ| <= h (m the middle, h the half-width). R_θ P = R_m R_φ P and
+        R_φ P = ∩_e {x : (R_φ n_e)·x <= c_e} over P's edges (outward normal n_e, offset
+        c_e). For one edge, x = |x|(cos α, sin α) relative to n_e, (R_φ n_e)·x =
+        |x| cos(φ − α) is largest over the interval at an end, or at φ = α if α is in it.
+        So J = ∩_φ R_φ P is cut by the two end half-planes (φ = ±h) of every edge, and,
+        for c_e >= 0, by |x| <= c_e on the wedge |α| <= h, which the chord half-plane
+        n_e·x <= c_e cos h implies (there |x| cos h <= |x| cos α = n_e·x). (For c_e < 0
+        the end half-planes already exclude the wedge: 2h < π/2.) Every offset is
+        lowered by four slab pads times |n_e| (the rounding of the turned normals, of
+        the float clipping, of the final rotation and of the C-space sums), and
+        I = R_m J.
         """
-        import shapely
-
-        from .hull import convex_hull
-        from .slab import inscribed_polygon
-
         half = 0.5 * (b - a)
         m = a + half
+        ch, sh = math.cos(half), math.sin(half)
         out = []
         for p in self.robot_pieces:
             r = float(np.hypot(p[:, 0], p[:, 1]).max())
-            best, best_area = None, 0.0
-            for rho in (r, r * 0.7071, r * 0.5, r * 0.3536, r * 0.25):
-                d = 2.0 * rho * math.sin(0.5 * half) * (1.0 + 2.0**-40) + 4.0 * self.pad
-                sq = np.array([[-d, -d], [d, -d], [d, d], [-d, d]])
-                e = erode(p, sq)
-                if len(e) < 3:
-                    continue
-                if rho < r:
-                    g = shapely.Polygon(e).intersection(shapely.Polygon(inscribed_polygon(rho, 16)))
-                    if g.is_empty or g.geom_type != "Polygon" or g.area <= 0.0:
-                        continue
-                    e = convex_hull(np.asarray(g.exterior.coords)[:-1])
-                    if len(e) < 3:
-                        continue
-                area = float(shapely.Polygon(e).area)
-                if area > best_area:
-                    best, best_area = e, area
-            if best is not None:
-                out.append(rotate_piece(best, m))
+            box = 2.0 * r + 1.0
+            poly = [(-box, -box), (box, -box), (box, box), (-box, box)]
+            for nx, ny, c, ln in _edges(p):
+                c_safe = c - 4.0 * self.pad * ln
+                for ux, uy, off in ((nx * ch - ny * sh, nx * sh + ny * ch, c_safe),
+                                    (nx * ch + ny * sh, -nx * sh + ny * ch, c_safe),
+                                    (nx, ny, c * ch - 4.0 * self.pad * ln if c >= 0.0 else None)):
+                    if off is not None:
+                        poly = _clip_halfplane(poly, ux, uy, off)
+                if len(poly) < 3:
+                    break
+            if len(poly) >= 3:
+                from .hull import convex_hull
+
+                j = convex_hull(np.array(poly))
+                if len(j) >= 3:
+                    out.append(rotate_piece(j, m))
         return out
 
     def _slab_index(self, th: float) -> int:
@@ -411,46 +411,55 @@ class SE2CSpace:
         self.checks["exact_states"] += 1
         if not self.in_bounds(x, y):
             return False
-        cs = self.slab(k)
-        packed = cs.packed
-        if not len(packed):
-            return True
-        cell = cs.index.cell_of(x, y)
-        if cs.index.state_list[cell] == 1:  # MIXED: the cell's candidates are every piece meeting it
-            near = cs.index.candidates(cell).tolist()
-        else:  # BLOCKED cells keep one blocker only: every piece whose box holds (x, y)
-            near = np.flatnonzero((packed.lo[:, 0] <= x) & (packed.hi[:, 0] >= x)
-                                  & (packed.lo[:, 1] <= y) & (packed.hi[:, 1] >= y)).tolist()
-        # Every pair whose sum holds (x, y) is listed under a slab piece holding it, and
-        # that piece is among ``near``; the float filter decides almost every pair.
         c, sn = math.cos(th), math.sin(th)
         rotated: dict = {}
-        seen = set()
         margin = self.pad
-        for s in near:
-            for pair in cs.piece_pairs[s]:
-                if pair in seen:
-                    continue
-                seen.add(pair)
-                i, j = pair
-                if j < 0:
-                    if _in_convex(self.obstacle_pieces[i], x, y):
-                        return False
-                    continue
-                r = rotated.get(j)
-                if r is None:  # rotate() in scalars: the same IEEE operations, the same doubles
-                    r = rotated[j] = [(vx * c - vy * sn + 0.0, vx * sn + vy * c + 0.0) for vx, vy in self._robot_lists[j]]
-                side = _pair_filter(self._obstacle_edges[i], self.obstacle_lists[i], r, self._robot_normals[j],
-                                    c, sn, x, y, margin)
-                if side < 0:
-                    return False  # inside the sum by more than its rounding: the exact answer too
-                if side > 0:
-                    continue  # outside by more than the rounding
-                self.checks["exact_sums"] += 1
-                neg = reflect(rotate_piece(self.robot_pieces[j], th))
-                if _in_convex(minkowski_sum(self.obstacle_pieces[i], neg), x, y):
-                    return False
+        for i, j, o_edges, o_pts, r_normals in self._cell_pairs(k, x, y):
+            r = rotated.get(j)
+            if r is None:  # rotate() in scalars: the same IEEE operations, the same doubles
+                r = rotated[j] = [(vx * c - vy * sn + 0.0, vx * sn + vy * c + 0.0) for vx, vy in self._robot_lists[j]]
+            side = _pair_filter(o_edges, o_pts, r, r_normals, c, sn, x, y, margin)
+            if side < 0:
+                return False  # inside the sum by more than its rounding: the exact answer too
+            if side > 0:
+                continue  # outside by more than the rounding
+            self.checks["exact_sums"] += 1
+            neg = reflect(rotate_piece(self.robot_pieces[j], th))
+            if _in_convex(minkowski_sum(self.obstacle_pieces[i], neg), x, y):
+                return False
         return True
+
+    def _cell_pairs(self, k: int, x: float, y: float) -> list:
+        """The (obstacle piece, robot piece) pairs of every slab-k piece that may meet the
+        grid cell of (x, y), with their filter data; cached per (slab, cell).
+
+        A pair whose sum holds (x, y) has its sum inside a slab piece holding (x, y)
+        (the slab hull holds the robot piece at θ, with the pad for the rounding), and
+        that piece meets the cell: a MIXED cell lists every piece within the grid's
+        margin of it; for a BLOCKED cell (which keeps one blocker) the pieces whose
+        box meets the cell's box widened by the margin are taken.
+        """
+        cs = self._outer[k]
+        g = cs.index
+        cell = g.cell_of(x, y)
+        cache = self._pair_cache[k]
+        got = cache.get(cell)
+        if got is not None:
+            return got
+        if g.state_list[cell] == 1:
+            near = g.candidates(cell).tolist()
+        else:
+            ci, cj = cell % g.nx, cell // g.nx
+            m = g.margin
+            x0, x1 = g.x0 + ci * g.cw - m, g.x0 + (ci + 1) * g.cw + m
+            y0, y1 = g.y0 + cj * g.ch - m, g.y0 + (cj + 1) * g.ch + m
+            pk = cs.packed
+            near = np.flatnonzero((pk.lo[:, 0] <= x1) & (pk.hi[:, 0] >= x0)
+                                  & (pk.lo[:, 1] <= y1) & (pk.hi[:, 1] >= y0)).tolist()
+        pairs = sorted({pair for s in near for pair in cs.piece_pairs[s]})
+        got = [(i, j, self._obstacle_edges[i], self.obstacle_lists[i], self._robot_normals[j]) for i, j in pairs]
+        cache[cell] = got
+        return got
 
     def robot_at(self, q) -> list[np.ndarray]:
         """The robot pieces at pose q (the exact test's robot: rotated, then translated).
@@ -652,3 +661,23 @@ def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_normals: list, c: fl
             inside = False
     del k
     return -1 if inside else 0
+
+
+def _clip_halfplane(poly: list, nx: float, ny: float, c: float) -> list:
+    """The part of a convex polygon (list of points) where n·x <= c, in floats
+    (Sutherland–Hodgman on one edge; the caller's margins cover the rounding)."""
+    out = []
+    k = len(poly)
+    for t in range(k):
+        px, py = poly[t - 1]
+        qx, qy = poly[t]
+        fp, fq = nx * px + ny * py - c, nx * qx + ny * qy - c
+        if fq <= 0.0:
+            if fp > 0.0:
+                s = fp / (fp - fq)
+                out.append((px + (qx - px) * s, py + (qy - py) * s))
+            out.append((qx, qy))
+        elif fp <= 0.0:
+            s = fp / (fp - fq)
+            out.append((px + (qx - px) * s, py + (qy - py) * s))
+    return out
