@@ -49,6 +49,10 @@ from .slab import (ANGLE_SLACK, TWO_PI, rotate, rotate_piece, slab_hull, slab_of
 FLOOR_REL = 1e-9
 # ... or after this many swept hulls for one motion (never a hang).
 MAX_REFINE = 2048
+# Grid cells of each slab's C-space (unless grid_cells is given): a quarter of the
+# translation C-space's default. The grid build dominates a slab's cost (K of them),
+# and the SE(2) hot path reads the slab grid once per state either way.
+SLAB_GRID_CELLS = 1 << 14
 
 
 def interpolate(q0, q1, t: float) -> tuple[float, float, float]:
@@ -100,22 +104,26 @@ def default_slabs(robot_radius: float, extent: float, gap: float | None = None) 
     """K, the number of slabs, and a one-line reason.
 
     In a slab of width Δ = 2π/K a robot point at radius r sweeps a chord of about
-    r·Δ, so each slab C-obstacle is thicker than the C-obstacle at one angle by up
-    to about r·Δ (plus r·Δ²/4, the hull's excess over the two end poses). States
-    and motions in that band are not certified by the slab grid and take the slow
-    exact route, so the band should be a small fraction of the scene's typical gap
-    g: K is the smallest power of two with r·2π/K <= g/4. Each slab costs two
-    translational C-space builds (outer and inner), built lazily, so K is clamped
-    to [16, 64]: beyond 64 the build time grows linearly while the band is already
-    well below the gaps of the bundled scenes. ``gap`` defaults to extent / 8.
+    r·Δ, so the slab C-obstacles are thicker than the C-obstacle at one angle by up
+    to about r·Δ (plus r·Δ²/4, the hull's excess over the two end poses), and the
+    inner (certified blocked) ones thinner by about as much. States in that band
+    take the exact test (~20x a grid lookup) and motions through it are refined, so
+    the validity cost grows with r·Δ / g, g the scene's typical gap: K is the
+    smallest power of two with r·2π/K <= g/8 (measured on the bundled scenes: an
+    exact-test share of a few per cent of uniform states). Each slab costs a
+    translational C-space build plus an inner grid (~50-200 ms on the bundled
+    scenes), paid lazily on first use, so K is clamped to [16, 64]: beyond 64 the
+    build time dominates a planning run while the band is already a small
+    fraction of the gaps. Tightness (the hull excess, ~r·Δ²/4) is then below 1 %
+    of r. ``gap`` defaults to extent / 8 and is capped there.
 
     >>> default_slabs(1.0, 10.0)[0], default_slabs(0.1, 10.0)[0], default_slabs(5.0, 10.0)[0]
-    (32, 16, 64)
+    (64, 16, 64)
     """
     g = extent / 8.0 if gap is None or not gap > 0.0 else min(gap, extent / 8.0)
     if robot_radius <= 0.0:
         return 1, "K = 1: a point robot does not turn"
-    need = TWO_PI * robot_radius / (0.25 * g)
+    need = TWO_PI * robot_radius / (g / 8.0)
     k = 16
     while k < need and k < 64:
         k *= 2
@@ -201,7 +209,7 @@ class SE2CSpace:
         self.obstacle_lists = [p.tolist() for p in self.obstacle_pieces]
         self._obstacle_edges = [_edges(p) for p in self.obstacle_pieces]
         self._robot_lists = [p.tolist() for p in self.robot_pieces]
-        self._robot_normals = [[(nx, ny) for nx, ny, _, _ in _edges(p)] for p in self.robot_pieces]
+        self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
         self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
                        "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
         self._states = itertools.count()
@@ -247,7 +255,7 @@ class SE2CSpace:
             return
         a, b = self._lo[k], self._hi[k]
         hulls = [slab_hull(p, a, b, scale=self.scale) for p in self.robot_pieces]
-        outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells)
+        outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells or SLAB_GRID_CELLS)
         t_outer = time.perf_counter() - t
         inner_pieces = self._inner_pieces(a, b)
         g = outer.index
@@ -415,10 +423,14 @@ class SE2CSpace:
         rotated: dict = {}
         margin = self.pad
         for i, j, o_edges, o_pts, r_normals in self._cell_pairs(k, x, y):
-            r = rotated.get(j)
-            if r is None:  # rotate() in scalars: the same IEEE operations, the same doubles
-                r = rotated[j] = [(vx * c - vy * sn + 0.0, vx * sn + vy * c + 0.0) for vx, vy in self._robot_lists[j]]
-            side = _pair_filter(o_edges, o_pts, r, r_normals, c, sn, x, y, margin)
+            got = rotated.get(j)
+            if got is None:  # rotate() in scalars: the same IEEE operations, the same doubles
+                r = [(vx * c - vy * sn + 0.0, vx * sn + vy * c + 0.0) for vx, vy in self._robot_lists[j]]
+                # −R''s outward normals: minus R''s (the body normals turned); edge e ends at vertex e.
+                axes = [(-(bx * c - by * sn), -(bx * sn + by * c), r[e][0], r[e][1], ln)
+                        for e, (bx, by, ln) in enumerate(r_normals)]
+                got = rotated[j] = (r, axes)
+            side = _pair_filter(o_edges, o_pts, got[0], got[1], x, y, margin)
             if side < 0:
                 return False  # inside the sum by more than its rounding: the exact answer too
             if side > 0:
@@ -626,10 +638,10 @@ def _edges(p: np.ndarray) -> list[tuple[float, float, float, float]]:
     return out
 
 
-def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_normals: list, c: float, s: float,
-                 x: float, y: float, margin: float) -> int:
-    """Float filter for "is (x, y) in O ⊕ −R'" (R' the robot piece at θ, rotated vertices
-    ``r_pts``, body normals ``r_normals`` turned by (c, s)): +1 outside, −1 inside, 0 unsure.
+def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_axes: list, x: float, y: float, margin: float) -> int:
+    """Float filter for "is (x, y) in O ⊕ −R'" (R' the robot piece at θ: rotated vertices
+    ``r_pts``; ``r_axes`` the outward normals of −R' with a vertex of R' on each edge and
+    the normal's length): +1 outside, −1 inside, 0 unsure.
 
     The sum's edge normals are O's and −R''s. For each such n, g(n) = n·p − h_O(n) −
     h_{−R'}(n) > 0 puts p outside (for ANY direction n); g(n) < 0 for every edge normal
@@ -639,27 +651,30 @@ def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_normals: list, c: fl
     decided answer is also the exact test's answer.
     """
     inside = True
-    for nx, ny, off, ln in o_edges:  # O's normals: h_{−R'}(n) = max over r of −n·r
-        h = max(-(nx * rx + ny * ry) for rx, ry in r_pts)
-        g = nx * x + ny * y - off - h
+    for nx, ny, off, ln in o_edges:  # O's normals: h_{−R'}(n) = −min over r of n·r
+        lo = math.inf
+        for rx, ry in r_pts:
+            v = nx * rx + ny * ry
+            if v < lo:
+                lo = v
+        g = nx * x + ny * y - off + lo
         m = margin * ln
         if g > m:
             return 1
         if g >= -m:
             inside = False
-    k = len(r_pts)
-    for e, (bx, by) in enumerate(r_normals):
-        nx, ny = -(bx * c - by * s), -(bx * s + by * c)  # −R''s outward normal: minus R''s
-        rx, ry = r_pts[e]  # a vertex on that edge of R' (edge e ends at vertex e)
-        h_r = -(nx * rx + ny * ry)  # h_{−R'}(n) = n·(−r_e)
-        h_o = max(nx * ox + ny * oy for ox, oy in o_pts)
-        g = nx * x + ny * y - h_o - h_r
-        m = margin * math.hypot(nx, ny)
+    for nx, ny, rx, ry, ln in r_axes:  # −R''s normals: h_{−R'}(n) = n·(−r_e), h_O(n) = max n·o
+        hi = -math.inf
+        for ox, oy in o_pts:
+            v = nx * ox + ny * oy
+            if v > hi:
+                hi = v
+        g = nx * x + ny * y - hi + (nx * rx + ny * ry)
+        m = margin * ln
         if g > m:
             return 1
         if g >= -m:
             inside = False
-    del k
     return -1 if inside else 0
 
 
