@@ -257,6 +257,9 @@ class SE2CSpace:
         hulls = [slab_hull(p, a, b, scale=self.scale) for p in self.robot_pieces]
         outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells or SLAB_GRID_CELLS)
         t_outer = time.perf_counter() - t
+        if len(outer.obstacle_pieces) != len(self.obstacle_pieces) or len(outer.robot_pieces) != len(hulls):
+            # piece_pairs index our pieces: the slab must keep them as given (they are convex)
+            raise RuntimeError("SE2CSpace: a slab re-decomposed a convex piece")  # pragma: no cover
         inner_pieces = self._inner_pieces(a, b)
         g = outer.index
         inner = False
@@ -321,7 +324,7 @@ class SE2CSpace:
         out = []
         for p in self.robot_pieces:
             r = float(np.hypot(p[:, 0], p[:, 1]).max())
-            box = 2.0 * r + 1.0
+            box = 2.0 * r  # the piece lies within radius r: the clipping's rounding stays ~u·r
             poly = [(-box, -box), (box, -box), (box, box), (-box, box)]
             for nx, ny, c, ln in _edges(p):
                 c_safe = c - 4.0 * self.pad * ln

@@ -217,3 +217,55 @@ def test_point_robot_and_default_slabs():
     assert default_slabs(10.0, 20.0)[0] == 64 and default_slabs(0.01, 20.0)[0] == 16
     with pytest.raises(ValueError):
         SE2CSpace((0, 10, 0, 10), [sq], [BAR], slabs=2)
+
+
+def test_inner_sets_are_inside_the_robot_at_every_angle_of_their_slab():
+    """The certified-blocked inner set of each slab lies in rotate_piece(piece, θ) at every θ of the slab
+    (dense θ plus both widened ends; exact predicate on the float vertices)."""
+    from cspace.predicates import orient2d_xy
+
+    u = _scene("u_robot.toml")
+    pieces = [BAR, np.array([[0.3, -0.2], [1.0, 0.1], [0.2, 0.6]])] + [p.polygon for p in u.robot]
+    cs = SE2CSpace((0, 10, 0, 10), [np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]])], pieces, slabs=16)
+    rng = np.random.default_rng(16)
+    for k in range(16):
+        a, b = cs._lo[k], cs._hi[k]
+        inner = cs._inner_pieces(a, b)
+        assert len(inner) >= 2
+        for th in list(rng.uniform(a, b, 40)) + [a, b]:
+            for I in inner:
+                assert any(all(orient2d_xy(*P[i - 1], *P[i], x, y) >= 0 for i in range(len(P)) for x, y in I.tolist())
+                           for P in (rotate_piece(p, float(th)).tolist() for p in cs.robot_pieces))
+
+
+def test_pair_filter_decides_like_the_exact_sum():
+    """The float filter in front of the exact test never contradicts the exact sum, and defers near its boundary."""
+    from cspace.minkowski import minkowski_sum, reflect
+    from cspace.se2 import _edges, _in_convex, _pair_filter
+
+    rng = np.random.default_rng(17)
+    O = np.array([[4.0, 4.0], [6.0, 4.5], [5.5, 6.0], [4.2, 5.5]])
+    cs = SE2CSpace((0, 10, 0, 10), [O], [BAR], slabs=8)
+    oe, op = _edges(O), O.tolist()
+    undecided = 0
+    for _ in range(1500):
+        th = float(rng.uniform(-math.pi, math.pi))
+        c, s = math.cos(th), math.sin(th)
+        rp = rotate_piece(BAR, th)
+        r = rp.tolist()
+        axes = [(-(bx * c - by * s), -(bx * s + by * c), r[e][0], r[e][1], ln)
+                for e, (bx, by, _, ln) in enumerate(_edges(BAR))]
+        S = minkowski_sum(O, reflect(rp))
+        # a point near the sum's boundary: on an edge, pushed by ±10^-(3..17) along the normal (below rounding too)
+        e = int(rng.integers(len(S)))
+        p0, p1 = S[e - 1], S[e]
+        t = float(rng.random())
+        n = np.array([p1[1] - p0[1], p0[0] - p1[0]])
+        q = p0 + (p1 - p0) * t + n / np.linalg.norm(n) * float(rng.choice([-1, 1])) * 10.0 ** -float(rng.uniform(3, 17))
+        side = _pair_filter(oe, op, r, axes, float(q[0]), float(q[1]), cs.pad)
+        inside = _in_convex(S, float(q[0]), float(q[1]))
+        if side == 0:
+            undecided += 1
+        else:
+            assert (side < 0) == inside
+    assert 0 < undecided < 1500
