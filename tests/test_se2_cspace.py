@@ -19,7 +19,7 @@ from shapely import affinity
 
 from cspace import CSpace, load_scenario
 from cspace.se2 import SE2CSpace, default_slabs, interpolate
-from cspace.slab import rotate_piece
+from cspace.slab import rotate_piece, slab_inner
 
 from conftest import SCENARIOS
 
@@ -230,7 +230,7 @@ def test_inner_sets_are_inside_the_robot_at_every_angle_of_their_slab():
     rng = np.random.default_rng(16)
     for k in range(16):
         a, b = cs._lo[k], cs._hi[k]
-        inner = cs._inner_pieces(a, b)
+        inner = [j for j in (slab_inner(p, a, b, cs.pad) for p in cs.robot_pieces) if len(j)]
         assert len(inner) >= 2
         for th in list(rng.uniform(a, b, 40)) + [a, b]:
             for I in inner:
