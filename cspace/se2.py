@@ -91,7 +91,6 @@ class SE2CSpace(SE2Motions):
         self._inner: list = [None] * K  # slab k's certified-blocked grid (GridIndex), or False if empty
         self._tests: list = [None] * K  # (outer point test, None)
         self._grids: list = [None] * K  # the one-lookup grid of each slab (see _combined_grid)
-        self._pair_cache: list[dict] = [{} for _ in range(K)]  # slab -> cell -> pairs (see _cell_pairs)
         self._built: list[dict] = []
         olo = np.array([p.min(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         ohi = np.array([p.max(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
@@ -101,6 +100,7 @@ class SE2CSpace(SE2Motions):
         self._obstacle_edges = [_edges(p) for p in self.obstacle_pieces]
         self._robot_lists = [p.tolist() for p in self.robot_pieces]
         self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
+        self._pair_grid()
         self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
                        "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
         self._states = itertools.count()
@@ -295,37 +295,37 @@ class SE2CSpace(SE2Motions):
                 return False
         return True
 
-    def _cell_pairs(self, k: int, x: float, y: float) -> list:
-        """The (obstacle piece, robot piece) pairs of every slab-k piece that may meet the
-        grid cell of (x, y), with their filter data; cached per (slab, cell).
+    def _pair_grid(self) -> None:
+        """A coarse grid over the bounds (at most 64 x 64, one for all slabs): per cell, the
+        (obstacle piece, robot piece) pairs whose sum may hold a point of the cell, with
+        the filter's data. The sum O ⊕ −R_θ lies in O's box grown by R's radius r_j at
+        every θ (grown further by 2^-40 r_j and the pad for the rotation's rounding)."""
+        xmin, xmax, ymin, ymax = self.bounds
+        n = 64
+        self._pg_n, self._pg_x0, self._pg_y0 = n, xmin, ymin
+        self._pg_iw, self._pg_ih = n / (xmax - xmin), n / (ymax - ymin)
+        cells: list[list] = [[] for _ in range(n * n)]
+        for j, p in enumerate(self.robot_pieces):
+            grow = float(np.hypot(p[:, 0], p[:, 1]).max()) * (1.0 + 2.0**-40) + self.pad
+            for i in range(len(self.obstacle_pieces)):
+                lo, hi = self._olo[i] - grow, self._ohi[i] + grow
+                i0 = max(math.floor((lo[0] - xmin) * self._pg_iw) - 1, 0)
+                i1 = min(math.floor((hi[0] - xmin) * self._pg_iw) + 1, n - 1)
+                j0 = max(math.floor((lo[1] - ymin) * self._pg_ih) - 1, 0)
+                j1 = min(math.floor((hi[1] - ymin) * self._pg_ih) + 1, n - 1)
+                entry = (i, j, self._obstacle_edges[i], self.obstacle_lists[i], self._robot_normals[j])
+                for cj in range(j0, j1 + 1):
+                    for ci in range(i0, i1 + 1):
+                        cells[cj * n + ci].append(entry)
+        self._pg_cells = cells
 
-        A pair whose sum holds (x, y) has its sum inside a slab piece holding (x, y)
-        (the slab hull holds the robot piece at θ, with the pad for the rounding), and
-        that piece meets the cell: a MIXED cell lists every piece within the grid's
-        margin of it; for a BLOCKED cell (which keeps one blocker) the pieces whose
-        box meets the cell's box widened by the margin are taken.
-        """
-        cs = self._outer[k]
-        g = cs.index
-        cell = g.cell_of(x, y)
-        cache = self._pair_cache[k]
-        got = cache.get(cell)
-        if got is not None:
-            return got
-        if g.state_list[cell] == 1:
-            near = g.candidates(cell).tolist()
-        else:
-            ci, cj = cell % g.nx, cell // g.nx
-            m = g.margin
-            x0, x1 = g.x0 + ci * g.cw - m, g.x0 + (ci + 1) * g.cw + m
-            y0, y1 = g.y0 + cj * g.ch - m, g.y0 + (cj + 1) * g.ch + m
-            pk = cs.packed
-            near = np.flatnonzero((pk.lo[:, 0] <= x1) & (pk.hi[:, 0] >= x0)
-                                  & (pk.lo[:, 1] <= y1) & (pk.hi[:, 1] >= y0)).tolist()
-        pairs = sorted({pair for s in near for pair in cs.piece_pairs[s]})
-        got = [(i, j, self._obstacle_edges[i], self.obstacle_lists[i], self._robot_normals[j]) for i, j in pairs]
-        cache[cell] = got
-        return got
+    def _cell_pairs(self, k: int, x: float, y: float) -> list:
+        """The pairs whose sum may hold (x, y) at an angle of slab k (see :meth:`_pair_grid`;
+        the cells are widened by one on each side against the rounding of the cell index)."""
+        n = self._pg_n
+        ci = min(max(math.floor((x - self._pg_x0) * self._pg_iw), 0), n - 1)
+        cj = min(max(math.floor((y - self._pg_y0) * self._pg_ih), 0), n - 1)
+        return self._pg_cells[cj * n + ci]
 
     def robot_at(self, q) -> list[np.ndarray]:
         """The robot pieces at pose q (the exact test's robot: rotated, then translated).
