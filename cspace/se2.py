@@ -269,14 +269,18 @@ class SE2CSpace(SE2Motions):
 
     def _exact(self, x: float, y: float, th: float, k: int) -> bool:
         """The exact test at θ (already wrapped): (x, y) against the sums obstacle piece ⊕
-        −(robot piece at θ) of the pairs whose slab piece holds (x, y)."""
+        −(robot piece at θ) of the pairs near (x, y); a pair whose obstacle box is farther
+        than the robot piece's (grown) radius is skipped, the others go through the float
+        filter, and only an undecided pair builds its sum."""
         self.checks["exact_states"] += 1
         if not self.in_bounds(x, y):
             return False
         c, sn = math.cos(th), math.sin(th)
         rotated: dict = {}
         margin = self.pad
-        for i, j, o_edges, o_pts, r_normals in self._cell_pairs(k, x, y):
+        for i, j, o_edges, o_pts, r_normals, bx0, by0, bx1, by1 in self._cell_pairs(k, x, y):
+            if x < bx0 or x > bx1 or y < by0 or y > by1:
+                continue  # beyond the robot piece's reach of this obstacle's box
             got = rotated.get(j)
             if got is None:  # rotate() in scalars: the same IEEE operations, the same doubles
                 r = [(vx * c - vy * sn + 0.0, vx * sn + vy * c + 0.0) for vx, vy in self._robot_lists[j]]
@@ -313,7 +317,8 @@ class SE2CSpace(SE2Motions):
                 i1 = min(math.floor((hi[0] - xmin) * self._pg_iw) + 1, n - 1)
                 j0 = max(math.floor((lo[1] - ymin) * self._pg_ih) - 1, 0)
                 j1 = min(math.floor((hi[1] - ymin) * self._pg_ih) + 1, n - 1)
-                entry = (i, j, self._obstacle_edges[i], self.obstacle_lists[i], self._robot_normals[j])
+                entry = (i, j, self._obstacle_edges[i], self.obstacle_lists[i], self._robot_normals[j],
+                         float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
                 for cj in range(j0, j1 + 1):
                     for ci in range(i0, i1 + 1):
                         cells[cj * n + ci].append(entry)
