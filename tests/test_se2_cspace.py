@@ -304,3 +304,18 @@ def test_bench_script_runs(capsys):
         sys.argv = argv
     out = capsys.readouterr().out
     assert "ratio" in out and "floor decisions" in out
+
+
+@pytest.mark.parametrize("gap,expect", [(1e-3, "free"), (1e-12, "free"), (1e-14, "floor"), (0.0, "floor"),
+                                        (-1e-12, "collision")])
+def test_grazing_rotation_is_refined_to_the_pad(gap, expect):
+    """A bar turning in place whose corner passes `gap` from a wall (its reach is sqrt(1.01)): clear
+    by more than the pad (~6e-13 here) is certified free; within the pad it ends at the floor
+    (False, counted); overlapping it finds a colliding pose."""
+    bar = np.array([[-1.0, -0.1], [1.0, -0.1], [1.0, 0.1], [-1.0, 0.1]])
+    x = 5 + math.sqrt(1.01) + gap
+    cs = SE2CSpace((0, 10, 0, 10), [np.array([[x, 0.0], [9.0, 0.0], [9.0, 10.0], [x, 10.0]])], [bar], slabs=16)
+    ok = cs.motion_free((5.0, 5.0, 0.5), (5.0, 5.0, -0.5))
+    assert ok == (expect == "free")
+    assert cs.checks["motion_floor"] == (expect == "floor")
+    assert cs.checks["motion_collisions"] == (expect == "collision")
