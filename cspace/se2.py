@@ -159,7 +159,7 @@ class SE2CSpace(SE2Motions):
             # exact test), so the inner set is a grid over its sums, not a whole CSpace.
             neg = [reflect(p) for p in inner_pieces]
             sums = [minkowski_sum(o, r) for o in self.obstacle_pieces for r in neg]
-            inner = GridIndex(sums, self.bounds, cells=g.nx * g.ny)
+            inner = GridIndex(sums, self.bounds, shape=(g.nx, g.ny))
         self._outer[k], self._inner[k] = outer, inner
         self._tests[k] = (outer.point_test(), None)
         self._grids[k] = self._combined_grid(k, outer, inner)
@@ -168,18 +168,18 @@ class SE2CSpace(SE2Motions):
 
     def _combined_grid(self, k: int, outer: CSpace, inner) -> tuple:
         """Slab k's one-lookup grid: per cell 0 (FREE in the slab C-space: free at every
-        angle), 2 (BLOCKED in the inner C-space: blocked at every angle) or 1 (ask
-        :meth:`_slow`), one bytes object per row with a border cell (3) at its end and a
-        border row after the last, as in :meth:`CSpace.point_test`. The inner grid is
-        built with the outer grid's cells; if its geometry differs, only FREE is used."""
+        angle), 2 (BLOCKED in the inner C-space: blocked at every angle) or 1 (the slow
+        path: the slab's own point test, then the exact test), one bytes object per row
+        with a border cell (3) at its end and a border row after the last, as in
+        :meth:`CSpace.point_test`. The inner grid shares the outer grid's cells."""
         from .broadphase import BLOCKED, FREE
 
         g = outer.index
         state = np.where(g.state == FREE, 0, 1).astype(np.uint8)
         if inner:
             h = inner
-            if (h.nx, h.ny, h.x0, h.y0, h.inv_w, h.inv_h) == (g.nx, g.ny, g.x0, g.y0, g.inv_w, g.inv_h):
-                state[(h.state == BLOCKED) & (state == 1)] = 2
+            assert (h.nx, h.ny, h.x0, h.y0, h.inv_w, h.inv_h) == (g.nx, g.ny, g.x0, g.y0, g.inv_w, g.inv_h)
+            state[(h.state == BLOCKED) & (state == 1)] = 2
         flat = state.tobytes()
         nx, ny = g.nx, g.ny
         rows = [flat[r * nx:(r + 1) * nx] + b"\x03" for r in range(ny)] + [b"\x03" * (nx + 1)]
