@@ -133,8 +133,9 @@ class Scenario:
 # Loading
 
 
-def load_scenario(path) -> Scenario:
-    """Read and validate a TOML scenario file.
+def load_scenario(path, space: str | None = None) -> Scenario:
+    """Read and validate a TOML scenario file; ``space`` (``"translation"`` or ``"se2"``)
+    overrides the file's ``space`` (``--space`` on the command line).
 
     >>> import tempfile, os
     >>> d = tempfile.mkdtemp(); f = os.path.join(d, "s.toml")
@@ -155,7 +156,7 @@ def load_scenario(path) -> Scenario:
         raise ScenarioError(path, "file", "not UTF-8 text") from None
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
-    return scenario_from_dict(data, path)
+    return scenario_from_dict(data, path, space=space)
 
 
 # The scenes the C-space supports: products of two coordinates (or of two extents)
@@ -166,8 +167,9 @@ MAX_MAGNITUDE = 2.0**400
 MIN_EXTENT = 2.0**-400
 
 
-def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
-    """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`."""
+def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None = None) -> Scenario:
+    """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`.
+    ``space``, if given, overrides the document's ``space``."""
     v = _Validator(path)
     known = {"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal", "planner", "queries",
              "space", "slabs"}
@@ -195,7 +197,9 @@ def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
                               f"2^-400 (about {MIN_EXTENT:.2g})")
     bounds = (xmin, xmax, ymin, ymax)
 
-    space = data.get("space", "translation")
+    if space is not None and space not in SPACES:
+        raise ScenarioError("--space", "space", f"must be one of {', '.join(SPACES)}, got {_short(space)}")
+    space = space or data.get("space", "translation")
     if space not in SPACES:
         raise v.err("space", f"must be one of {', '.join(repr(s) for s in SPACES)}, got {_short(space)}")
     slabs = data.get("slabs")

@@ -98,3 +98,14 @@ def test_bundled_se2_scenarios_load():
     for f in files:
         sc = load_scenario(os.path.join(SE2, f))
         assert sc.space == "se2" and len(sc.start) == 3
+
+
+def test_space_override_turns_a_translation_file_into_se2(tmp_path):
+    f = tmp_path / "t.toml"
+    f.write_text('[bounds]\nxmin=0\nxmax=10\nymin=0\nymax=10\n[robot]\npolygon=[[-1,-0.1],[1,-0.1],[1,0.1],[-1,0.1]]\n'
+                 '[start]\nx=2\ny=2\ntheta=0.5\n[goal]\nx=8\ny=8\ntheta=0.5\n')
+    assert load_scenario(f).space == "translation"
+    sc = load_scenario(f, space="se2")
+    assert sc.space == "se2" and sc.start == (2.0, 2.0, 0.5) and sc.theta == 0.0
+    with pytest.raises(ScenarioError):
+        load_scenario(f, space="bogus")
