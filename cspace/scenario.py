@@ -26,6 +26,7 @@ Schema (all lengths in one unit, angles in radians)::
 """
 from __future__ import annotations
 
+import difflib
 import math
 import os
 from dataclasses import dataclass, field
@@ -167,15 +168,34 @@ MAX_MAGNITUDE = 2.0**400
 MIN_EXTENT = 2.0**-400
 
 
+# The keys a scenario may have at its top level (a new section adds its key here).
+TOP_LEVEL_KEYS = frozenset({"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal",
+                            "planner", "queries", "space", "slabs"})
+# The forms of a robot table and of a shape (obstacle or robot part), by their keys: keys of two
+# different forms in one table exclude each other.
+ROBOT_FORMS = {"polygon": {"polygon"}, "parts": {"parts"}, "disk": {"radius"}}
+SHAPE_FORMS = {"polygon": {"polygon", "holes"}, "disk": {"center", "radius"}}
+
+
+def unknown_field_message(key: str, allowed) -> str:
+    """The message for a key that is not one of ``allowed``: the closest known key, if any.
+
+    >>> unknown_field_message("polgon", {"polygon", "holes", "center", "radius"})
+    'unknown field (did you mean polygon?)'
+    >>> unknown_field_message("colour", {"name", "bounds"})
+    'unknown field (expected one of: bounds, name)'
+    """
+    close = difflib.get_close_matches(str(key), sorted(allowed), n=1, cutoff=0.6)
+    if close:
+        return f"unknown field (did you mean {close[0]}?)"
+    return f"unknown field (expected one of: {', '.join(sorted(allowed))})"
+
+
 def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None = None) -> Scenario:
     """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`.
     ``space``, if given, overrides the document's ``space``."""
     v = _Validator(path)
-    known = {"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal", "planner", "queries",
-             "space", "slabs"}
-    for key in data:
-        if key not in known:
-            raise v.err(key, f"unknown field (expected one of: {', '.join(sorted(known))})")
+    v.no_extra(data, "", TOP_LEVEL_KEYS)
     name = data.get("name", os.path.splitext(os.path.basename(path))[0])
     if not isinstance(name, str):
         raise v.err("name", "must be a string")
@@ -272,10 +292,19 @@ class _Validator:
             raise self.err(key, "must be a table")
         return t
 
-    def no_extra(self, t: dict, where: str, allowed: set) -> None:
+    def no_extra(self, t: dict, where: str, allowed) -> None:
         for k in t:
             if k not in allowed:
-                raise self.err(f"{where}.{k}", f"unknown field (expected: {', '.join(sorted(allowed))})")
+                raise self.err(f"{where}.{k}" if where else str(k), unknown_field_message(k, allowed))
+
+    def one_form(self, t: dict, field: str, forms: dict, hint: str) -> None:
+        """Unknown keys, then keys of two forms (say polygon and radius) together, are errors."""
+        self.no_extra(t, field, set().union(*forms.values()))
+        used = [sorted(k for k in keys if k in t) for keys in forms.values()]
+        used = [keys for keys in used if keys]
+        if len(used) > 1:
+            a, b = sorted((used[0][0], used[1][0]))
+            raise self.err(field, f"{a} and {b} exclude each other ({hint})")
 
     def number(self, x, field: str, positive: bool = False) -> float:
         if x is None:
@@ -318,9 +347,12 @@ class _Validator:
 
         if not isinstance(t, dict):
             raise self.err(field, "must be a table")
-        allowed = {"polygon", "holes"} if allow_holes else {"polygon"}
+        if field == "robot":  # the robot table's forms are checked by robot()
+            forms = {"polygon": {"polygon"}, "disk": {"radius"}}
+        else:
+            forms = SHAPE_FORMS if allow_holes else {"polygon": {"polygon"}, "disk": {"center", "radius"}}
+        self.one_form(t, field, forms, "a polygon = [[x, y], ...] or a disk: center = [x, y], radius = r")
         if "polygon" in t:
-            self.no_extra(t, field, allowed)
             ext = self.polygon(t["polygon"], f"{field}.polygon")
             holes_raw = t.get("holes", [])
             if not isinstance(holes_raw, list):
@@ -343,7 +375,8 @@ class _Validator:
                     raise self.err(f"{field}.holes", f"holes do not fit the polygon ({shapely.is_valid_reason(whole)})")
             return Shape(ext_n, holes_n, None, convex=not holes_n and is_convex(ext_n))
         if "radius" in t:
-            self.no_extra(t, field, {"center", "radius"})
+            if field != "robot" and "center" not in t:
+                raise self.err(f"{field}.center", "missing (a disk needs center = [x, y] with its radius)")
             r = self.number(t.get("radius"), f"{field}.radius", positive=True)
             c = self.point(t.get("center", [0.0, 0.0] if field == "robot" else None), f"{field}.center")
             return Shape(disk_polygon(c, r, max_error=tol * r), [], (c[0], c[1], r), convex=True)
@@ -354,16 +387,16 @@ class _Validator:
             return [], "point"
         if not isinstance(t, dict):
             raise self.err("robot", "must be a table")
+        if "center" in t and "radius" in t:
+            raise self.err("robot.center", "a disk robot is centred on its reference point; give radius only")
+        self.one_form(t, "robot", ROBOT_FORMS, "one of polygon = [...], [[robot.parts]] or radius = r")
         if "parts" in t:
-            self.no_extra(t, "robot", {"parts"})
             parts = t["parts"]
             if not isinstance(parts, list) or not parts:
                 raise self.err("robot.parts", "must be a non-empty array of tables")
             shapes = [self.shape(p, f"robot.parts[{i}]", tol, allow_holes=False) for i, p in enumerate(parts)]
             kind = "parts"
         elif "radius" in t:
-            if "center" in t:
-                raise self.err("robot.center", "a disk robot is centred on its reference point; give radius only")
             shapes = [self.shape(t, "robot", tol, allow_holes=False)]
             kind = "disk"
         elif "polygon" in t:

@@ -1,9 +1,15 @@
 """Planning a path: scenario -> C-space -> OMPL -> simplified, exactly verified path.
 
-This module owns :func:`plan` and :class:`PlanResult`. A path is reported solved
-only if OMPL found an exact solution *and* every segment of the final (simplified)
-path passes the exact segment test of the C-space again, from the start exactly to
-the goal exactly.
+This module owns :func:`plan`, :class:`PlanResult` and :func:`run_planner`, the one
+routine that sets up, queries, solves, simplifies and verifies with OMPL. ``cspace
+plan``, ``planners.plan()`` and every ``cspace bench`` run go through it; the bench
+only asks for anytime planners to be solved in time slices (``slices=True``) to time
+the first solution and record the best cost along the run.
+
+The routine talks to a state-space adapter (:mod:`planners.spaces`), never to the
+geometry: a path is reported solved only if OMPL found an exact solution *and* the
+adapter's exact verification accepts the final (simplified) path, from the start
+exactly to the goal exactly.
 """
 from __future__ import annotations
 
@@ -38,6 +44,10 @@ class PlanResult:
     length_unsimplified: float | None = None
     cspace_report: dict | None = None
     queries: list | None = None
+    # Filled by run_planner: when the first exact solution was found (seconds into the
+    # solve) and [time, best raw length] pairs along the run (the bench's anytime curve).
+    first_solution: float | None = None
+    progress: list = field(default_factory=list)
     # The objects behind the result, for plots and further queries (not serialised).
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
@@ -82,6 +92,10 @@ def path_length(path: np.ndarray) -> float:
     return float(np.hypot(*np.diff(path, axis=0).T).sum())
 
 
+MAX_TIME = 1e8  # seconds (about three years); OMPL's steady clock overflows near 8e9 s
+SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit
+
+
 def _resolve(scenario, planner, time_limit, seed, iterations=None):
     """Scenario object plus the effective planner, time and seed (arguments over file defaults)."""
     from .ompl_glue import planner_name
@@ -91,32 +105,54 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None):
     load_s = time.perf_counter() - t0
     src = sc.path or "<scenario>"
     opts = sc.planner
-    name = planner_name(planner if planner is not None else opts.get("name"), src,
-                        "planner" if planner is not None else "planner.name")
+    # An argument is blamed as an argument of plan(), a file's value as the file's field.
+    def where(arg, fld):
+        return ("plan()", fld) if arg is not None else (src, f"planner.{fld}")
+
+    if planner is not None:
+        name = planner_name(planner, "plan()", "planner")
+    else:
+        name = planner_name(opts.get("name"), src, "planner.name")
     t = time_limit if time_limit is not None else opts.get("time", 1.0)
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
-        raise ScenarioError(src, "time", f"must be a positive number of seconds, got {t!r}")
+        raise ScenarioError(*where(time_limit, "time"), f"must be a positive number of seconds, got {t!r}")
+    if t > MAX_TIME:
+        raise ScenarioError(*where(time_limit, "time"),
+                            f"at most {MAX_TIME:g} s (OMPL's clock overflows near 8e9 s), got {t!r}")
     s = seed if seed is not None else opts.get("seed", 0)
     if iterations is not None and (isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1):
-        raise ScenarioError(src, "iterations", f"must be a positive integer, got {iterations!r}")
-    if isinstance(s, bool) or not isinstance(s, int) or s < 0:
-        raise ScenarioError(src, "seed", f"must be a non-negative integer, got {s!r}")
+        raise ScenarioError("plan()", "iterations", f"must be a positive integer, got {iterations!r}")
+    if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s < SEED_LIMIT:
+        raise ScenarioError(*where(seed, "seed"), f"must be an integer in [0, 2^32 - 1), got {s!r}")
     return sc, name, float(t), int(s), load_s
 
 
 def plan(scenario, planner: str | None = None, time: float | None = None, seed: int | None = None,
          *, simplify: bool = True, iterations: int | None = None, cspace: CSpace | None = None,
-         all_queries: bool = False) -> PlanResult:
+         all_queries: bool = False, slices: bool = False, on_progress=None) -> PlanResult:
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
     (defaults: RRTConnect, 1 s, seed 0). ``iterations`` adds a deterministic budget
     in planner iterations. With ``all_queries`` every ``[[queries]]`` entry is
-    planned on the same C-space (and, for PRM-family planners, the same roadmap);
-    the result then carries ``queries``, one result per query, and the top-level
-    fields describe the first one.
+    planned on the same C-space (and, for PRM-family planners, the same roadmap),
+    each query with its own seeded random stream; the result then carries
+    ``queries``, one result per query, and the top-level fields describe the first.
+    ``cspace`` reuses a C-space built from the same scenario. ``slices`` and
+    ``on_progress`` are the bench's hooks (see :func:`run_planner`).
+
+    >>> import os
+    >>> res = plan(os.path.join(os.path.dirname(__file__), "..", "scenarios", "basic.toml"), seed=3)
+    >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
+    (True, [1.0, 1.0], [9.0, 9.0])
     """
+    from .spaces import TranslationSpace
+
     sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations)
+    if name != "exact":
+        from .ompl_glue import ompl
+
+        ompl()  # without OMPL: fails here, before the C-space is built
     wall0 = _now()
     if cspace is None:
         t0 = _now()
@@ -125,19 +161,24 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     else:
         build_s = 0.0
     report = cspace.report()
+    space = TranslationSpace(cspace)
     queries = sc.all_queries() if all_queries else sc.all_queries()[:1]
     src = sc.path or "<scenario>"
+    poses = []
     for i, q in enumerate(queries):
-        for pt, fld in ((q.start, "start"), (q.goal, "goal")):
-            if not cspace.is_free(pt):
+        pair = (space.pose(q.start), space.pose(q.goal))
+        for pt, fld in zip(pair, ("start", "goal")):
+            if not space.is_free(pt):
                 label = fld if i == 0 else f"queries[{i - 1}].{fld}"
                 raise ScenarioError(src, label, f"({pt[0]}, {pt[1]}) is not a free state of the C-space")
+        poses.append(pair)
     if name == "exact":
         from .exact import exact_plan
 
         results = [exact_plan(sc, cspace, q, time_limit=tlim) for q in queries]
     else:
-        results = _plan_ompl(sc, cspace, queries, name, tlim, sd, simplify, iterations)
+        results = run_planner(space, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
+                              slices=slices, on_progress=on_progress, scenario=sc.name)
     for r in results:
         r.timings = {"load": load_s, "cspace": build_s, **r.timings}
         r.stages = [s["stage"] for s in report["stages"] if s["ran"]] + r.stages
@@ -156,76 +197,149 @@ def _now() -> float:
     return time.perf_counter()
 
 
-def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> list[PlanResult]:
-    from .ompl_glue import ANYTIME, frame_exponent, make_setup, path_states, set_query, termination
+# Anytime planners solved in slices (``slices=True``): MIN_SLICE s, doubling up to
+# budget / SLICES. Calling solve() again continues the same search in these planners
+# (not in AORRTC, which crashed under repeated solves).
+SLICES = 20
+MIN_SLICE = 0.002
+SLICED = {"rrtstar", "informedrrtstar", "sorrtstar", "bitstar", "prm", "prmstar"}
+ROADMAP = {"prm", "prmstar"}  # multi-query: the roadmap is kept from query to query
 
-    t0 = _now()
-    k = frame_exponent(cspace.bounds)
-    ss, space, checker, validator = make_setup(cspace, name, seed, k)
-    setup_s = _now() - t0
-    planner = ss.getPlanner()
-    multi = name.lower() in ("prm", "prmstar")
+
+def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *,
+                iterations: int | None = None, simplify: bool = True, slices: bool = False,
+                on_progress=None, scenario: str = "") -> list[PlanResult]:
+    """THE planning routine: one OMPL planner over a state-space adapter, for each query.
+
+    ``space`` is an adapter of :mod:`planners.spaces`; ``queries`` is a list of
+    ``(start, goal)`` poses of its dimension, already checked to be free. Per query:
+    set up (seeded with the query's own stream; PRM-family planners keep their
+    roadmap from query to query), set the query, solve within ``time_limit`` seconds
+    (and ``iterations`` if given), simplify, snap the last step to the exact goal,
+    and verify exactly through the adapter.
+
+    With ``slices``, anytime planners are solved in slices of the same total budget
+    so that the time of the first solution (to within one slice) and the best raw
+    length along the run are recorded in ``first_solution`` and ``progress``;
+    ``on_progress(t, length)`` is called at each recorded point.
+    """
+    from .ompl_glue import make_setup, set_query
+
     out = []
-    for i, q in enumerate(queries):
-        if i:
-            if multi:
-                planner.clearQuery()  # keep the roadmap, drop the old start and goal
-            else:
-                ss.clear()
-        set_query(ss, space, q.start, q.goal, k)
-        before = {"points": cspace.point_count(), "segments": cspace.checks["segments"]}
+    ss = None
+    key = name.lower()
+    for i, (start, goal) in enumerate(queries):
+        t0 = _now()
+        if tuple(start) == tuple(goal):  # nothing to plan: the one-point path
+            out.append(_trivial(space, name, seed, scenario, start, goal))
+            continue
+        if ss is None or key not in ROADMAP:
+            ss, _ospace, _checker, _validator = make_setup(space, name, seed, query=i)
+        else:
+            ss.getPlanner().clearQuery()  # keep the roadmap, drop the old start and goal
+        set_query(ss, space, start, goal)
+        setup_s = _now() - t0
+        c0 = space.counts()
         t1 = _now()
-        ptc, _keep = termination(tlim, iterations)
-        status = ss.solve(ptc)
+        first, progress = _solve(ss, space, key, time_limit, iterations, slices, on_progress)
         solve_s = _now() - t1
-        exact_sol = bool(status) and ss.haveExactSolutionPath()
-        raw = _snap(path_states(ss.getSolutionPath(), k), q) if exact_sol else np.zeros((0, 2))
-        length_raw = path_length(raw) if exact_sol else None
+        status = ss.getLastPlannerStatus()
+        found = ss.haveExactSolutionPath()
+        raw = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
         t2 = _now()
-        if exact_sol and simplify:
+        if found and simplify:
             ss.simplifySolution()
-        simp_s = _now() - t2 if exact_sol and simplify else 0.0
-        path = _snap(path_states(ss.getSolutionPath(), k), q) if exact_sol else np.zeros((0, 2))
+        simp_s = _now() - t2 if found and simplify else 0.0
+        path = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
         t3 = _now()
-        verified, message = _verify(cspace, path, q) if exact_sol else (False, str(status))
+        ok, message = space.verify(path, start, goal) if found else (False, failure_message(status, space))
         verify_s = _now() - t3
-        after = {"points": cspace.point_count(), "segments": cspace.checks["segments"]}
+        c1 = space.counts()
+        if ok and key in SLICED | {"aorrtc"} and iterations is None and solve_s >= 0.9 * time_limit:
+            message += " (anytime planner: ran to its time limit)"
         out.append(PlanResult(
-            scenario=sc.name, solved=verified, exact=verified, path=path if verified else np.zeros((0, 2)),
-            length=path_length(path) if verified else math.inf, planner=name, seed=seed,
-            timings={"setup": setup_s if i == 0 else 0.0, "solve": solve_s, "simplify": simp_s, "verify": verify_s},
-            checks={"states": after["points"] - before["points"], "motions": after["segments"] - before["segments"]},
-            stages=["setup", "solve"] + (["simplify"] if exact_sol and simplify else []) + ["verify"],
-            start=tuple(q.start), goal=tuple(q.goal), message=message,
-            length_unsimplified=length_raw,
+            scenario=scenario, solved=ok, exact=ok, path=path if ok else np.zeros((0, space.dim)),
+            length=space.length(path) if ok else math.inf, planner=name, seed=seed,
+            timings={"setup": setup_s, "solve": solve_s, "simplify": simp_s, "verify": verify_s},
+            checks={"states": c1[0] - c0[0], "motions": c1[1] - c0[1]},
+            stages=["setup", "solve"] + (["simplify"] if found and simplify else []) + ["verify"],
+            start=tuple(start), goal=tuple(goal), message=message,
+            length_unsimplified=space.length(raw) if ok else None,
+            first_solution=first if ok else None, progress=progress,
         ))
-        if name.lower() in ANYTIME and iterations is None:
-            out[-1].message += " (anytime planner: ran to its time limit)"
     return out
 
 
-def _snap(states, q) -> np.ndarray:
+def _solve(ss, space, key, time_limit, iterations, slices, on_progress):
+    """Solve within the budget; returns (time of the first exact solution, progress)."""
+    from .ompl_glue import ompl, termination
+
+    ob = ompl()[0]
+    first, progress = None, []
+    t0 = _now()
+
+    def record():
+        nonlocal first
+        if ss.haveExactSolutionPath():
+            t = _now() - t0
+            first = t if first is None else first
+            progress.append([t, space.length(space.path_array(ss.getSolutionPath()))])
+            if on_progress is not None:
+                on_progress(*progress[-1])
+
+    if slices and key in SLICED and not iterations:
+        # Continue the same search slice by slice: same total budget. Slices double
+        # from MIN_SLICE up to budget / SLICES, so an early first solution is timed
+        # finely and a long run still takes few slices.
+        step, n = max(time_limit / SLICES, MIN_SLICE), 0
+        while (left := time_limit - (_now() - t0)) > 0:
+            ss.solve(ob.timedPlannerTerminationCondition(min(step, MIN_SLICE * 2 ** n, left)))
+            n += 1
+            record()
+    else:
+        ptc, _keep = termination(time_limit, iterations)
+        ss.solve(ptc)
+        record()
+    return first, progress
+
+
+def failure_message(status, space=None) -> str:
+    """Why a sampling planner did not solve, in plain words (OMPL's status explained).
+
+    >>> failure_message("Timeout")
+    'no path found within the budget (OMPL: Timeout)'
+    """
+    text = str(status)
+    if "Approximate" in text:
+        msg = ("no path found within the budget (OMPL's \"Approximate solution\": its best path only "
+               "comes near the goal, it does not reach it)")
+    else:
+        msg = f"no path found within the budget (OMPL: {text})"
+    hint = getattr(space, "unsolved_hint", None)
+    return msg + (f"; {hint}" if hint else "")
+
+
+def _trivial(space, name, seed, scenario, start, goal) -> PlanResult:
+    """Start equals goal: the one-point path, verified like any other."""
+    path = np.array([start], dtype=np.float64).reshape(1, space.dim)
+    ok, message = space.verify(path, start, goal)
+    return PlanResult(scenario=scenario, solved=ok, exact=ok, path=path, length=0.0, planner=name, seed=seed,
+                      timings={"setup": 0.0, "solve": 0.0, "simplify": 0.0, "verify": 0.0},
+                      checks={"states": 0, "motions": 0}, stages=["verify"], start=tuple(start), goal=tuple(goal),
+                      message=message, length_unsimplified=0.0, first_solution=0.0, progress=[[0.0, 0.0]])
+
+
+def _snap(path: np.ndarray, goal) -> np.ndarray:
     """The planner's path, ending exactly at the goal.
 
     OMPL reports the goal reached within ``GOAL_THRESHOLD`` (1e-9; a threshold of 0
     makes RRT miss a goal it has sampled); the last little step to the exact goal is
     appended and, like every segment, verified exactly afterwards.
+
+    >>> _snap(np.array([[0., 0], [1, 1 - 1e-12]]), (1, 1)).tolist()
+    [[0.0, 0.0], [1.0, 0.999999999999], [1.0, 1.0]]
     """
-    path = np.array(states, dtype=np.float64).reshape(-1, 2)
-    goal = np.array(q.goal, dtype=np.float64)
+    goal = np.array(goal, dtype=np.float64)
     if len(path) and not (path[-1] == goal).all():
         path = np.vstack([path, goal])
     return path
-
-
-def _verify(cspace: CSpace, path: np.ndarray, q) -> tuple[bool, str]:
-    """Every segment exactly free, and the path runs from the start to the goal exactly."""
-    if len(path) < 2:
-        same = len(path) == 1 and tuple(path[0]) == tuple(q.start) == tuple(q.goal)
-        return same, "" if same else "empty path"
-    if tuple(path[0]) != tuple(map(float, q.start)) or tuple(path[-1]) != tuple(map(float, q.goal)):
-        return False, "path does not run exactly from start to goal"
-    for k in range(len(path) - 1):
-        if not cspace.segment_free(path[k], path[k + 1]):
-            return False, f"segment {k} failed the exact test"
-    return True, "exact solution"
