@@ -405,10 +405,10 @@ class _Validator:
         else:
             raise self.err("robot", "needs polygon, [[robot.parts]] or radius")
         if theta:
-            c, s = math.cos(theta), math.sin(theta)
-            rot = np.array([[c, s], [-s, c]])  # row vectors: p @ rot rotates by +theta
+            from .slab import rotate  # the one rotation used for "the robot at theta"
+
             for sh in shapes:
-                sh.polygon = sh.polygon @ rot
+                sh.polygon = rotate(sh.polygon, theta)
                 if sh.disk is not None:
                     sh.disk = (0.0, 0.0, sh.disk[2])
         return shapes, kind

@@ -1,0 +1,701 @@
+"""The C-space of a robot that translates and rotates (SE(2)), sliced into angle slabs.
+
+This module owns the SE(2) queries (note se2-rotation.md, sections 1 and 2). The
+circle of angles is cut into K slabs; slab k holds, for each convex robot piece, its
+slab hull H (:func:`cspace.slab.slab_hull`, a convex superset of the piece at every
+angle of the slab), and is a plain translational :class:`CSpace` of those hulls:
+
+- a reference point free in slab k's C-space is free at EVERY angle of the slab (a
+  certificate, not a sample);
+- a reference point inside the slab's *inner* C-space (the obstacles summed with each
+  robot piece eroded by its largest displacement in the slab, 2 r sin(Δ/4) about the
+  middle angle) collides at every angle of the slab (certified blocked);
+- anything else gets the exact test at its own angle: the body-frame robot pieces
+  rotated by :func:`cspace.slab.rotate`, then exactly the translation C-space's
+  semantics (is (x, y) in the computed sum obstacle piece ⊕ −(rotated piece), closed).
+
+"The pose (x, y, θ)" always means: θ wrapped into [−π, π) as OMPL does, each robot
+piece turned by :func:`rotate_piece`, translated by (x, y). Slabs are built lazily, on
+first use, and cached. Everything is deterministic.
+
+Motions follow OMPL's SE(2) interpolation (:func:`interpolate`). A motion is split at
+slab boundaries; a sub-motion whose reference segment is free in its slab's C-space
+is free (the robot stays in segment ⊕ H). Otherwise it is refined: the sub-motion's
+own hull (over its own, smaller angle range) swept along its segment is tested
+exactly against the obstacle pieces, and halved on a hit, until an exact pose in
+collision is found (False) or a floor of size is reached (False, counted: a
+conservative answer, never a false "free").
+"""
+from __future__ import annotations
+
+import itertools
+import math
+import time
+
+import numpy as np
+
+from .broadphase import GridIndex
+from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
+from .gjk import exact_relation
+from .minkowski import minkowski_sum, reflect
+from .pieces import PieceSet
+from .predicates import orient2d_xy
+from .scenario import Scenario, load_scenario
+from .slab import (ANGLE_SLACK, TWO_PI, rotate, rotate_piece, slab_hull, slab_of, slab_pad, slab_range,
+                   wrap_angle)
+
+# Refinement of a motion stops (answer "not free", counted) when the sub-motion's
+# sweep is smaller than this fraction of the scene's extent...
+FLOOR_REL = 1e-9
+# ... or after this many swept hulls for one motion (never a hang).
+MAX_REFINE = 2048
+# Grid cells of each slab's C-space (unless grid_cells is given): a quarter of the
+# translation C-space's default. The grid build dominates a slab's cost (K of them),
+# and the SE(2) hot path reads the slab grid once per state either way.
+SLAB_GRID_CELLS = 1 << 14
+
+
+def interpolate(q0, q1, t: float) -> tuple[float, float, float]:
+    """The pose at fraction t of the motion q0 -> q1, exactly as OMPL's SE2StateSpace computes it.
+
+    x and y: ``from + (to - from) * t`` (RealVectorStateSpace). θ (SO2StateSpace):
+    ``diff = to - from``; if ``|diff| <= π`` then ``from + diff * t``; otherwise along
+    the shorter arc the other way, ``from - d * t`` with ``d = 2π - diff`` (diff > 0)
+    or ``-2π - diff``, then wrapped back by one turn if it left [−π, π]. Both ends
+    must already be in [−π, π] (OMPL's states are).
+
+    >>> interpolate((0, 0, 3.0), (2, 4, -3.0), 0.75)  # through π, the shorter way
+    (1.5, 3.0, -3.0707963267948966)
+    """
+    x0, y0, a = float(q0[0]), float(q0[1]), float(q0[2])
+    x1, y1, b = float(q1[0]), float(q1[1]), float(q1[2])
+    t = float(t)
+    diff = b - a
+    if abs(diff) <= math.pi:
+        th = a + diff * t
+    else:
+        diff = TWO_PI - diff if diff > 0.0 else -TWO_PI - diff
+        th = a - diff * t
+        if th > math.pi:
+            th -= TWO_PI
+        elif th < -math.pi:
+            th += TWO_PI
+    return x0 + (x1 - x0) * t, y0 + (y1 - y0) * t, th
+
+
+def _arc(a: float, b: float) -> float:
+    """The signed angle swept by OMPL's interpolation from a to b (|result| <= π)."""
+    diff = b - a
+    if abs(diff) <= math.pi:
+        return diff
+    return diff - TWO_PI if diff > 0.0 else diff + TWO_PI
+
+
+def robot_radius(pieces: list[np.ndarray]) -> float:
+    """Largest distance of a robot vertex from the reference point (0 for a point robot).
+
+    >>> robot_radius([np.array([[0., 0], [3, 4], [0, 1]])])
+    5.0
+    """
+    return max((float(np.hypot(p[:, 0], p[:, 1]).max()) for p in pieces if len(p)), default=0.0)
+
+
+def default_slabs(robot_radius: float, extent: float, gap: float | None = None) -> tuple[int, str]:
+    """K, the number of slabs, and a one-line reason.
+
+    In a slab of width Δ = 2π/K a robot point at radius r sweeps a chord of about
+    r·Δ, so the slab C-obstacles are thicker than the C-obstacle at one angle by up
+    to about r·Δ (plus r·Δ²/4, the hull's excess over the two end poses), and the
+    inner (certified blocked) ones thinner by about as much. States in that band
+    take the exact test (~20x a grid lookup) and motions through it are refined, so
+    the validity cost grows with r·Δ / g, g the scene's typical gap: K is the
+    smallest power of two with r·2π/K <= g/8 (measured on the bundled scenes: an
+    exact-test share of a few per cent of uniform states). Each slab costs a
+    translational C-space build plus an inner grid (~50-200 ms on the bundled
+    scenes), paid lazily on first use, so K is clamped to [16, 64]: beyond 64 the
+    build time dominates a planning run while the band is already a small
+    fraction of the gaps. Tightness (the hull excess, ~r·Δ²/4) is then below 1 %
+    of r. ``gap`` defaults to extent / 8 and is capped there.
+
+    >>> default_slabs(1.0, 10.0)[0], default_slabs(0.1, 10.0)[0], default_slabs(5.0, 10.0)[0]
+    (64, 16, 64)
+    """
+    g = extent / 8.0 if gap is None or not gap > 0.0 else min(gap, extent / 8.0)
+    if robot_radius <= 0.0:
+        return 1, "K = 1: a point robot does not turn"
+    need = TWO_PI * robot_radius / (g / 8.0)
+    k = 16
+    while k < need and k < 64:
+        k *= 2
+    delta = TWO_PI / k
+    chord = 2.0 * robot_radius * math.sin(0.5 * delta)
+    excess = math.sin(0.5 * delta) ** 2 / math.cos(0.5 * delta)
+    return k, (f"K = {k}: robot radius {robot_radius:.3g}, a slab of {math.degrees(delta):.3g} deg moves its "
+               f"farthest point by {chord:.3g} ({100 * chord / g:.2g} % of the typical gap {g:.3g}); "
+               f"hull excess over the end poses <= {100 * excess:.2g} % of the radius")
+
+
+def _typical_gap(pieces: list[np.ndarray], extent: float) -> float:
+    """Median distance from an obstacle piece to its nearest other piece (shapely),
+    ignoring touching pieces (parts of one decomposed obstacle); extent / 8 if none."""
+    if len(pieces) < 2:
+        return extent / 8.0
+    import shapely
+
+    geoms = [shapely.Polygon(p) for p in pieces[:400]]
+    tree = shapely.STRtree(geoms)
+    gaps = []
+    for i, g in enumerate(geoms):
+        j, d = tree.query_nearest(g, exclusive=True, return_distance=True, all_matches=False)
+        if len(d) and d[0] > 0.0:
+            gaps.append(float(d[0]))
+    return float(np.median(gaps)) if gaps else extent / 8.0
+
+
+class SE2CSpace:
+    """C-space of a rotating polygonal robot: K lazily built angle slabs plus exact tests.
+
+    >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+    >>> bar = np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])
+    >>> cs = SE2CSpace((0, 10, 0, 10), [sq], [bar], slabs=16)
+    >>> cs.is_free((3.1, 5, 0.0)), cs.is_free((3.1, 5, math.pi / 2)), cs.is_free((5, 5, 1.0))
+    (False, True, False)
+    >>> cs.motion_free((2.5, 2, 0), (7.5, 2, 0)), cs.motion_free((3.1, 5, math.pi / 2), (3.1, 5, -math.pi / 2))
+    (True, False)
+    """
+
+    def __init__(self, bounds, obstacles: list[np.ndarray] | None = None, robot: list[np.ndarray] | None = None,
+                 *, obstacle_holes: list[list[np.ndarray]] | None = None, robot_is_disk: bool = False,
+                 slabs: int | None = None, grid_cells: int | None = None):
+        t0 = time.perf_counter()
+        self.bounds = tuple(float(v) for v in bounds)
+        obstacles = obstacles or []
+        _check_range(self.bounds, obstacles + (robot or []))
+        self.obstacle_pieces, self.obstacle_of, _ = decompose_obstacles(obstacles, obstacle_holes)
+        self.robot_pieces, _ = decompose_robot(robot or [], robot_is_disk)
+        self.grid_cells = grid_cells
+        xmin, xmax, ymin, ymax = self.bounds
+        self.extent = max(xmax - xmin, ymax - ymin)
+        self.radius = robot_radius(self.robot_pieces)
+        # Magnitude of every coordinate the slab hulls are summed with (obstacles, bounds,
+        # positions along motions): the slab pad scales with it (slab_pad).
+        self.scale = max([abs(v) for v in self.bounds]
+                         + [float(np.abs(p).max()) for p in self.obstacle_pieces if len(p)])
+        self.pad = slab_pad(self.radius * math.sqrt(2.0) + self.scale)
+        if slabs is None:
+            gap = _typical_gap(self.obstacle_pieces, self.extent)
+            self.slabs, self.slabs_reason = default_slabs(self.radius, self.extent, gap)
+        else:
+            if isinstance(slabs, bool) or not isinstance(slabs, int) or not slabs >= 4:
+                if not (slabs == 1 and not self.robot_pieces):
+                    raise ValueError(f"SE2CSpace: slabs must be an integer >= 4, got {slabs!r}")
+            self.slabs, self.slabs_reason = slabs, f"K = {slabs}: given"
+        if not self.robot_pieces:
+            self.slabs, self.slabs_reason = 1, "K = 1: a point robot does not turn"
+        K = self.slabs
+        # Each slab's angle interval, widened by ANGLE_SLACK: what its hulls are built for.
+        self._lo = [slab_range(k, K)[0] - ANGLE_SLACK for k in range(K)] if K > 1 else [-math.inf]
+        self._hi = [slab_range(k, K)[1] + ANGLE_SLACK for k in range(K)] if K > 1 else [math.inf]
+        self._outer: list = [None] * K  # slab k's CSpace (robot = slab hulls)
+        self._inner: list = [None] * K  # slab k's certified-blocked grid (GridIndex), or False if empty
+        self._tests: list = [None] * K  # (outer point test, None)
+        self._grids: list = [None] * K  # the one-lookup grid of each slab (see _combined_grid)
+        self._pair_cache: list[dict] = [{} for _ in range(K)]  # slab -> cell -> pairs (see _cell_pairs)
+        self._built: list[dict] = []
+        olo = np.array([p.min(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
+        ohi = np.array([p.max(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
+        self._olo, self._ohi = olo, ohi
+        # Plain lists for the float filter of the exact test (see _pair_filter).
+        self.obstacle_lists = [p.tolist() for p in self.obstacle_pieces]
+        self._obstacle_edges = [_edges(p) for p in self.obstacle_pieces]
+        self._robot_lists = [p.tolist() for p in self.robot_pieces]
+        self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
+        self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
+                       "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
+        self._states = itertools.count()
+        self._pose = self.pose_test(self._states.__next__)
+        self.setup_seconds = time.perf_counter() - t0
+
+    @classmethod
+    def from_scenario(cls, scenario, slabs: int | None = None, grid_cells: int | None = None) -> "SE2CSpace":
+        """The SE(2) C-space of a :class:`Scenario` (or a file path); ``sc.robot`` is the body frame.
+
+        >>> import os, tempfile
+        >>> f = os.path.join(tempfile.mkdtemp(), "s.toml")
+        >>> _ = open(f, "w").write("[bounds]\\nxmin=0\\nxmax=4\\nymin=0\\nymax=4\\n[start]\\nx=0.5\\ny=0.5\\n"
+        ...     "[goal]\\nx=3.5\\ny=3.5\\n[robot]\\npolygon=[[0,0],[0.2,0],[0,0.2]]\\n"
+        ...     "[[obstacles]]\\npolygon=[[1,1],[3,1],[3,3],[1,3]]\\n")
+        >>> SE2CSpace.from_scenario(f, slabs=8).is_free((2, 2, 0.3))
+        False
+        """
+        sc = scenario if isinstance(scenario, Scenario) else load_scenario(str(scenario))
+        cs = cls(sc.bounds, [o.polygon for o in sc.obstacles], [r.polygon for r in sc.robot],
+                 obstacle_holes=[o.holes for o in sc.obstacles], robot_is_disk=sc.robot_kind == "disk",
+                 slabs=slabs, grid_cells=grid_cells)
+        cs.scenario = sc
+        return cs
+
+    # -- slabs -------------------------------------------------------------------------
+
+    def slab(self, k: int) -> CSpace:
+        """Slab k's translational C-space (robot pieces = their slab hulls), built on first use."""
+        if self._outer[k] is None:
+            self._build(k)
+        return self._outer[k]
+
+    def _build(self, k: int) -> None:
+        t = time.perf_counter()
+        if self.slabs == 1:  # point robot: one C-space, the obstacles themselves
+            outer = CSpace(self.bounds, self.obstacle_pieces, [], grid_cells=self.grid_cells)
+            self._outer[k], self._inner[k] = outer, False
+            self._tests[k] = (outer.point_test(), None)
+            self._grids[k] = self._combined_grid(k, outer, None)
+            self._built.append({"slab": k, "seconds": time.perf_counter() - t, "pieces": len(outer.pieces),
+                                "inner_pieces": 0})
+            return
+        a, b = self._lo[k], self._hi[k]
+        hulls = [slab_hull(p, a, b, scale=self.scale) for p in self.robot_pieces]
+        outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells or SLAB_GRID_CELLS)
+        t_outer = time.perf_counter() - t
+        if len(outer.obstacle_pieces) != len(self.obstacle_pieces) or len(outer.robot_pieces) != len(hulls):
+            # piece_pairs index our pieces: the slab must keep them as given (they are convex)
+            raise RuntimeError("SE2CSpace: a slab re-decomposed a convex piece")  # pragma: no cover
+        inner_pieces = self._inner_pieces(a, b)
+        g = outer.index
+        inner = False
+        if inner_pieces and self.obstacle_pieces:
+            # Only the inner grid's BLOCKED cells are used (everything else goes to the
+            # exact test), so the inner set is a grid over its sums, not a whole CSpace.
+            neg = [reflect(p) for p in inner_pieces]
+            sums = [minkowski_sum(o, r) for o in self.obstacle_pieces for r in neg]
+            inner = GridIndex(sums, self.bounds, cells=g.nx * g.ny)
+        self._outer[k], self._inner[k] = outer, inner
+        self._tests[k] = (outer.point_test(), None)
+        self._grids[k] = self._combined_grid(k, outer, inner)
+        self._built.append({"slab": k, "seconds": time.perf_counter() - t, "outer_seconds": t_outer,
+                            "pieces": len(outer.pieces), "inner_pieces": len(inner_pieces)})
+
+    def _combined_grid(self, k: int, outer: CSpace, inner) -> tuple:
+        """Slab k's one-lookup grid: per cell 0 (FREE in the slab C-space: free at every
+        angle), 2 (BLOCKED in the inner C-space: blocked at every angle) or 1 (ask
+        :meth:`_slow`), one bytes object per row with a border cell (3) at its end and a
+        border row after the last, as in :meth:`CSpace.point_test`. The inner grid is
+        built with the outer grid's cells; if its geometry differs, only FREE is used."""
+        from .broadphase import BLOCKED, FREE
+
+        g = outer.index
+        state = np.where(g.state == FREE, 0, 1).astype(np.uint8)
+        if inner:
+            h = inner
+            if (h.nx, h.ny, h.x0, h.y0, h.inv_w, h.inv_h) == (g.nx, g.ny, g.x0, g.y0, g.inv_w, g.inv_h):
+                state[(h.state == BLOCKED) & (state == 1)] = 2
+        flat = state.tobytes()
+        nx, ny = g.nx, g.ny
+        rows = [flat[r * nx:(r + 1) * nx] + b"\x03" for r in range(ny)] + [b"\x03" * (nx + 1)]
+        outer_test = self._tests[k][0]
+        # A point robot's one slab is its exact C-space: its point test is the answer.
+        exact = self._exact if self.robot_pieces else (lambda x, y, th, k: False)
+
+        def slow(x: float, y: float, th: float) -> bool:
+            if outer_test(x, y):
+                return True  # free in the slab: free at every angle of it
+            return exact(x, y, th, k)
+
+        return rows, g.inv_w, g.x0 * g.inv_w, g.inv_h, g.y0 * g.inv_h, slow
+
+    def _inner_pieces(self, a: float, b: float) -> list[np.ndarray]:
+        """Convex sets inside every robot piece at every angle of [a, b] (certified blocked).
+
+        Write θ = m + φ, |φ| <= h (m the middle, h the half-width). R_θ P = R_m R_φ P and
+        R_φ P = ∩_e {x : (R_φ n_e)·x <= c_e} over P's edges (outward normal n_e, offset
+        c_e). For one edge, x = |x|(cos α, sin α) relative to n_e, (R_φ n_e)·x =
+        |x| cos(φ − α) is largest over the interval at an end, or at φ = α if α is in it.
+        So J = ∩_φ R_φ P is cut by the two end half-planes (φ = ±h) of every edge, and,
+        for c_e >= 0, by |x| <= c_e on the wedge |α| <= h, which the chord half-plane
+        n_e·x <= c_e cos h implies (there |x| cos h <= |x| cos α = n_e·x). (For c_e < 0
+        the end half-planes already exclude the wedge: 2h < π/2.) Every offset is
+        lowered by four slab pads times |n_e| (the rounding of the turned normals, of
+        the float clipping, of the final rotation and of the C-space sums), and
+        I = R_m J.
+        """
+        half = 0.5 * (b - a)
+        m = a + half
+        ch, sh = math.cos(half), math.sin(half)
+        out = []
+        for p in self.robot_pieces:
+            r = float(np.hypot(p[:, 0], p[:, 1]).max())
+            box = 2.0 * r  # the piece lies within radius r: the clipping's rounding stays ~u·r
+            poly = [(-box, -box), (box, -box), (box, box), (-box, box)]
+            for nx, ny, c, ln in _edges(p):
+                c_safe = c - 4.0 * self.pad * ln
+                for ux, uy, off in ((nx * ch - ny * sh, nx * sh + ny * ch, c_safe),
+                                    (nx * ch + ny * sh, -nx * sh + ny * ch, c_safe),
+                                    (nx, ny, c * ch - 4.0 * self.pad * ln if c >= 0.0 else None)):
+                    if off is not None:
+                        poly = _clip_halfplane(poly, ux, uy, off)
+                if len(poly) < 3:
+                    break
+            if len(poly) >= 3:
+                from .hull import convex_hull
+
+                j = convex_hull(np.array(poly))
+                if len(j) >= 3:
+                    out.append(rotate_piece(j, m))
+        return out
+
+    def _slab_index(self, th: float) -> int:
+        """Slab of an angle already in [−π, π)."""
+        return slab_of(th, self.slabs) if self.slabs > 1 else 0
+
+    # -- states ------------------------------------------------------------------------
+
+    def in_bounds(self, x: float, y: float) -> bool:
+        xmin, xmax, ymin, ymax = self.bounds
+        return xmin <= x <= xmax and ymin <= y <= ymax
+
+    def is_free(self, q) -> bool:
+        """Is the pose q = (x, y, θ) valid: reference point in bounds, robot touching nothing?"""
+        return self._pose(float(q[0]), float(q[1]), float(q[2]))
+
+    def pose_test(self, tick=None, state: bool = False):
+        """A fast ``(x, y, theta) -> bool`` free-pose test: the validity checker's hot path.
+
+        Slab lookup (two comparisons certify the float slab index), then the slab's
+        grid: FREE in the slab C-space is free at every angle of the slab; inside the
+        inner C-space is blocked at every angle; anything else goes to the exact test
+        at θ. ``tick`` is called once per query; with ``state`` the test takes one
+        indexable ``q`` (``q[0], q[1], q[2]``).
+
+        >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+        >>> cs = SE2CSpace((0, 10, 0, 10), [sq], [np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])], slabs=8)
+        >>> f = cs.pose_test()
+        >>> f(1.0, 1.0, 0.3), f(5.0, 5.0, -2.0), cs.pose_test(state=True)([2.9, 5.0, 1.5707963])
+        (True, False, True)
+        """
+        K = self.slabs
+        per = K / TWO_PI
+        lo, hi, grids = self._lo, self._hi, self._grids
+        build = self._build
+        pi, wrap, slab_of_ = math.pi, wrap_angle, self._slab_index
+        count = int if tick is None else tick  # int() is a C-level no-op
+        floor = math.floor
+
+        def free_q(q) -> bool:
+            count()
+            x = q[0]
+            y = q[1]
+            th = q[2]
+            if not -pi <= th < pi:
+                th = wrap(th)
+            k = floor((th + pi) * per)
+            if k >= K or not lo[k] <= th <= hi[k]:  # the float index is certified by two comparisons
+                k = slab_of_(th)
+            g = grids[k]
+            if g is None:
+                build(k)
+                g = grids[k]
+            rows, iw, a0, ih, b0, slow = g
+            i = x * iw - a0
+            j = y * ih - b0
+            if i >= 0.0 and j >= 0.0:  # also False for NaN
+                try:
+                    c = rows[floor(j)][floor(i)]
+                except (IndexError, OverflowError):
+                    return slow(x, y, th)  # off the grid's top or right
+                if not c:
+                    return True  # FREE in the slab C-space
+                if c == 2:
+                    return False  # BLOCKED in the inner C-space
+            return slow(x, y, th)
+
+        if state:
+            return free_q
+
+        def free(x: float, y: float, th: float) -> bool:
+            return free_q((x, y, th))
+
+        return free
+
+    def _exact(self, x: float, y: float, th: float, k: int) -> bool:
+        """The exact test at θ (already wrapped): (x, y) against the sums obstacle piece ⊕
+        −(robot piece at θ) of the pairs whose slab piece holds (x, y)."""
+        self.checks["exact_states"] += 1
+        if not self.in_bounds(x, y):
+            return False
+        c, sn = math.cos(th), math.sin(th)
+        rotated: dict = {}
+        margin = self.pad
+        for i, j, o_edges, o_pts, r_normals in self._cell_pairs(k, x, y):
+            got = rotated.get(j)
+            if got is None:  # rotate() in scalars: the same IEEE operations, the same doubles
+                r = [(vx * c - vy * sn + 0.0, vx * sn + vy * c + 0.0) for vx, vy in self._robot_lists[j]]
+                # −R''s outward normals: minus R''s (the body normals turned); edge e ends at vertex e.
+                axes = [(-(bx * c - by * sn), -(bx * sn + by * c), r[e][0], r[e][1], ln)
+                        for e, (bx, by, ln) in enumerate(r_normals)]
+                got = rotated[j] = (r, axes)
+            side = _pair_filter(o_edges, o_pts, got[0], got[1], x, y, margin)
+            if side < 0:
+                return False  # inside the sum by more than its rounding: the exact answer too
+            if side > 0:
+                continue  # outside by more than the rounding
+            self.checks["exact_sums"] += 1
+            neg = reflect(rotate_piece(self.robot_pieces[j], th))
+            if _in_convex(minkowski_sum(self.obstacle_pieces[i], neg), x, y):
+                return False
+        return True
+
+    def _cell_pairs(self, k: int, x: float, y: float) -> list:
+        """The (obstacle piece, robot piece) pairs of every slab-k piece that may meet the
+        grid cell of (x, y), with their filter data; cached per (slab, cell).
+
+        A pair whose sum holds (x, y) has its sum inside a slab piece holding (x, y)
+        (the slab hull holds the robot piece at θ, with the pad for the rounding), and
+        that piece meets the cell: a MIXED cell lists every piece within the grid's
+        margin of it; for a BLOCKED cell (which keeps one blocker) the pieces whose
+        box meets the cell's box widened by the margin are taken.
+        """
+        cs = self._outer[k]
+        g = cs.index
+        cell = g.cell_of(x, y)
+        cache = self._pair_cache[k]
+        got = cache.get(cell)
+        if got is not None:
+            return got
+        if g.state_list[cell] == 1:
+            near = g.candidates(cell).tolist()
+        else:
+            ci, cj = cell % g.nx, cell // g.nx
+            m = g.margin
+            x0, x1 = g.x0 + ci * g.cw - m, g.x0 + (ci + 1) * g.cw + m
+            y0, y1 = g.y0 + cj * g.ch - m, g.y0 + (cj + 1) * g.ch + m
+            pk = cs.packed
+            near = np.flatnonzero((pk.lo[:, 0] <= x1) & (pk.hi[:, 0] >= x0)
+                                  & (pk.lo[:, 1] <= y1) & (pk.hi[:, 1] >= y0)).tolist()
+        pairs = sorted({pair for s in near for pair in cs.piece_pairs[s]})
+        got = [(i, j, self._obstacle_edges[i], self.obstacle_lists[i], self._robot_normals[j]) for i, j in pairs]
+        cache[cell] = got
+        return got
+
+    def robot_at(self, q) -> list[np.ndarray]:
+        """The robot pieces at pose q (the exact test's robot: rotated, then translated).
+
+        >>> cs = SE2CSpace((0, 4, 0, 4), [], [np.array([[0., 0], [1, 0], [0, 1]])], slabs=4)
+        >>> cs.robot_at((1, 1, 0))[0].tolist()
+        [[1.0, 1.0], [2.0, 1.0], [1.0, 2.0]]
+        """
+        th = wrap_angle(float(q[2]))
+        return [rotate_piece(p, th) + np.array([float(q[0]), float(q[1])]) for p in self.robot_pieces]
+
+    # -- motions -----------------------------------------------------------------------
+
+    def motion_free(self, q0, q1) -> bool:
+        """Is every pose of OMPL's SE(2) interpolation from q0 to q1 free? Certified.
+
+        True only if every pose is free (slab certificates or exact sweeps); False on
+        an exact pose in collision, or (counted in ``checks["motion_floor"]``) when
+        refinement reaches its floor without deciding.
+        """
+        self.checks["motions"] += 1
+        x0, y0, a0 = float(q0[0]), float(q0[1]), wrap_angle(float(q0[2]))
+        x1, y1, a1 = float(q1[0]), float(q1[1]), wrap_angle(float(q1[2]))
+        if not (self._pose(x1, y1, a1) and self._pose(x0, y0, a0)):
+            self.checks["motion_collisions"] += 1
+            return False
+        D = _arc(a0, a1)
+        budget = [MAX_REFINE]
+        for ta, tb in self._split(a0, D):
+            self.checks["submotions"] += 1
+            pa = (x0, y0) if ta == 0.0 else (x0 + (x1 - x0) * ta, y0 + (y1 - y0) * ta)
+            pb = (x1, y1) if tb == 1.0 else (x0 + (x1 - x0) * tb, y0 + (y1 - y0) * tb)
+            mid = wrap_angle(a0 + D * (0.5 * (ta + tb)))
+            k = self._slab_index(mid)
+            if self.slab(k).segment_free(pa, pb):
+                self.checks["slab_certified"] += 1
+                continue
+            if not self.robot_pieces:  # a point robot: the one slab is the exact C-space
+                self.checks["motion_collisions"] += 1
+                return False
+            ok = self._refine((x0, y0, a0), (x1, y1), D, ta, tb, budget)
+            if not ok:
+                return False
+        return True
+
+    def _split(self, a0: float, D: float) -> list[tuple[float, float]]:
+        """Fractions [ta, tb] of the motion whose angles a0 + D t each stay in one slab."""
+        K = self.slabs
+        if D == 0.0 or K == 1:
+            return [(0.0, 1.0)]
+        w = TWO_PI / K
+        a1 = a0 + D
+        lo, hi = min(a0, a1), max(a0, a1)
+        j0, j1 = math.floor((lo + math.pi) / w) + 1, math.ceil((hi + math.pi) / w) - 1
+        cuts = sorted({min(max((-math.pi + j * w - a0) / D, 0.0), 1.0) for j in range(j0, j1 + 1)})
+        ts = [0.0] + [c for c in cuts if 0.0 < c < 1.0] + [1.0]
+        return list(zip(ts[:-1], ts[1:]))
+
+    def _refine(self, p0, p1, D: float, ta: float, tb: float, budget: list) -> bool:
+        """Decide the sub-motion [ta, tb] with swept hulls, halving on a hit (see module doc)."""
+        x0, y0, a0 = p0
+        x1, y1 = p1
+        self.checks["refined"] += 1
+        floor_len = FLOOR_REL * self.extent
+        stack = [(ta, tb)]
+        while stack:
+            sa, sb = stack.pop()
+            pa = (x0, y0) if sa == 0.0 else (x0 + (x1 - x0) * sa, y0 + (y1 - y0) * sa)
+            pb = (x1, y1) if sb == 1.0 else (x0 + (x1 - x0) * sb, y0 + (y1 - y0) * sb)
+            if D == 0.0:
+                if self._translation_hits(pa, pb, a0):
+                    self.checks["motion_collisions"] += 1
+                    return False  # the exact translational answer at a0
+                continue
+            fa, fb = a0 + D * sa, a0 + D * sb
+            lo, hi = min(fa, fb) - ANGLE_SLACK, max(fa, fb) + ANGLE_SLACK
+            budget[0] -= 1
+            self.checks["sweeps"] += 1
+            if not self._sweep_hits(pa, pb, lo, hi):
+                continue
+            sm = 0.5 * (sa + sb)
+            xm, ym, am = x0 + (x1 - x0) * sm, y0 + (y1 - y0) * sm, wrap_angle(a0 + D * sm)
+            if not self._pose(xm, ym, am):
+                self.checks["motion_collisions"] += 1
+                return False  # a real collision
+            size = self.radius * (hi - lo) + math.hypot(pb[0] - pa[0], pb[1] - pa[1])
+            if size <= floor_len or budget[0] <= 0 or not (sa < sm < sb):
+                self.checks["motion_floor"] += 1
+                return False  # undecided at the floor: conservative
+            stack.append((sm, sb))
+            stack.append((sa, sm))
+        return True
+
+    def _sweep_hits(self, pa, pb, lo: float, hi: float) -> bool:
+        """Does some robot piece's hull over [lo, hi], swept along pa-pb, meet an obstacle piece?
+        Exact on the computed sweep (separating axes with the exact predicate)."""
+        seg = np.array([pa, pb], dtype=np.float64)
+        for p in self.robot_pieces:
+            # The hull of a sub-range of a slab is built in unwrapped angles; the rotation
+            # by lo is the rotation by lo ± 2π up to rounding, which the pad covers.
+            sweep = minkowski_sum(slab_hull(p, lo, hi, scale=self.scale), seg)
+            smin, smax = sweep.min(axis=0), sweep.max(axis=0)
+            cand = np.flatnonzero((self._olo[:, 0] <= smax[0]) & (self._ohi[:, 0] >= smin[0])
+                                  & (self._olo[:, 1] <= smax[1]) & (self._ohi[:, 1] >= smin[1]))
+            for i in cand.tolist():
+                if exact_relation(sweep, self.obstacle_pieces[i]) != "separated":
+                    return True
+        return False
+
+    def _translation_hits(self, pa, pb, th: float) -> bool:
+        """Does the segment pa-pb meet a sum obstacle piece ⊕ −(robot piece at θ)? Exact:
+        the translation C-space's own segment semantics at the angle θ."""
+        r = self.radius * (1.0 + 2.0**-40) + self.pad  # rotated vertices may round past r
+        lo = np.minimum(pa, pb) - r
+        hi = np.maximum(pa, pb) + r
+        cand = np.flatnonzero((self._olo[:, 0] <= hi[0]) & (self._ohi[:, 0] >= lo[0])
+                              & (self._olo[:, 1] <= hi[1]) & (self._ohi[:, 1] >= lo[1]))
+        if not cand.size:
+            return False
+        neg = [reflect(rotate_piece(p, th)) for p in self.robot_pieces]
+        sums = [minkowski_sum(self.obstacle_pieces[i], n) for i in cand.tolist() for n in neg]
+        ps = PieceSet(sums)
+        return bool(ps.segment_hits_many(np.arange(len(sums)), pa, pb).any())
+
+    # -- report ------------------------------------------------------------------------
+
+    def report(self) -> dict:
+        """K and its reason, the slabs built (seconds, piece counts) and the query counters."""
+        self.checks["states"] = int(self._states.__reduce__()[1][0])
+        return {
+            "slabs": self.slabs,
+            "slabs_reason": self.slabs_reason,
+            "robot_radius": self.radius,
+            "pad": self.pad,
+            "robot_pieces": len(self.robot_pieces),
+            "obstacle_pieces": len(self.obstacle_pieces),
+            "setup_seconds": self.setup_seconds,
+            "slabs_built": sorted(self._built, key=lambda d: d["slab"]),
+            "build_seconds": sum(d["seconds"] for d in self._built),
+            "checks": dict(self.checks),
+        }
+
+
+def _in_convex(p: np.ndarray, x: float, y: float) -> bool:
+    """Is (x, y) in the closed convex CCW polygon p (at least 3 vertices)? Exact."""
+    pts = p.tolist()
+    px, py = pts[-1]
+    for qx, qy in pts:
+        if orient2d_xy(px, py, qx, qy, x, y) < 0:
+            return False
+        px, py = qx, qy
+    return True
+
+
+def _edges(p: np.ndarray) -> list[tuple[float, float, float, float]]:
+    """Per edge of a CCW polygon: outward normal (dy, −dx), offset n·start, and |n|."""
+    pts = p.tolist()
+    out = []
+    px, py = pts[-1]
+    for qx, qy in pts:
+        nx, ny = qy - py, px - qx
+        out.append((nx, ny, nx * px + ny * py, math.hypot(nx, ny)))
+        px, py = qx, qy
+    return out
+
+
+def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_axes: list, x: float, y: float, margin: float) -> int:
+    """Float filter for "is (x, y) in O ⊕ −R'" (R' the robot piece at θ: rotated vertices
+    ``r_pts``; ``r_axes`` the outward normals of −R' with a vertex of R' on each edge and
+    the normal's length): +1 outside, −1 inside, 0 unsure.
+
+    The sum's edge normals are O's and −R''s. For each such n, g(n) = n·p − h_O(n) −
+    h_{−R'}(n) > 0 puts p outside (for ANY direction n); g(n) < 0 for every edge normal
+    puts it inside. Decisions are taken only with |g| > margin·|n|, the margin (the
+    slab pad, 512 units of roundoff of the magnitudes) far above the float error of g,
+    of the turned normals, and of the rounded vertices of the computed sum, so a
+    decided answer is also the exact test's answer.
+    """
+    inside = True
+    for nx, ny, off, ln in o_edges:  # O's normals: h_{−R'}(n) = −min over r of n·r
+        lo = math.inf
+        for rx, ry in r_pts:
+            v = nx * rx + ny * ry
+            if v < lo:
+                lo = v
+        g = nx * x + ny * y - off + lo
+        m = margin * ln
+        if g > m:
+            return 1
+        if g >= -m:
+            inside = False
+    for nx, ny, rx, ry, ln in r_axes:  # −R''s normals: h_{−R'}(n) = n·(−r_e), h_O(n) = max n·o
+        hi = -math.inf
+        for ox, oy in o_pts:
+            v = nx * ox + ny * oy
+            if v > hi:
+                hi = v
+        g = nx * x + ny * y - hi + (nx * rx + ny * ry)
+        m = margin * ln
+        if g > m:
+            return 1
+        if g >= -m:
+            inside = False
+    return -1 if inside else 0
+
+
+def _clip_halfplane(poly: list, nx: float, ny: float, c: float) -> list:
+    """The part of a convex polygon (list of points) where n·x <= c, in floats
+    (Sutherland–Hodgman on one edge; the caller's margins cover the rounding)."""
+    out = []
+    k = len(poly)
+    for t in range(k):
+        px, py = poly[t - 1]
+        qx, qy = poly[t]
+        fp, fq = nx * px + ny * py - c, nx * qx + ny * qy - c
+        if fq <= 0.0:
+            if fp > 0.0:
+                s = fp / (fp - fq)
+                out.append((px + (qx - px) * s, py + (qy - py) * s))
+            out.append((qx, qy))
+        elif fp <= 0.0:
+            s = fp / (fp - fq)
+            out.append((px + (qx - px) * s, py + (qy - py) * s))
+    return out
