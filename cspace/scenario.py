@@ -21,7 +21,8 @@ Schema (all lengths in one unit, angles in radians)::
     [goal]     x, y, theta (optional; must equal the start's unless space = "se2")
     [planner]  name, time, seed        # optional defaults
     [[queries]] start = [x, y], goal = [x, y]   # optional extra queries ([x, y, theta] in SE(2))
-    space = "translation" | "se2"      # optional: "se2" lets the robot rotate (theta is free)
+    space = "translation" | "se2"      # optional: "se2" lets the robot rotate (theta is free;
+                                       # pose angles are taken into [-pi, pi), as OMPL's SO(2))
     slabs = K                          # optional, SE(2) only: angle slabs of the sliced C-space
 """
 from __future__ import annotations
@@ -35,6 +36,7 @@ import numpy as np
 
 from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
 from .polygon import is_convex, normalize
+from .slab import wrap_angle
 
 try:  # Python >= 3.11
     import tomllib
@@ -234,8 +236,8 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
     goal_t = v.table(data, "goal", required=True)
     start, theta = v.pose(start_t, "start")
     goal, goal_theta = v.pose(goal_t, "goal")
-    if se2:
-        start, goal = (*start, theta or 0.0), (*goal, goal_theta or 0.0)
+    if se2:  # angles as OMPL's SO(2) holds them: in [-pi, pi) (pi itself is -pi)
+        start, goal = (*start, wrap_angle(theta or 0.0)), (*goal, wrap_angle(goal_theta or 0.0))
         theta = 0.0  # the robot stays in its body frame; poses carry the angle
     else:
         if goal_theta is not None and theta is not None and goal_theta != theta:
@@ -454,11 +456,11 @@ class _Validator:
                     if th is not None and not se2:
                         raise self.err(f"{fk}.theta", 'the robot only translates here: add space = "se2" to give '
                                                       "queries an angle")
-                    pts.append((*xy, th or 0.0) if se2 else xy)
+                    pts.append((*xy, wrap_angle(th or 0.0)) if se2 else xy)
                 elif p is None:
                     raise self.err(fk, "missing")
                 elif se2 and isinstance(p, list) and len(p) == 3:
-                    pts.append((*self.point(p[:2], fk), self.number(p[2], f"{fk}[2]")))
+                    pts.append((*self.point(p[:2], fk), wrap_angle(self.number(p[2], f"{fk}[2]"))))
                 elif not se2 and isinstance(p, list) and len(p) == 3:
                     raise self.err(fk, 'has an angle, but the robot only translates here: add space = "se2" '
                                        "to let it rotate")

@@ -24,7 +24,7 @@ def poses_along(path: np.ndarray, count: int, weight: float = 0.5) -> np.ndarray
     [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]
     >>> p = poses_along(np.array([[0., 0, 3.0], [0, 0, -3.0]]), 3)   # the shorter arc, through pi
     >>> round(float(p[1, 2]), 6)
-    -3.141593
+    3.141593
     """
     from cspace.se2 import interpolate
 

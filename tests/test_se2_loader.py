@@ -109,3 +109,12 @@ def test_space_override_turns_a_translation_file_into_se2(tmp_path):
     assert sc.space == "se2" and sc.start == (2.0, 2.0, 0.5) and sc.theta == 0.0
     with pytest.raises(ScenarioError):
         load_scenario(f, space="bogus")
+
+
+def test_se2_angles_are_wrapped_into_ompls_range():
+    d = doc(space="se2", queries=[{"start": [1, 1, 7.0], "goal": [9, 9, -4.0]}])
+    d["goal"] = {"x": 8, "y": 8, "theta": math.pi}
+    sc = scenario_from_dict(d)
+    assert sc.goal[2] == -math.pi  # OMPL's SO(2) holds [-pi, pi): pi is -pi
+    assert -math.pi <= sc.queries[0].start[2] < math.pi and abs(sc.queries[0].start[2] - (7.0 - 2 * math.pi)) < 1e-15
+    assert abs(sc.queries[0].goal[2] - (-4.0 + 2 * math.pi)) < 1e-15
