@@ -8,8 +8,8 @@ angle of the slab), and is a plain translational :class:`CSpace` of those hulls:
 - a reference point free in slab k's C-space is free at EVERY angle of the slab (a
   certificate, not a sample);
 - a reference point inside the slab's *inner* C-space (the obstacles summed with each
-  robot piece eroded by its largest displacement in the slab, 2 r sin(Δ/4) about the
-  middle angle) collides at every angle of the slab (certified blocked);
+  robot piece's part that stays inside it through the whole slab,
+  :func:`cspace.slab.slab_inner`) collides at every angle of the slab (certified blocked);
 - anything else gets the exact test at its own angle: the body-frame robot pieces
   rotated by :func:`cspace.slab.rotate`, then exactly the translation C-space's
   semantics (is (x, y) in the computed sum obstacle piece ⊕ −(rotated piece), closed).
@@ -18,13 +18,7 @@ angle of the slab), and is a plain translational :class:`CSpace` of those hulls:
 piece turned by :func:`rotate_piece`, translated by (x, y). Slabs are built lazily, on
 first use, and cached. Everything is deterministic.
 
-Motions follow OMPL's SE(2) interpolation (:func:`interpolate`). A motion is split at
-slab boundaries; a sub-motion whose reference segment is free in its slab's C-space
-is free (the robot stays in segment ⊕ H). Otherwise it is refined: the sub-motion's
-own hull (over its own, smaller angle range) swept along its segment is tested
-exactly against the obstacle pieces, and halved on a hit, until an exact pose in
-collision is found (False) or a floor of size is reached (False, counted: a
-conservative answer, never a false "free").
+Motions (OMPL's SE(2) interpolation, certified) are :mod:`cspace.se2_motion`.
 """
 from __future__ import annotations
 
@@ -36,123 +30,20 @@ import numpy as np
 
 from .broadphase import GridIndex
 from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
-from .gjk import exact_relation
 from .minkowski import minkowski_sum, reflect
-from .pieces import PieceSet
 from .predicates import orient2d_xy
 from .scenario import Scenario, load_scenario
-from .slab import (ANGLE_SLACK, TWO_PI, rotate, rotate_piece, slab_hull, slab_of, slab_pad, slab_range,
-                   wrap_angle)
+from .se2_motion import SE2Motions, interpolate  # noqa: F401  (interpolate: part of this module's API)
+from .slab import (ANGLE_SLACK, TWO_PI, _edges, _typical_gap, default_slabs, robot_radius, rotate_piece,
+                   slab_hull, slab_inner, slab_of, slab_pad, slab_range, wrap_angle)
 
-# Refinement of a motion stops (answer "not free", counted) when the sub-motion's
-# sweep is smaller than this fraction of the scene's extent...
-FLOOR_REL = 1e-9
-# ... or after this many swept hulls for one motion (never a hang).
-MAX_REFINE = 2048
 # Grid cells of each slab's C-space (unless grid_cells is given): a quarter of the
 # translation C-space's default. The grid build dominates a slab's cost (K of them),
 # and the SE(2) hot path reads the slab grid once per state either way.
 SLAB_GRID_CELLS = 1 << 14
 
 
-def interpolate(q0, q1, t: float) -> tuple[float, float, float]:
-    """The pose at fraction t of the motion q0 -> q1, exactly as OMPL's SE2StateSpace computes it.
-
-    x and y: ``from + (to - from) * t`` (RealVectorStateSpace). θ (SO2StateSpace):
-    ``diff = to - from``; if ``|diff| <= π`` then ``from + diff * t``; otherwise along
-    the shorter arc the other way, ``from - d * t`` with ``d = 2π - diff`` (diff > 0)
-    or ``-2π - diff``, then wrapped back by one turn if it left [−π, π]. Both ends
-    must already be in [−π, π] (OMPL's states are).
-
-    >>> interpolate((0, 0, 3.0), (2, 4, -3.0), 0.75)  # through π, the shorter way
-    (1.5, 3.0, -3.0707963267948966)
-    """
-    x0, y0, a = float(q0[0]), float(q0[1]), float(q0[2])
-    x1, y1, b = float(q1[0]), float(q1[1]), float(q1[2])
-    t = float(t)
-    diff = b - a
-    if abs(diff) <= math.pi:
-        th = a + diff * t
-    else:
-        diff = TWO_PI - diff if diff > 0.0 else -TWO_PI - diff
-        th = a - diff * t
-        if th > math.pi:
-            th -= TWO_PI
-        elif th < -math.pi:
-            th += TWO_PI
-    return x0 + (x1 - x0) * t, y0 + (y1 - y0) * t, th
-
-
-def _arc(a: float, b: float) -> float:
-    """The signed angle swept by OMPL's interpolation from a to b (|result| <= π)."""
-    diff = b - a
-    if abs(diff) <= math.pi:
-        return diff
-    return diff - TWO_PI if diff > 0.0 else diff + TWO_PI
-
-
-def robot_radius(pieces: list[np.ndarray]) -> float:
-    """Largest distance of a robot vertex from the reference point (0 for a point robot).
-
-    >>> robot_radius([np.array([[0., 0], [3, 4], [0, 1]])])
-    5.0
-    """
-    return max((float(np.hypot(p[:, 0], p[:, 1]).max()) for p in pieces if len(p)), default=0.0)
-
-
-def default_slabs(robot_radius: float, extent: float, gap: float | None = None) -> tuple[int, str]:
-    """K, the number of slabs, and a one-line reason.
-
-    In a slab of width Δ = 2π/K a robot point at radius r sweeps a chord of about
-    r·Δ, so the slab C-obstacles are thicker than the C-obstacle at one angle by up
-    to about r·Δ (plus r·Δ²/4, the hull's excess over the two end poses), and the
-    inner (certified blocked) ones thinner by about as much. States in that band
-    take the exact test (~20x a grid lookup) and motions through it are refined, so
-    the validity cost grows with r·Δ / g, g the scene's typical gap: K is the
-    smallest power of two with r·2π/K <= g/8 (measured on the bundled scenes: an
-    exact-test share of a few per cent of uniform states). Each slab costs a
-    translational C-space build plus an inner grid (~50-200 ms on the bundled
-    scenes), paid lazily on first use, so K is clamped to [16, 64]: beyond 64 the
-    build time dominates a planning run while the band is already a small
-    fraction of the gaps. Tightness (the hull excess, ~r·Δ²/4) is then below 1 %
-    of r. ``gap`` defaults to extent / 8 and is capped there.
-
-    >>> default_slabs(1.0, 10.0)[0], default_slabs(0.1, 10.0)[0], default_slabs(5.0, 10.0)[0]
-    (64, 16, 64)
-    """
-    g = extent / 8.0 if gap is None or not gap > 0.0 else min(gap, extent / 8.0)
-    if robot_radius <= 0.0:
-        return 1, "K = 1: a point robot does not turn"
-    need = TWO_PI * robot_radius / (g / 8.0)
-    k = 16
-    while k < need and k < 64:
-        k *= 2
-    delta = TWO_PI / k
-    chord = 2.0 * robot_radius * math.sin(0.5 * delta)
-    excess = math.sin(0.5 * delta) ** 2 / math.cos(0.5 * delta)
-    return k, (f"K = {k}: robot radius {robot_radius:.3g}, a slab of {math.degrees(delta):.3g} deg moves its "
-               f"farthest point by {chord:.3g} ({100 * chord / g:.2g} % of the typical gap {g:.3g}); "
-               f"hull excess over the end poses <= {100 * excess:.2g} % of the radius")
-
-
-def _typical_gap(pieces: list[np.ndarray], extent: float) -> float:
-    """Median distance from an obstacle piece to its nearest other piece (shapely),
-    ignoring touching pieces (parts of one decomposed obstacle); extent / 8 if none."""
-    if len(pieces) < 2:
-        return extent / 8.0
-    import shapely
-
-    geoms = [shapely.Polygon(p) for p in pieces[:400]]
-    tree = shapely.STRtree(geoms)
-    gaps = []
-    for i, g in enumerate(geoms):
-        j, d = tree.query_nearest(g, exclusive=True, return_distance=True, all_matches=False)
-        if len(d) and d[0] > 0.0:
-            gaps.append(float(d[0]))
-    return float(np.median(gaps)) if gaps else extent / 8.0
-
-
-class SE2CSpace:
+class SE2CSpace(SE2Motions):
     """C-space of a rotating polygonal robot: K lazily built angle slabs plus exact tests.
 
     >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
@@ -260,7 +151,7 @@ class SE2CSpace:
         if len(outer.obstacle_pieces) != len(self.obstacle_pieces) or len(outer.robot_pieces) != len(hulls):
             # piece_pairs index our pieces: the slab must keep them as given (they are convex)
             raise RuntimeError("SE2CSpace: a slab re-decomposed a convex piece")  # pragma: no cover
-        inner_pieces = self._inner_pieces(a, b)
+        inner_pieces = [j for j in (slab_inner(p, a, b, self.pad) for p in self.robot_pieces) if len(j) >= 3]
         g = outer.index
         inner = False
         if inner_pieces and self.obstacle_pieces:
@@ -302,46 +193,6 @@ class SE2CSpace:
             return exact(x, y, th, k)
 
         return rows, g.inv_w, g.x0 * g.inv_w, g.inv_h, g.y0 * g.inv_h, slow
-
-    def _inner_pieces(self, a: float, b: float) -> list[np.ndarray]:
-        """Convex sets inside every robot piece at every angle of [a, b] (certified blocked).
-
-        Write θ = m + φ, |φ| <= h (m the middle, h the half-width). R_θ P = R_m R_φ P and
-        R_φ P = ∩_e {x : (R_φ n_e)·x <= c_e} over P's edges (outward normal n_e, offset
-        c_e). For one edge, x = |x|(cos α, sin α) relative to n_e, (R_φ n_e)·x =
-        |x| cos(φ − α) is largest over the interval at an end, or at φ = α if α is in it.
-        So J = ∩_φ R_φ P is cut by the two end half-planes (φ = ±h) of every edge, and,
-        for c_e >= 0, by |x| <= c_e on the wedge |α| <= h, which the chord half-plane
-        n_e·x <= c_e cos h implies (there |x| cos h <= |x| cos α = n_e·x). (For c_e < 0
-        the end half-planes already exclude the wedge: 2h < π/2.) Every offset is
-        lowered by four slab pads times |n_e| (the rounding of the turned normals, of
-        the float clipping, of the final rotation and of the C-space sums), and
-        I = R_m J.
-        """
-        half = 0.5 * (b - a)
-        m = a + half
-        ch, sh = math.cos(half), math.sin(half)
-        out = []
-        for p in self.robot_pieces:
-            r = float(np.hypot(p[:, 0], p[:, 1]).max())
-            box = 2.0 * r  # the piece lies within radius r: the clipping's rounding stays ~u·r
-            poly = [(-box, -box), (box, -box), (box, box), (-box, box)]
-            for nx, ny, c, ln in _edges(p):
-                c_safe = c - 4.0 * self.pad * ln
-                for ux, uy, off in ((nx * ch - ny * sh, nx * sh + ny * ch, c_safe),
-                                    (nx * ch + ny * sh, -nx * sh + ny * ch, c_safe),
-                                    (nx, ny, c * ch - 4.0 * self.pad * ln if c >= 0.0 else None)):
-                    if off is not None:
-                        poly = _clip_halfplane(poly, ux, uy, off)
-                if len(poly) < 3:
-                    break
-            if len(poly) >= 3:
-                from .hull import convex_hull
-
-                j = convex_hull(np.array(poly))
-                if len(j) >= 3:
-                    out.append(rotate_piece(j, m))
-        return out
 
     def _slab_index(self, th: float) -> int:
         """Slab of an angle already in [−π, π)."""
@@ -486,119 +337,6 @@ class SE2CSpace:
         th = wrap_angle(float(q[2]))
         return [rotate_piece(p, th) + np.array([float(q[0]), float(q[1])]) for p in self.robot_pieces]
 
-    # -- motions -----------------------------------------------------------------------
-
-    def motion_free(self, q0, q1) -> bool:
-        """Is every pose of OMPL's SE(2) interpolation from q0 to q1 free? Certified.
-
-        True only if every pose is free (slab certificates or exact sweeps); False on
-        an exact pose in collision, or (counted in ``checks["motion_floor"]``) when
-        refinement reaches its floor without deciding.
-        """
-        self.checks["motions"] += 1
-        x0, y0, a0 = float(q0[0]), float(q0[1]), wrap_angle(float(q0[2]))
-        x1, y1, a1 = float(q1[0]), float(q1[1]), wrap_angle(float(q1[2]))
-        if not (self._pose(x1, y1, a1) and self._pose(x0, y0, a0)):
-            self.checks["motion_collisions"] += 1
-            return False
-        D = _arc(a0, a1)
-        budget = [MAX_REFINE]
-        for ta, tb in self._split(a0, D):
-            self.checks["submotions"] += 1
-            pa = (x0, y0) if ta == 0.0 else (x0 + (x1 - x0) * ta, y0 + (y1 - y0) * ta)
-            pb = (x1, y1) if tb == 1.0 else (x0 + (x1 - x0) * tb, y0 + (y1 - y0) * tb)
-            mid = wrap_angle(a0 + D * (0.5 * (ta + tb)))
-            k = self._slab_index(mid)
-            if self.slab(k).segment_free(pa, pb):
-                self.checks["slab_certified"] += 1
-                continue
-            if not self.robot_pieces:  # a point robot: the one slab is the exact C-space
-                self.checks["motion_collisions"] += 1
-                return False
-            ok = self._refine((x0, y0, a0), (x1, y1), D, ta, tb, budget)
-            if not ok:
-                return False
-        return True
-
-    def _split(self, a0: float, D: float) -> list[tuple[float, float]]:
-        """Fractions [ta, tb] of the motion whose angles a0 + D t each stay in one slab."""
-        K = self.slabs
-        if D == 0.0 or K == 1:
-            return [(0.0, 1.0)]
-        w = TWO_PI / K
-        a1 = a0 + D
-        lo, hi = min(a0, a1), max(a0, a1)
-        j0, j1 = math.floor((lo + math.pi) / w) + 1, math.ceil((hi + math.pi) / w) - 1
-        cuts = sorted({min(max((-math.pi + j * w - a0) / D, 0.0), 1.0) for j in range(j0, j1 + 1)})
-        ts = [0.0] + [c for c in cuts if 0.0 < c < 1.0] + [1.0]
-        return list(zip(ts[:-1], ts[1:]))
-
-    def _refine(self, p0, p1, D: float, ta: float, tb: float, budget: list) -> bool:
-        """Decide the sub-motion [ta, tb] with swept hulls, halving on a hit (see module doc)."""
-        x0, y0, a0 = p0
-        x1, y1 = p1
-        self.checks["refined"] += 1
-        floor_len = FLOOR_REL * self.extent
-        stack = [(ta, tb)]
-        while stack:
-            sa, sb = stack.pop()
-            pa = (x0, y0) if sa == 0.0 else (x0 + (x1 - x0) * sa, y0 + (y1 - y0) * sa)
-            pb = (x1, y1) if sb == 1.0 else (x0 + (x1 - x0) * sb, y0 + (y1 - y0) * sb)
-            if D == 0.0:
-                if self._translation_hits(pa, pb, a0):
-                    self.checks["motion_collisions"] += 1
-                    return False  # the exact translational answer at a0
-                continue
-            fa, fb = a0 + D * sa, a0 + D * sb
-            lo, hi = min(fa, fb) - ANGLE_SLACK, max(fa, fb) + ANGLE_SLACK
-            budget[0] -= 1
-            self.checks["sweeps"] += 1
-            if not self._sweep_hits(pa, pb, lo, hi):
-                continue
-            sm = 0.5 * (sa + sb)
-            xm, ym, am = x0 + (x1 - x0) * sm, y0 + (y1 - y0) * sm, wrap_angle(a0 + D * sm)
-            if not self._pose(xm, ym, am):
-                self.checks["motion_collisions"] += 1
-                return False  # a real collision
-            size = self.radius * (hi - lo) + math.hypot(pb[0] - pa[0], pb[1] - pa[1])
-            if size <= floor_len or budget[0] <= 0 or not (sa < sm < sb):
-                self.checks["motion_floor"] += 1
-                return False  # undecided at the floor: conservative
-            stack.append((sm, sb))
-            stack.append((sa, sm))
-        return True
-
-    def _sweep_hits(self, pa, pb, lo: float, hi: float) -> bool:
-        """Does some robot piece's hull over [lo, hi], swept along pa-pb, meet an obstacle piece?
-        Exact on the computed sweep (separating axes with the exact predicate)."""
-        seg = np.array([pa, pb], dtype=np.float64)
-        for p in self.robot_pieces:
-            # The hull of a sub-range of a slab is built in unwrapped angles; the rotation
-            # by lo is the rotation by lo ± 2π up to rounding, which the pad covers.
-            sweep = minkowski_sum(slab_hull(p, lo, hi, scale=self.scale), seg)
-            smin, smax = sweep.min(axis=0), sweep.max(axis=0)
-            cand = np.flatnonzero((self._olo[:, 0] <= smax[0]) & (self._ohi[:, 0] >= smin[0])
-                                  & (self._olo[:, 1] <= smax[1]) & (self._ohi[:, 1] >= smin[1]))
-            for i in cand.tolist():
-                if exact_relation(sweep, self.obstacle_pieces[i]) != "separated":
-                    return True
-        return False
-
-    def _translation_hits(self, pa, pb, th: float) -> bool:
-        """Does the segment pa-pb meet a sum obstacle piece ⊕ −(robot piece at θ)? Exact:
-        the translation C-space's own segment semantics at the angle θ."""
-        r = self.radius * (1.0 + 2.0**-40) + self.pad  # rotated vertices may round past r
-        lo = np.minimum(pa, pb) - r
-        hi = np.maximum(pa, pb) + r
-        cand = np.flatnonzero((self._olo[:, 0] <= hi[0]) & (self._ohi[:, 0] >= lo[0])
-                              & (self._olo[:, 1] <= hi[1]) & (self._ohi[:, 1] >= lo[1]))
-        if not cand.size:
-            return False
-        neg = [reflect(rotate_piece(p, th)) for p in self.robot_pieces]
-        sums = [minkowski_sum(self.obstacle_pieces[i], n) for i in cand.tolist() for n in neg]
-        ps = PieceSet(sums)
-        return bool(ps.segment_hits_many(np.arange(len(sums)), pa, pb).any())
-
     # -- report ------------------------------------------------------------------------
 
     def report(self) -> dict:
@@ -627,18 +365,6 @@ def _in_convex(p: np.ndarray, x: float, y: float) -> bool:
             return False
         px, py = qx, qy
     return True
-
-
-def _edges(p: np.ndarray) -> list[tuple[float, float, float, float]]:
-    """Per edge of a CCW polygon: outward normal (dy, −dx), offset n·start, and |n|."""
-    pts = p.tolist()
-    out = []
-    px, py = pts[-1]
-    for qx, qy in pts:
-        nx, ny = qy - py, px - qx
-        out.append((nx, ny, nx * px + ny * py, math.hypot(nx, ny)))
-        px, py = qx, qy
-    return out
 
 
 def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_axes: list, x: float, y: float, margin: float) -> int:
@@ -681,21 +407,3 @@ def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_axes: list, x: float
     return -1 if inside else 0
 
 
-def _clip_halfplane(poly: list, nx: float, ny: float, c: float) -> list:
-    """The part of a convex polygon (list of points) where n·x <= c, in floats
-    (Sutherland–Hodgman on one edge; the caller's margins cover the rounding)."""
-    out = []
-    k = len(poly)
-    for t in range(k):
-        px, py = poly[t - 1]
-        qx, qy = poly[t]
-        fp, fq = nx * px + ny * py - c, nx * qx + ny * qy - c
-        if fq <= 0.0:
-            if fp > 0.0:
-                s = fp / (fp - fq)
-                out.append((px + (qx - px) * s, py + (qy - py) * s))
-            out.append((qx, qy))
-        elif fp <= 0.0:
-            s = fp / (fp - fq)
-            out.append((px + (qx - px) * s, py + (qy - py) * s))
-    return out

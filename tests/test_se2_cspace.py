@@ -19,7 +19,7 @@ from shapely import affinity
 
 from cspace import CSpace, load_scenario
 from cspace.se2 import SE2CSpace, default_slabs, interpolate
-from cspace.slab import rotate_piece
+from cspace.slab import rotate_piece, slab_inner
 
 from conftest import SCENARIOS
 
@@ -230,7 +230,7 @@ def test_inner_sets_are_inside_the_robot_at_every_angle_of_their_slab():
     rng = np.random.default_rng(16)
     for k in range(16):
         a, b = cs._lo[k], cs._hi[k]
-        inner = cs._inner_pieces(a, b)
+        inner = [j for j in (slab_inner(p, a, b, cs.pad) for p in cs.robot_pieces) if len(j)]
         assert len(inner) >= 2
         for th in list(rng.uniform(a, b, 40)) + [a, b]:
             for I in inner:
@@ -269,3 +269,38 @@ def test_pair_filter_decides_like_the_exact_sum():
         else:
             assert (side < 0) == inside
     assert 0 < undecided < 1500
+
+
+def test_piece_pairs_cover_every_sum():
+    """CSpace.piece_pairs: each kept piece lists pairs whose sums lie inside it, and every pair
+    whose sum meets the bounds is listed once (including sums pruned as inside another piece)."""
+    from cspace.minkowski import minkowski_sum, reflect
+    from cspace.predicates import orient2d_xy
+
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    parts = [sq * 0.3, sq * 0.2 + 0.05, sq * 0.1 + 0.1, np.array([[-0.5, -0.5], [-0.4, -0.5], [-0.45, -0.3]])]
+    obstacles = [sq * 2 + 3, sq + 6, sq * 0.5 + 3.2, np.array([[20.0, 20.0], [21.0, 20.0], [21.0, 21.0]])]
+    cs = CSpace((0, 10, 0, 10), obstacles, parts)
+    listed = [pair for pairs in cs.piece_pairs for pair in pairs]
+    assert len(listed) == len(set(listed)) == 3 * 4  # the far obstacle's sums are outside the bounds
+    assert len(cs.pieces) < 12  # some sums were pruned as inside another: their pairs moved
+    for piece, pairs in zip(cs.pieces, cs.piece_pairs):
+        P = piece.tolist()
+        for i, j in pairs:
+            S = minkowski_sum(cs.obstacle_pieces[i], reflect(cs.robot_pieces[j]))
+            assert all(orient2d_xy(*P[e - 1], *P[e], x, y) >= 0 for e in range(len(P)) for x, y in S.tolist())
+
+
+def test_bench_script_runs(capsys):
+    from conftest import load_script
+    import sys
+
+    bench = load_script("bench_se2")
+    argv = sys.argv
+    sys.argv = ["bench_se2.py", "--slabs", "4", "--states", "200", "--motions", "10", "--reps", "1", "theta.toml"]
+    try:
+        bench.main()
+    finally:
+        sys.argv = argv
+    out = capsys.readouterr().out
+    assert "ratio" in out and "floor decisions" in out
