@@ -228,8 +228,9 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
     if slabs is not None:
         if space != "se2":
             raise v.err("slabs", 'applies to space = "se2" only')
-        if isinstance(slabs, bool) or not isinstance(slabs, int) or not 1 <= slabs <= MAX_SLABS:
-            raise v.err("slabs", f"must be an integer from 1 to {MAX_SLABS}, got {_short(slabs)}")
+        if isinstance(slabs, bool) or not isinstance(slabs, int) or not 4 <= slabs <= MAX_SLABS:
+            raise v.err("slabs", f"must be an integer from 4 to {MAX_SLABS} (a slab spans at most a quarter "
+                                 f"turn), got {_short(slabs)}")
     se2 = space == "se2"
 
     start_t = v.table(data, "start", required=True)

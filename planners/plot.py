@@ -55,12 +55,12 @@ def draw_scene(ax, scenario, cspace=None, pieces_edges: bool = False) -> None:
         ax.add_patch(_poly_patch(ob.polygon, ob.holes, facecolor=OBSTACLE, edgecolor="none", alpha=0.85))
 
 
-def draw_robot(ax, scenario, x: float, y: float, color=ROBOT, alpha=0.5, fill=True) -> None:
-    """The robot's parts with the reference point at (x, y)."""
+def draw_robot(ax, scenario, x: float, y: float, theta: float = 0.0, color=ROBOT, alpha=0.5, fill=True) -> None:
+    """The robot's parts with the reference point at (x, y), turned by theta (SE(2))."""
     if scenario.is_point_robot:
         ax.plot([x], [y], "o", color=color, markersize=5)
         return
-    for part in scenario.robot_at(x, y):
+    for part in scenario.robot_at(x, y, theta):
         ax.add_patch(_poly_patch(part, facecolor=color if fill else "none", edgecolor=color,
                                  alpha=alpha, linewidth=0.8))
     ax.plot([x], [y], ".", color=color, markersize=3)
@@ -84,12 +84,21 @@ def plot_result(res, out: str, fmt: str | None = None, scenario=None, cspace=Non
     sc = scenario or res.scenario_data
     if sc is None:
         raise ValueError("plot_result needs the scenario (pass scenario=...)")
-    cs = cspace or res.cspace or CSpace.from_scenario(sc)
+    se2 = sc.space == "se2"
+    # In SE(2) the C-obstacles depend on the angle: the picture shows the workspace and
+    # the robot's footprint along the path instead.
+    cs = None if se2 else (cspace or res.cspace or CSpace.from_scenario(sc))
     fig, ax = plt.subplots(figsize=(7, 7 * (sc.bounds[3] - sc.bounds[2]) / (sc.bounds[1] - sc.bounds[0]) + 0.6))
     draw_scene(ax, sc, cs)
     results = res.queries or [res]
     for r in results:
-        if r.solved and len(r.path):
+        if r.solved and len(r.path) and se2:
+            from .animate import poses_along
+
+            for q in poses_along(r.path, 14 if len(results) == 1 else 0)[1:-1]:
+                draw_robot(ax, sc, *q, color=PATH, alpha=0.35, fill=False)
+            ax.plot(r.path[:, 0], r.path[:, 1], "-", color=PATH, linewidth=1.4)
+        elif r.solved and len(r.path):
             for q in _poses(r.path, poses if len(results) == 1 else 0):
                 draw_robot(ax, sc, q[0], q[1], color=PATH, alpha=0.25, fill=False)
             ax.plot(r.path[:, 0], r.path[:, 1], "-", color=PATH, linewidth=1.4)
