@@ -123,16 +123,24 @@ def _frame(ax, bounds) -> None:
     ax.set_aspect("equal")
 
 
-def plot_scene(scenario, cspace, out: str, fmt: str | None = None) -> None:
-    """Save a picture of the workspace, the C-obstacles and their convex pieces."""
+def plot_scene(scenario, cspace, out: str, fmt: str | None = None, theta: float | None = None,
+               title: str | None = None) -> None:
+    """Save a picture of the workspace, the C-obstacles and their convex pieces.
+
+    In SE(2) ``cspace`` is one angle slab's C-space and ``theta`` the angle at which the
+    robot is drawn at the start and the goal."""
     plt = _mpl()[0]
     sc = scenario
     fig, ax = plt.subplots(figsize=(7, 7 * (sc.bounds[3] - sc.bounds[2]) / (sc.bounds[1] - sc.bounds[0]) + 0.6))
     draw_scene(ax, sc, cspace, pieces_edges=True)
-    draw_robot(ax, sc, *sc.start, color=ROBOT, alpha=0.6)
-    draw_robot(ax, sc, *sc.goal, color="#c0392b", alpha=0.6)
+    if theta is None:
+        draw_robot(ax, sc, *sc.start, color=ROBOT, alpha=0.6)
+        draw_robot(ax, sc, *sc.goal, color="#c0392b", alpha=0.6)
+    else:
+        draw_robot(ax, sc, sc.start[0], sc.start[1], theta, color=ROBOT, alpha=0.6)
+        draw_robot(ax, sc, sc.goal[0], sc.goal[1], theta, color="#c0392b", alpha=0.6)
     _frame(ax, sc.bounds)
-    ax.set_title(f"{sc.name}: {len(sc.obstacles)} obstacles, {len(cspace.pieces)} C-obstacle pieces")
+    ax.set_title(title or f"{sc.name}: {len(sc.obstacles)} obstacles, {len(cspace.pieces)} C-obstacle pieces")
     _save(fig, out, fmt)
 
 

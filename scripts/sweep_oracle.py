@@ -60,8 +60,16 @@ def at(piece, pose):
     return affinity.translate(affinity.rotate(piece, pose[2], origin=(0, 0), use_radians=True), pose[0], pose[1])
 
 
-def sweep_check(sc, path, dtheta: float = 2e-3, dxy: float | None = None) -> dict:
-    """{'collides': bool, 'certain': bool, 'out_of_bounds': bool, 'steps': int} for an (N, 3) path."""
+def sweep_check(sc, path, dtheta: float = 2e-3, dxy: float | None = None, floor: float = 1e-12) -> dict:
+    """{'collides': bool, 'certain': bool, 'out_of_bounds': bool, 'steps': int, 'undecided': int} for an
+    (N, 3) path.
+
+    A step whose padded hull meets an obstacle is halved (the pad shrinks with the square
+    of the step's rotation) until a sampled pose collides (``certain``), the padded hull
+    misses, or the pad falls below ``floor`` x the extent with the hull still within it of
+    an obstacle (``undecided``: a contact closer than the floor, counted, and reported as
+    ``collides`` only with ``strict``). The judge is shapely's, independent of cspace.
+    """
     obstacles = shapely.union_all([o.to_shapely() for o in sc.obstacles]) if sc.obstacles else shapely.Polygon()
     tree_obs = prep(obstacles) if not obstacles.is_empty else None
     pieces = robot_pieces(sc) if sc.robot else [shapely.Point(0, 0)]
@@ -70,24 +78,43 @@ def sweep_check(sc, path, dtheta: float = 2e-3, dxy: float | None = None) -> dic
     xmin, xmax, ymin, ymax = sc.bounds
     ext = max(xmax - xmin, ymax - ymin)
     dxy = dxy or ext * 2e-3
-    res = {"collides": False, "certain": False, "out_of_bounds": False, "steps": 0}
+    res = {"collides": False, "certain": False, "out_of_bounds": False, "steps": 0, "undecided": 0}
+
+    def pad_of(a, b):
+        return r * (1 - math.cos(min(abs(_shortest(a[2], b[2])), math.pi) / 2)) * 1.01 + 1e-15 * ext
+
+    def step_hits(p0, p1) -> str:
+        """'free', 'collides' (a sampled pose meets an obstacle) or 'undecided'."""
+        stack = [(p0, p1)]
+        while stack:
+            q0, q1 = stack.pop()
+            res["steps"] += 1
+            pad = pad_of(q0, q1)
+            for piece in pieces:
+                g0, g1 = at(piece, q0), at(piece, q1)
+                if tree_obs.intersects(g0) or tree_obs.intersects(g1):
+                    return "collides"
+                hull = shapely.union(g0, g1).convex_hull
+                if not tree_obs.intersects(hull.buffer(pad, quad_segs=2)):
+                    continue
+                if pad < floor * ext and math.hypot(q1[0] - q0[0], q1[1] - q0[1]) < floor * ext:
+                    res["undecided"] += 1
+                    continue
+                mid = _interp(q0, q1, 0.5)
+                stack += [(q0, mid), (mid, q1)]
+                break
+        return "free"
+
     for a, b in zip(path[:-1], path[1:]):
         n = max(1, math.ceil(abs(_shortest(a[2], b[2])) / dtheta), math.ceil(math.hypot(b[0] - a[0], b[1] - a[1]) / dxy))
         poses = [_interp(a, b, k / n) for k in range(n + 1)]
-        pad = r * (1 - math.cos(min(abs(_shortest(a[2], b[2])) / n, math.pi) / 2)) * 1.01 + 1e-12 * ext
         for p in poses:
             if not (xmin <= p[0] <= xmax and ymin <= p[1] <= ymax):
                 res["out_of_bounds"] = True
         if tree_obs is None:
             continue
         for p0, p1 in zip(poses[:-1], poses[1:]):
-            res["steps"] += 1
-            for piece in pieces:
-                g0, g1 = at(piece, p0), at(piece, p1)
-                if tree_obs.intersects(g0) or tree_obs.intersects(g1):
-                    res["collides"] = res["certain"] = True
-                    return res
-                hull = shapely.union(g0, g1).convex_hull.buffer(pad, quad_segs=2)
-                if tree_obs.intersects(hull):
-                    res["collides"] = True
+            if step_hits(p0, p1) == "collides":
+                res["collides"] = res["certain"] = True
+                return res
     return res
