@@ -40,7 +40,7 @@ from .slab import (ANGLE_SLACK, TWO_PI, _edges, _typical_gap, default_slabs, rob
 # Grid cells of each slab's C-space (unless grid_cells is given): a quarter of the
 # translation C-space's default. The grid build dominates a slab's cost (K of them),
 # and the SE(2) hot path reads the slab grid once per state either way.
-SLAB_GRID_CELLS = 1 << 14
+SLAB_GRID_CELLS = 1 << 12
 
 
 class SE2CSpace(SE2Motions):

@@ -143,12 +143,12 @@ def draw_scene(ax, scenario, cspace=None, pieces_edges: bool = False) -> list[st
     return keys
 
 
-def draw_robot(ax, scenario, x: float, y: float, color=ROBOT, alpha=0.5, fill=True) -> None:
-    """The robot's parts with the reference point at (x, y)."""
+def draw_robot(ax, scenario, x: float, y: float, theta: float = 0.0, color=ROBOT, alpha=0.5, fill=True) -> None:
+    """The robot's parts with the reference point at (x, y), turned by theta (SE(2))."""
     if scenario.is_point_robot:
         ax.plot([x], [y], "o", color=color, markersize=5)
         return
-    for part in scenario.robot_at(x, y):
+    for part in scenario.robot_at(x, y, theta):
         ax.add_patch(_poly_patch(part, facecolor=color if fill else "none", edgecolor=color,
                                  alpha=alpha, linewidth=0.8))
     ax.plot([x], [y], ".", color=color, markersize=3)
@@ -183,8 +183,20 @@ def _draw_queries(ax, sc, results: list, poses: int) -> list[str]:
     """Paths, robots at start and goal, failed queries; returns the legend keys drawn."""
     single = len(results) == 1
     keys: list[str] = []
+    se2 = sc.space == "se2"
     for i, r in enumerate(results):
-        if r.solved and len(r.path):
+        if r.solved and len(r.path) and se2:
+            # A rotating robot: its footprint at poses spaced along the path, moved as
+            # the planner's motions move it (OMPL's SE(2) interpolation), so it is seen to turn.
+            from .animate import poses_along
+
+            along = poses_along(r.path, 3 * poses + 2 if single else 0)[1:-1]
+            for q in along:
+                draw_robot(ax, sc, q[0], q[1], q[2], color=PATH, alpha=0.35, fill=False)
+            keys += ["along"] if len(along) else []
+            ax.plot(r.path[:, 0], r.path[:, 1], "-", color=PATH, linewidth=1.4)
+            keys.append("path")
+        elif r.solved and len(r.path):
             along = _poses(r.path, poses if single else 0)
             for q in along:
                 draw_robot(ax, sc, q[0], q[1], color=PATH, alpha=0.25, fill=False)
@@ -194,8 +206,8 @@ def _draw_queries(ax, sc, results: list, poses: int) -> list[str]:
         else:
             draw_failed(ax, r.start, r.goal, label=None if single else f"query {i}")
             keys.append("failed")
-        draw_robot(ax, sc, *r.start[:2], color=ROBOT, alpha=0.6)
-        draw_robot(ax, sc, *r.goal[:2], color=GOAL, alpha=0.6)
+        draw_robot(ax, sc, *r.start[:3], color=ROBOT, alpha=0.6)
+        draw_robot(ax, sc, *r.goal[:3], color=GOAL, alpha=0.6)
     keys += ["start", "goal"] if single else ["query_start", "query_goal"]
     order = ["start", "goal", "query_start", "query_goal", "along", "path", "failed"]
     return [k for k in order if k in keys]
@@ -274,7 +286,9 @@ def figure_result(res, scenario=None, cspace=None, poses: int = 4):
     sc = scenario or res.scenario_data
     if sc is None:
         raise ValueError("plot_result needs the scenario (pass scenario=...)")
-    cs = cspace or res.cspace or CSpace.from_scenario(sc)
+    # In SE(2) the C-obstacles depend on the angle: the picture shows the workspace and
+    # the robot's footprint along the path (cspace show --space se2 --theta draws a slab).
+    cs = None if sc.space == "se2" else (cspace or res.cspace or CSpace.from_scenario(sc))
     results = res.queries or [res]
     gap = narrow_gap(sc, cs, results)
     fig, ax = _new_figure(sc, wide=gap is not None)
@@ -310,22 +324,27 @@ def plot_result(res, out: str, fmt: str | None = None, scenario=None, cspace=Non
     save(figure_result(res, scenario=scenario, cspace=cspace, poses=poses), out, fmt)
 
 
-def figure_scene(scenario, cspace):
-    """The Figure of a scene: workspace, C-obstacles and their convex pieces, start and goal."""
+def figure_scene(scenario, cspace, theta: float | None = None, title: str | None = None):
+    """The Figure of a scene: workspace, C-obstacles and their convex pieces, start and goal.
+
+    In SE(2) ``cspace`` is one angle slab's C-space and ``theta`` the angle at which the
+    robot is drawn at the start and the goal."""
     sc = scenario
     fig, ax = _new_figure(sc)
     keys = draw_scene(ax, sc, cspace, pieces_edges=True)
-    draw_robot(ax, sc, *sc.start[:2], color=ROBOT, alpha=0.6)
-    draw_robot(ax, sc, *sc.goal[:2], color=GOAL, alpha=0.6)
+    th = () if theta is None else (theta,)
+    draw_robot(ax, sc, *sc.start[:2], *th, color=ROBOT, alpha=0.6)
+    draw_robot(ax, sc, *sc.goal[:2], *th, color=GOAL, alpha=0.6)
     _frame(ax, sc.bounds)
-    ax.set_title(f"{sc.name}: {len(sc.obstacles)} obstacles, {len(cspace.pieces)} C-obstacle pieces")
+    ax.set_title(title or f"{sc.name}: {len(sc.obstacles)} obstacles, {len(cspace.pieces)} C-obstacle pieces")
     add_legend(ax, legend_handles(keys + ["start", "goal"], sc.is_point_robot))
     return fig
 
 
-def plot_scene(scenario, cspace, out: str, fmt: str | None = None) -> None:
+def plot_scene(scenario, cspace, out: str, fmt: str | None = None, theta: float | None = None,
+               title: str | None = None) -> None:
     """Save a picture of the workspace, the C-obstacles and their convex pieces."""
-    save(figure_scene(scenario, cspace), out, fmt)
+    save(figure_scene(scenario, cspace, theta=theta, title=title), out, fmt)
 
 
 def save(fig, out: str, fmt: str | None = None) -> None:

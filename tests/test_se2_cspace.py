@@ -295,9 +295,9 @@ def test_bench_script_runs(capsys):
     from conftest import load_script
     import sys
 
-    bench = load_script("bench_se2")
+    bench = load_script("bench_se2_checks")
     argv = sys.argv
-    sys.argv = ["bench_se2.py", "--slabs", "4", "--states", "200", "--motions", "10", "--reps", "1", "theta.toml"]
+    sys.argv = ["bench_se2_checks.py", "--slabs", "4", "--states", "200", "--motions", "10", "--reps", "1", "theta.toml"]
     try:
         bench.main()
     finally:
