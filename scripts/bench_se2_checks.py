@@ -68,7 +68,7 @@ def main():
                   (q0[2] + d[2] + math.pi) % (2 * math.pi) - math.pi)
             motions.append((q0, q1))
         before = dict(se2.checks)
-        m_tr, m_se2 = interleaved([lambda m: cs.segment_free(m[0], m[1]), lambda m: se2.motion_free(m[0], m[1])],
+        m_tr, m_se2 = interleaved([lambda m: cs.segment_free(m[0][:2], m[1][:2]), lambda m: se2.motion_free(m[0], m[1])],
                                   motions, args.reps)
         c = {k: (se2.checks[k] - before[k]) // args.reps for k in se2.checks}
         ok = sum(se2.motion_free(a, b) for a, b in motions)
