@@ -45,7 +45,7 @@ MAX_BUDGET = 1e6  # seconds per run (11 days); OMPL's clock overflows near 8e9 s
 # Fields of a row, in CSV order. Times in seconds; lengths in scenario units.
 FIELDS = (
     "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
-    "length", "length_unsimplified", "optimum", "error", "error_unsimplified",
+    "length", "length_unsimplified", "optimum", "reference", "error", "error_unsimplified",
     "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks",
     "wall_s", "message",
 )
@@ -74,6 +74,9 @@ def register(sub) -> None:
     p.add_argument("--out", default="bench_out", help="output folder (created if missing)")
     p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on")
     p.add_argument("--no-plot", action="store_true", help="skip error_vs_time.png")
+    from .cli_plan import add_space_options
+
+    add_space_options(p)
     p.add_argument("--quiet", "-q", action="store_true", help="no progress line")
     # Test hook: the child of this (planner, seed) calls os.abort(), as a segfaulting planner would.
     p.add_argument("--abort-on", help=argparse.SUPPRESS)
@@ -150,7 +153,9 @@ def run(args) -> int:
     if os.path.exists(out) and not os.path.isdir(out):
         raise InputError(out, "--out", "exists and is not a folder")
     held: dict = {}
-    scenarios = reference(args.scenario, quiet=args.quiet, held=held)
+    if args.slabs is not None and not 4 <= args.slabs <= 4096:
+        raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
+    scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
     os.makedirs(out, exist_ok=True)
     _clear_outputs(out)  # never mix two sweeps in one folder
     tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on)
@@ -210,10 +215,16 @@ def _clear_outputs(out: str) -> None:
 
 # ---------------------------------------------------------------- the reference
 
-def reference(files: list[str], quiet: bool = True, held: dict | None = None) -> list[dict]:
-    """Load each scenario and compute its exact shortest path length once.
+def reference(files: list[str], quiet: bool = True, held: dict | None = None, space: str | None = None,
+              slabs: int | None = None) -> list[dict]:
+    """Load each scenario and compute its reference length once.
 
-    Returns ``[{"file", "scenario", "optimum"}]`` (``optimum`` None if no path exists).
+    Returns ``[{"file", "scenario", "optimum", "reference", "space", "slabs"}]``.
+    Translation: ``optimum`` is the exact shortest path's length (``reference`` is
+    ``"optimum"``; None if no path exists). SE(2) has no exact planner: ``optimum`` is
+    the inscribed-disk lower bound on the reference point's path length
+    (:mod:`planners.se2_bounds`; ``reference`` is ``"lower_bound"``), so a row's
+    ``error = length / lower bound - 1`` is an upper bound on its true error.
     ``scenario`` is the scenario's name, made unique when two files share a name (the
     file's name is added), so that the summary, the figure and the logs keep them
     apart. With ``held``, ``held[file] = (scenario, cspace)`` keeps each built C-space
@@ -221,20 +232,35 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None) ->
     """
     from cspace.scenario import load_scenario
 
-    from .plan import plan
+    from .plan import _build_cspace, plan
 
     out = []
     for f in files:
         full = os.path.abspath(f)
         if any(o["file"] == full for o in out):
             raise InputError(f, "scenario", "given twice")
-        sc = load_scenario(f)
-        res = plan(sc, planner="exact")
-        out.append({"file": full, "scenario": sc.name, "optimum": float(res.length) if res.solved else None})
+        sc = load_scenario(f, space=space)
+        if sc.space == "se2":
+            from .se2_bounds import disk_bound
+
+            cs = _build_cspace(sc, slabs)
+            for k in range(cs.slabs):  # built once here, not lazily in every forked run
+                cs.slab(k)
+            db = disk_bound(sc, sc.all_queries()[0])
+            bound = db.lower_bound if math.isfinite(db.lower_bound) else None
+            out.append({"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
+                        "space": "se2", "slabs": cs.slabs})
+            note = f"lower bound {bound:.6g} ({db.message})" if bound else db.message
+        else:
+            res = plan(sc, planner="exact")
+            cs = res.cspace
+            out.append({"file": full, "scenario": sc.name, "optimum": float(res.length) if res.solved else None,
+                        "reference": "optimum", "space": "translation", "slabs": None})
+            note = f"exact shortest path {res.length:.6g} ({res.message})"
         if held is not None:
-            held[full] = (sc, res.cspace)
+            held[full] = (sc, cs)
         if not quiet:
-            sys.stderr.write(f"{sc.name}: exact shortest path {res.length:.6g} ({res.message})\n")
+            sys.stderr.write(f"{sc.name}: {note}\n")
     names = [o["scenario"] for o in out]
     for i, o in enumerate(out):
         if names.count(o["scenario"]) > 1:
@@ -250,7 +276,9 @@ def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None)
             for t in times:
                 for seed in range(runs):
                     tasks.append({"order": [si, pi, t, seed], "file": sc["file"], "scenario": sc["scenario"],
-                                  "optimum": sc["optimum"], "planner": p, "time_budget": t, "seed": seed,
+                                  "optimum": sc["optimum"], "reference": sc.get("reference", "optimum"),
+                                  "space": sc.get("space"), "slabs": sc.get("slabs"),
+                                  "planner": p, "time_budget": t, "seed": seed,
                                   "iterations": iterations, "abort": abort_on == (p, seed)})
     return tasks
 
@@ -271,10 +299,10 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
 
     if task.get("abort"):
         os.abort()
-    sc = scenario if scenario is not None else load_scenario(task["file"])
+    sc = scenario if scenario is not None else load_scenario(task["file"], space=task.get("space"))
     planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
     res = plan(sc, planner=planner, time=budget, seed=int(task["seed"]), iterations=iters,
-               cspace=cspace, slices=True)
+               cspace=cspace, slices=True, slabs=task.get("slabs") if cspace is None else None)
     ok = bool(res.solved)
     opt = task["optimum"]
     length = float(res.length) if ok else None
@@ -283,6 +311,7 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
         "scenario": task["scenario"], "file": task["file"], "planner": planner, "time_budget": budget,
         "seed": int(task["seed"]), "status": "ok", "solved": ok,
         "length": length, "length_unsimplified": raw_len, "optimum": opt,
+        "reference": task.get("reference", "optimum"),
         "error": _error(length, opt), "error_unsimplified": _error(raw_len, opt),
         "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings["solve"],
         "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
@@ -379,7 +408,7 @@ def _complete(task: dict, row: dict, wall: float) -> dict:
     base = {f: None for f in FIELDS}
     base.update({"scenario": task["scenario"], "file": task["file"], "planner": task["planner"],
                  "time_budget": task["time_budget"], "seed": task["seed"], "optimum": task["optimum"],
-                 "solved": False, "progress": []})
+                 "reference": task.get("reference", "optimum"), "solved": False, "progress": []})
     base.update(row)
     base["wall_s"] = wall
     base["order"] = task["order"]
@@ -691,11 +720,15 @@ def curves(rows: list[dict]) -> dict:
 def summary(rows: list[dict]) -> str:
     """A table: median error and success rate at the largest budget, per scenario and planner."""
     cs = curves(rows)
+    bounded = {r["scenario"] for r in rows if r.get("reference") == "lower_bound"}
     lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'success':>8}"]
     for (scen, p), c in cs.items():
         m = c["median"][-1]
-        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {'-' if m is None else f'{m:.4f}':>13} "
-                     f"{c['success'][-1]:>8.0%}")
+        text = "-" if m is None else (f"<= {m:.4f}" if scen in bounded else f"{m:.4f}")
+        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} {c['success'][-1]:>8.0%}")
+    if bounded:
+        lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
+                     "bound on the error")
     return "\n".join(lines)
 
 

@@ -137,5 +137,5 @@ class SE2Space:
 
     def counts(self) -> tuple[int, int]:
         """Checks made so far: (state checks, motion checks)."""
-        c = self.cspace.checks
+        c = self.cspace.report()["checks"]
         return c.get("states", 0), c.get("motions", 0)

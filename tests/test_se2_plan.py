@@ -106,3 +106,21 @@ def test_show_draws_one_slab(tmp_path):
 def test_bad_se2_options(args, field, tmp_path):
     r = cli("plan", os.path.join(SCENARIOS, "se2", "bar_door.toml"), *args, cwd=str(tmp_path))
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+
+
+def test_bench_on_an_se2_scene(tmp_path):
+    """The bench plans SE(2) scenes through the same routine; the reference is the
+    inscribed-disk lower bound, so every error it reports is >= 0 (an upper bound)."""
+    import csv
+
+    out = tmp_path / "b"
+    r = cli("bench", os.path.join(SCENARIOS, "se2", "bar_door.toml"), "--planners", "RRTConnect", "--times", "3",
+            "--runs", "2", "--out", str(out), "-q")
+    assert r.returncode == 0, r.stderr
+    rows = list(csv.DictReader(open(out / "results.csv")))
+    assert len(rows) == 2 and all(row["reference"] == "lower_bound" for row in rows)
+    solved = [row for row in rows if row["solved"] == "True"]
+    assert solved, rows
+    for row in solved:
+        assert float(row["length"]) >= float(row["optimum"]) and float(row["error"]) >= 0.0
+        assert int(row["state_checks"]) > 0 and int(row["motion_checks"]) > 0
