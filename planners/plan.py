@@ -93,6 +93,9 @@ MAX_TIME = 1e8  # seconds (about three years); OMPL's steady clock overflows nea
 SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit
 
 
+DEFAULT_TIME_SE2 = 10.0  # seconds, when neither the call nor the file gives a time (translation: 1)
+
+
 def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
     """Scenario object plus the effective planner, time and seed (arguments over file defaults)."""
     from .ompl_glue import planner_name
@@ -116,7 +119,8 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
         name = planner_name(planner, "plan()", "planner")
     else:
         name = planner_name(opts.get("name"), src, "planner.name")
-    t = time_limit if time_limit is not None else opts.get("time", 1.0)
+    # SE(2) builds its angle slabs lazily, inside the planner's time: a longer default.
+    t = time_limit if time_limit is not None else opts.get("time", DEFAULT_TIME_SE2 if sc.space == "se2" else 1.0)
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
         raise ScenarioError(*where(time_limit, "time"), f"must be a positive number of seconds, got {t!r}")
     if t > MAX_TIME:
