@@ -60,6 +60,38 @@ def plan_figure(scenario: str, planner: str | None = None, seed: int = SEED) -> 
     return draw
 
 
+def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False) -> Callable[[str], str]:
+    """A rotating robot's plan (scenarios/se2/), its footprint along the path; with ``animate``
+    also the GIF of ``cspace plan --animate`` beside the PNG (same name, .gif)."""
+
+    def draw(out: str) -> str:
+        from planners.animate import animate_path
+        from planners.plan import plan
+        from planners.plot import plot_result
+
+        res = plan(os.path.join(SCENARIOS, "se2", f"{scenario}.toml"), seed=seed)
+        plot_result(res, out)
+        if animate and res.solved:
+            animate_path(res, os.path.splitext(out)[0] + ".gif")
+        state = f"length {res.length:.6g}" if res.solved else "not solved"
+        return f"{res.planner} seed {res.seed}: {state}" + (" (+ GIF)" if animate and res.solved else "")
+
+    return draw
+
+
+def se2_slab_figure(scenario: str, theta: float) -> Callable[[str], str]:
+    """One angle slab's C-space of a rotating robot, as ``cspace show --space se2 --theta``."""
+
+    def draw(out: str) -> str:
+        from planners.cli import main
+
+        code = main(["show", os.path.join(SCENARIOS, "se2", f"{scenario}.toml"), "--theta", repr(theta),
+                     "--plot", out])
+        return f"slab of theta {theta:g} (exit {code})"
+
+    return draw
+
+
 def cspace_figure(scenario: str) -> Callable[[str], str]:
     """Workspace, C-obstacles and their convex pieces, as ``cspace show --plot``."""
 
@@ -153,6 +185,12 @@ def figures() -> list[Figure]:
     for fam in FAMILIES:
         out.append(Figure(f"{fam}_cspace", "families", f"C-space of {fam}.toml", cspace_figure(fam)))
         out.append(Figure(f"{fam}_plan", "families", f"plan of {fam}.toml", plan_figure(fam)))
+    out.append(Figure("se2_piano_corridor", "se2", "SE(2): a bar round a corner (GIF beside it)",
+                      se2_plan_figure("piano_corridor", animate=True)))
+    out.append(Figure("se2_tee_slot", "se2", "SE(2): a T through a slot", se2_plan_figure("tee_slot")))
+    out.append(Figure("se2_car_maze", "se2", "SE(2): a car-shaped body through a maze", se2_plan_figure("car_maze")))
+    out.append(Figure("se2_tee_slot_slab", "se2", "SE(2): the slab C-space of theta = pi/2",
+                      se2_slab_figure("tee_slot", 1.5707963267948966)))
     out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
     out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure()))
     out.append(Figure("error_vs_time", "acceptance", "cspace bench: the acceptance sweep (4 scenarios, 4 planners)",
@@ -178,7 +216,7 @@ def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "figures"), help="folder for the PNGs")
-    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, circles, bench, "
+    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, se2, circles, bench, "
                                    "stability; acceptance, the long sweep, only when named)")
     ap.add_argument("--list", action="store_true", help="list the figures and exit")
     args = ap.parse_args(argv)
