@@ -7,8 +7,9 @@ its length. In open space the piece runs from wall to wall (or to the bounds); i
 passage it spans the passage, whatever side of it the path hugs (the exact planner's
 optimum touches the walls). The narrowest gap along the path is the minimum over
 points sampled inside every segment (not at the bends, where the perpendicular is
-ambiguous); along a passage of constant width, the middle of the narrowest run. This is a measure for display, not a certificate: the sampling can
-step over a pinch shorter than the spacing of the samples.
+ambiguous); along a passage of constant width, the middle of the narrowest run. This
+is a measure for display, not a certificate: the sampling can step over a pinch
+shorter than the spacing of the samples.
 """
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ class Gap:
 
 
 def narrowest_gap(pieces: list, bounds, path, samples: int = 400, free=None) -> Gap | None:
-    """The narrowest gap across ``path`` ((N, 2) points) in the free space of ``pieces``.
+    """The narrowest gap across ``path`` ((N, 2) points, or poses whose first two are x, y).
 
     ``samples`` points are spread over the segments by length (at least one inside
     each segment); ``free`` may pass a prebuilt free space
@@ -49,7 +50,8 @@ def narrowest_gap(pieces: list, bounds, path, samples: int = 400, free=None) -> 
 
     from .shortest import free_space
 
-    path = np.asarray(path, dtype=np.float64).reshape(-1, 2)
+    path = np.asarray(path, dtype=np.float64)
+    path = path.reshape(-1, path.shape[-1])[:, :2]  # (x, y) of each pose; theta, if any, ignored
     d = np.diff(path, axis=0)
     seg_len = np.hypot(d[:, 0], d[:, 1])
     keep = seg_len > 0

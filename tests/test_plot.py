@@ -175,3 +175,14 @@ def test_gap_in_open_space_is_the_extent_across_the_path():
     g = narrowest_gap([], (0, 10, 0, 4), np.array([[1.0, 1.0], [9.0, 1.0]]))
     assert g.width == pytest.approx(4.0)
     assert narrowest_gap([], (0, 10, 0, 4), np.array([[1.0, 1.0], [1.0, 1.0]])) is None
+
+
+def test_gap_ignores_theta_of_poses():
+    walls = _corridor(4.0, 0.3)
+    xy = np.array([[1.0, 4.1], [9.0, 4.2]])
+    poses = np.column_stack([xy, [0.3, 1.2]])
+    a = narrowest_gap(walls, (0, 10, 0, 10), xy)
+    b = narrowest_gap(walls, (0, 10, 0, 10), poses)
+    assert a == b
+    # Across a path of slope 0.1 / 8 the perpendicular meets the walls at that angle.
+    assert a.width == pytest.approx(0.3 * np.hypot(8.0, 0.1) / 8.0, rel=1e-9)
