@@ -141,8 +141,9 @@ def run(args) -> int:
         name, _, seed = args.abort_on.partition(":")
         abort_on = (parse_planners(name)[0], int(seed or 0))
     out = args.out
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise InputError(out, "--out", "exists and is not a folder")
+    from .output import check_folder
+
+    check_folder(out, "--out")
     scenarios = reference(args.scenario, quiet=args.quiet)
     os.makedirs(out, exist_ok=True)
     tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on)
@@ -586,7 +587,12 @@ def _token(name: str) -> str:
     >>> _token("maze 8x8/a")
     'maze_8x8_a'
     """
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name)) or "scenario"
+    tok = "".join(c if (c.isascii() and c.isalnum()) or c in "-_." else "_" for c in str(name)) or "scenario"
+    if len(tok) > 80:  # a file name has at most 255 bytes: keep a prefix, and a digest for distinctness
+        import hashlib
+
+        tok = tok[:80] + "_" + hashlib.sha256(str(name).encode("utf-8", "replace")).hexdigest()[:10]
+    return tok
 
 
 # ---------------------------------------------------------------- statistics and the figure

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from .output import PLOT_FORMATS, check_output, write_json
+from .output import PLOT_FORMATS, check_distinct, check_output, write_json
 
 
 def register(sub) -> None:
@@ -31,6 +31,8 @@ def integer(s: str) -> int:
 
 
 def run(args) -> int:
+    from cspace.scenario import MAX_SEED, check_input
+
     from .errors import InputError
 
     src = args.scenario
@@ -40,9 +42,13 @@ def run(args) -> int:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
-    fmt = check_output(args.plot, "--plot", PLOT_FORMATS) if args.plot else None
-    if args.json:
-        check_output(args.json, "--json")
+    if args.seed is not None and args.seed > MAX_SEED:
+        raise InputError(src, "--seed", f"must be at most 2^63 - 1, got {args.seed}")
+    check_input(src)
+    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[src]) if args.plot is not None else None
+    if args.json is not None:
+        check_output(args.json, "--json", inputs=[src])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot")])
     from .plan import plan
 
     if args.verbose:
@@ -52,9 +58,9 @@ def run(args) -> int:
     res = plan(src, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
                simplify=not args.no_simplify, all_queries=args.all_queries)
     print(summary(res, verbose=args.verbose))
-    if args.json:
-        write_json(args.json, res.as_dict())
-    if args.plot:
+    if args.json is not None:
+        write_json(args.json, res.as_dict(), "--json")
+    if args.plot is not None:
         from .plot import plot_result
 
         plot_result(res, args.plot, fmt=fmt)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cspace.cspace import CSpace
-from cspace.scenario import Scenario, ScenarioError, load_scenario
+from cspace.scenario import MAX_SEED, Scenario, ScenarioError, load_scenario, show
 
 
 @dataclass
@@ -99,8 +99,8 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None):
     s = seed if seed is not None else opts.get("seed", 0)
     if iterations is not None and (isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1):
         raise ScenarioError(src, "iterations", f"must be a positive integer, got {iterations!r}")
-    if isinstance(s, bool) or not isinstance(s, int) or s < 0:
-        raise ScenarioError(src, "seed", f"must be a non-negative integer, got {s!r}")
+    if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s <= MAX_SEED:
+        raise ScenarioError(src, "seed", f"must be an integer from 0 to 2^63 - 1, got {show(s)}")
     return sc, name, float(t), int(s), load_s
 
 
