@@ -141,7 +141,10 @@ class GridIndex:
         # Edge half-planes of p: n . x <= c, n the outward unit normal.
         e = np.roll(q, -1, axis=0) - q
         nrm = np.column_stack([e[:, 1], -e[:, 0]])
-        nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
+        length = np.hypot(nrm[:, 0], nrm[:, 1])
+        # A repeated vertex (a zero-area piece) has no edge: a zero normal, which makes
+        # no cell inside and none separated by it (the cells stay mixed, for the exact test).
+        nrm /= np.where(length > 0.0, length, 1.0)[:, None]
         c = np.einsum("ij,ij->i", nrm, q)
         inside = np.empty(ii.size, dtype=bool)
         separated = np.empty(ii.size, dtype=bool)

@@ -77,9 +77,15 @@ class CSpace:
         robot_is_disk: bool = False,
         grid_cells: int | None = None,
     ):
+        from .polygon import as_array
+
         self.bounds = tuple(float(v) for v in bounds)
         self.stages: list[Stage] = []
-        obstacles = obstacles or []
+        # The one input gate (finite reals, (N, 2), non-empty): never NaN into the grid.
+        obstacles = [as_array(o, copy=False, nonempty=True) for o in obstacles or []]
+        robot = [as_array(r, copy=False, nonempty=True) for r in robot] if robot else robot
+        if obstacle_holes is not None:
+            obstacle_holes = [[as_array(h, copy=False) for h in hs] for hs in obstacle_holes]
         _check_range(self.bounds, obstacles + (robot or []))
         holes = obstacle_holes or [[] for _ in obstacles]
         self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes)

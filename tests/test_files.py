@@ -105,15 +105,32 @@ def test_a_dangling_link_creates_its_target(capsys, scene, tmp_path):
     assert os.path.islink(link) and (tmp_path / "new.json").read_text().startswith("{")
 
 
-def test_a_character_device_is_written_not_replaced(capsys, scene):
-    assert run(capsys, "plan", scene, "--json", os.devnull)[0] == 0
-    assert stat.S_ISCHR(os.stat(os.devnull).st_mode)
+def private_device(tmp_path, name: str, minor: int) -> str:
+    """A private copy of /dev/null (minor 3), /dev/full (7) or /dev/zero (5) in tmp_path.
+
+    Never the system's nodes: a broken build (as main was) replaces the device it is
+    given by a regular file, and as root that would be the machine's /dev/null.
+    """
+    path = str(tmp_path / name)
+    try:
+        os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, minor))
+        with open(path, "rb" if minor == 5 else "wb") as fh:  # a nodev mount refuses it here
+            fh.read(1) if minor == 5 else None
+    except (OSError, AttributeError):
+        pytest.skip("cannot create a private device node here (not root, or a nodev mount)")
+    return path
 
 
-@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
-def test_a_full_device_fails_with_one_line(capsys, scene):
-    msg, _ = one_error(capsys, "plan", scene, "--json", "/dev/full", field="--json")
-    assert "No space" in msg or "cannot write" in msg
+def test_a_character_device_is_written_not_replaced(capsys, scene, tmp_path):
+    null = private_device(tmp_path, "null", 3)
+    assert run(capsys, "plan", scene, "--json", null)[0] == 0
+    assert stat.S_ISCHR(os.stat(null).st_mode)
+
+
+def test_a_full_device_fails_with_one_line(capsys, scene, tmp_path):
+    full = private_device(tmp_path, "full", 7)
+    msg, _ = one_error(capsys, "plan", scene, "--json", full, field="--json")
+    assert "No space" in msg and stat.S_ISCHR(os.stat(full).st_mode)
 
 
 def test_a_fifo_with_a_reader_gets_the_output(capsys, scene, tmp_path):
@@ -201,12 +218,19 @@ def test_a_fifo_as_the_scenario_is_refused_without_blocking(tmp_path):
     assert "regular file" in r.stderr
 
 
-@pytest.mark.parametrize("path", ["/dev/zero", "/dev/null"])
-def test_a_device_as_the_scenario_is_refused(capsys, path):
-    if not os.path.exists(path):
-        pytest.skip(f"no {path}")
-    msg, _ = one_error(capsys, "plan", path, field="file")
-    assert "regular file" in msg
+@pytest.mark.parametrize("name, minor", [("zero", 5), ("null", 3)])
+def test_a_device_as_the_scenario_is_refused(tmp_path, name, minor):
+    dev = private_device(tmp_path, name, minor)
+
+    def small():  # a broken build reads /dev/zero forever: cap its memory, and time
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    r = subprocess.run([sys.executable, "-m", "planners.cli", "plan", dev], cwd=ROOT, capture_output=True,
+                       text=True, timeout=60, preexec_fn=small)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr[-300:]
+    assert "regular file" in r.stderr
 
 
 def test_a_huge_scenario_is_refused_before_reading(capsys, tmp_path):
