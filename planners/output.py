@@ -68,7 +68,7 @@ def check_output(path: str, option: str, suffixes: dict | None = None, inputs=()
         if not stat.S_ISREG(st.st_mode):
             raise InputError(path, option, "is not a regular file, a character device or a FIFO")
     folder = os.path.dirname(os.path.realpath(path))
-    if not os.path.isdir(folder):
+    if not os.path.isdir(folder):  # (realpath and isdir take a NUL byte; _stat refused it above)
         raise InputError(path, option, f"folder {folder} does not exist")
     clean_stale(folder)
     try:  # the one reliable test (root passes access(); /proc and read-only mounts refuse files)
@@ -92,8 +92,8 @@ def check_folder(path: str, option: str) -> None:
         raise InputError(path, option, "exists and is not a folder") from None
     except NotADirectoryError:
         raise InputError(path, option, "a parent of this path is a file, not a folder") from None
-    except OSError as exc:
-        raise InputError(path, option, f"cannot create this folder ({exc.strerror or exc})") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte
+        raise InputError(path, option, f"cannot create this folder ({getattr(exc, 'strerror', None) or exc})") from None
     clean_stale(path)
     try:
         with _temporary(path, ""):
@@ -125,8 +125,8 @@ def _stat(path: str, option: str):
         return None
     except NotADirectoryError:
         raise InputError(path, option, "a parent of this path is a file, not a folder") from None
-    except OSError as exc:
-        raise InputError(path, option, f"cannot use this path ({exc.strerror or exc})") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        raise InputError(path, option, f"cannot use this path ({getattr(exc, 'strerror', None) or exc})") from None
 
 
 def _same(st: os.stat_result, src) -> bool:
@@ -213,7 +213,7 @@ def atomic_path(path: str, option: str = "output"):
     """
     try:
         st = os.stat(path)
-    except OSError:
+    except (OSError, ValueError):
         st = None
     try:
         if st is not None and (stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode)):
@@ -238,8 +238,8 @@ def atomic_path(path: str, option: str = "output"):
                 if os.path.lexists(name):
                     os.unlink(name)
                 raise
-    except OSError as exc:
-        raise InputError(path, option, f"cannot write ({exc.strerror or exc})") from None
+    except (OSError, ValueError) as exc:
+        raise InputError(path, option, f"cannot write ({getattr(exc, 'strerror', None) or exc})") from None
 
 
 @contextlib.contextmanager
