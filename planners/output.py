@@ -224,6 +224,8 @@ def atomic_path(path: str, option: str = "output"):
         folder = os.path.dirname(real)
         clean_stale(folder)
         with _temporary(folder, os.path.splitext(real)[1]) as (fd, name):
+            if st is not None and stat.S_ISREG(st.st_mode):
+                os.fchmod(fd, stat.S_IMODE(st.st_mode))  # a replaced file keeps its permissions
             yield name or f"/proc/self/fd/{fd}"
             if name is None:  # give the complete file a name, then move it over the target at once
                 name = os.path.join(folder, f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(6)}")

@@ -83,6 +83,13 @@ def test_empty_output_path_is_refused(capsys, scene, cmd, opt):
     assert out == ""
 
 
+@pytest.mark.parametrize("argv", [["stability", "--json", ""], ["stability", "--plot", ""],
+                                  ["generate", "maze", "--out", ""], ["bench", "x.toml", "--out", ""]])
+def test_empty_paths_are_refused_by_every_command(capsys, argv):
+    msg, out = one_error(capsys, *argv)
+    assert "empty path" in msg and out == ""
+
+
 def test_two_options_naming_one_file_are_refused(capsys, scene, tmp_path):
     one_error(capsys, "plan", scene, "--json", tmp_path / "a.png", "--plot", tmp_path / "a.png", field="--plot")
 
@@ -163,6 +170,14 @@ def test_bad_output_location_is_found_before_the_work(capsys, scene, tmp_path, w
 
 def test_bench_out_under_a_file_is_found_before_the_work(capsys, scene):
     one_error(capsys, "bench", scene, "--out", scene / "x", "--runs", "1", "--times", "0.01", "-q", field="--out")
+
+
+def test_a_replaced_file_keeps_its_permissions(tmp_path):
+    p = tmp_path / "r.json"
+    p.write_text("old\n")
+    os.chmod(p, 0o640)
+    write_text(str(p), "new\n")
+    assert p.read_text() == "new\n" and stat.S_IMODE(os.stat(p).st_mode) == 0o640
 
 
 def test_atomic_write_leaves_the_old_file_on_failure(tmp_path):

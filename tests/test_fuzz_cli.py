@@ -149,9 +149,9 @@ SCALAR = st.one_of(
     st.integers(-(2**70), 2**70), st.floats(allow_nan=True, allow_infinity=True), st.booleans(),
     st.text(max_size=20), st.sampled_from([0, 1, -1, 0.5, 1e-9, 1e9, 5e7, 2.0**400, 2.0**-400]),
 )
-VALUE = st.recursive(SCALAR, lambda kids: st.lists(kids, max_size=5) | st.dictionaries(
-    st.sampled_from(["x", "y", "polygon", "holes", "center", "radius", "name", "time", "seed", "zz"]), kids, max_size=4),
-    max_leaves=12)
+KEYS = st.sampled_from(["x", "y", "polygon", "holes", "center", "radius", "name", "time", "seed", "zz"])
+VALUE = st.recursive(SCALAR, lambda kids: st.lists(kids, max_size=5) | st.dictionaries(KEYS, kids, max_size=4),
+                     max_leaves=12)
 
 
 def toml_value(v) -> str:
@@ -167,7 +167,8 @@ def toml_value(v) -> str:
     if isinstance(v, str):
         return json.dumps(v, ensure_ascii=False)  # a JSON string is a valid TOML basic string
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{json.dumps(str(k), ensure_ascii=False)} = {toml_value(x)}" for k, x in v.items()) + "}"
+        return "{" + ", ".join(f"{json.dumps(str(k), ensure_ascii=False)} = {toml_value(x)}"
+                               for k, x in v.items()) + "}"
     return "[" + ", ".join(toml_value(x) for x in v) + "]"
 
 
