@@ -57,22 +57,36 @@ def split_pieces(pieces: list) -> tuple[list, list]:
     >>> len(proper), deg[0].tolist()
     (1, [[2.0, 2.0]])
     """
-    proper, deg = [], []
-    for p in pieces:
-        p = as_array(p, copy=False)
-        if len(p) >= 3:
-            x, y = p[:, 0] - p[0, 0], p[:, 1] - p[0, 1]
-            with np.errstate(all="ignore"):
-                area = float((x[:-1] * y[1:]).sum() - (y[:-1] * x[1:]).sum())
-                size = float((np.abs(x[:-1] * y[1:]) + np.abs(y[:-1] * x[1:])).sum())
-            if abs(area) > 1e-9 * size and size > 1e-280 and np.isfinite(size):
-                proper.append(p)
-                continue
-            if not is_degenerate(p):
-                proper.append(p)
-                continue
-        deg.append(collinear_extent(p) if len(p) else p)
-    return proper, [d for d in deg if len(d)]
+    flat = _flat_mask(pieces)
+    proper = [as_array(p, copy=False) for p, f in zip(pieces, flat) if not f]
+    deg = [collinear_extent(p) for p, f in zip(pieces, flat) if f and len(p)]
+    return proper, deg
+
+
+def _flat_mask(pieces: list) -> list[bool]:
+    """Which pieces have zero area: a float shoelace sum well above its rounding error
+    settles a piece at once (all pieces in one vectorised pass), the rest are decided
+    exactly (:func:`is_degenerate`)."""
+    arrs = [as_array(p, copy=False) for p in pieces]
+    sizes = np.array([len(p) for p in arrs], dtype=np.intp)
+    out = sizes < 3
+    big = np.flatnonzero(~out)
+    if len(big):
+        P = np.concatenate([arrs[k] for k in big.tolist()])
+        n = sizes[big]
+        starts = np.cumsum(n) - n
+        first = np.repeat(starts, n)
+        nxt = np.arange(len(P)) + 1
+        nxt[starts + n - 1] = starts  # each ring closes on itself
+        with np.errstate(all="ignore"):
+            x, y = P[:, 0] - P[first, 0], P[:, 1] - P[first, 1]  # about each piece's first vertex
+            l, r = x * y[nxt], y * x[nxt]
+            area = np.add.reduceat(l - r, starts)
+            size = np.add.reduceat(np.abs(l) + np.abs(r), starts)
+        certain = (np.abs(area) > 1e-9 * size) & (size > 1e-280) & np.isfinite(size)
+        for k in big[~certain].tolist():
+            out[k] = is_degenerate(arrs[k])
+    return out.tolist()
 
 
 def _on_closed(px: float, py: float, c, d) -> bool:
@@ -178,19 +192,21 @@ def path_violations(path, pieces: list, bounds=None) -> list[tuple[int, int]]:
     pts = as_array(path)
     if not np.isfinite(pts).all():
         raise ValueError("path coordinates must be finite")
-    proper_idx, deg_idx = [], []
-    for k, p in enumerate(pieces):
-        (deg_idx if is_degenerate(p) else proper_idx).append(k)
+    flat = _flat_mask(pieces)
+    proper_idx = [k for k, f in enumerate(flat) if not f]
+    deg_idx = [k for k, f in enumerate(flat) if f and len(pieces[k])]
     proper = [np.asarray(pieces[k], dtype=np.float64) for k in proper_idx]
-    boxes = [(p.min(axis=0), p.max(axis=0)) for p in proper]
+    plo = np.array([p.min(axis=0) for p in proper]).reshape(-1, 2)
+    phi = np.array([p.max(axis=0) for p in proper]).reshape(-1, 2)
     deg = Degenerate([collinear_extent(pieces[k]) for k in deg_idx])
     out = []
     for e in range(len(pts) - 1):
         a, b = pts[e], pts[e + 1]
         lo, hi = np.minimum(a, b), np.maximum(a, b)
-        for k, P, (plo, phi) in zip(proper_idx, proper, boxes):
-            if not ((plo > hi).any() or (phi < lo).any()) and _enters(a, b, P):
-                out.append((e, k))
+        near = np.flatnonzero(~((plo > hi).any(axis=1) | (phi < lo).any(axis=1)))  # boxes that meet the edge's
+        for j in near.tolist():
+            if _enters(a, b, proper[j]):
+                out.append((e, proper_idx[j]))
         for j in deg._near(a, b):
             if open_meets(a, b, *deg.segs[j]):
                 out.append((e, deg_idx[j]))
@@ -223,7 +239,7 @@ def _on_other(x: float, y: float, j: int, deg: Degenerate, proper: list, bounds)
             return True
     if any(_on_closed(x, y, *deg.segs[k]) for k in deg._near((x, y), (x, y)) if k != j):
         return True
-    for P in proper:
+    for P in proper:  # (rare: only for a path vertex on a zero-area piece)
         if P[:, 0].min() <= x <= P[:, 0].max() and P[:, 1].min() <= y <= P[:, 1].max():
             if point_in_convex(P if orientation(P) > 0 else P[::-1], x, y) >= 0:
                 return True
