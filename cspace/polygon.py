@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .inputs import as_array, as_point  # noqa: F401  (the input gate, re-exported here)
+from .arrays import as_array, as_point  # noqa: F401  (the input gate, re-exported here)
 from .predicates import lower_half, orient2d_many, orient2d_xy
 
 

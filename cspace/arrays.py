@@ -1,4 +1,4 @@
-"""The one input gate of the geometry: points and polygons from what a caller passes.
+"""The one input gate of the geometry: arrays of real numbers from what a caller passes.
 
 Every public geometry function turns its polygons (and points, directions) into
 ``(N, 2)`` float64 arrays here, so one place decides what is refused: NaN and
