@@ -37,6 +37,8 @@ def as_array(polygon, copy: bool = True, nonempty: bool = False) -> np.ndarray:
         geom = polygon
         if geom.geom_type == "Polygon":
             geom = geom.exterior
+        elif geom.geom_type not in ("LinearRing", "LineString", "Point"):  # not one sequence of points
+            raise ValueError(f"expected one polygon, got a {geom.geom_type} (pass its parts, .geoms, one by one)")
         pts = np.array(geom.coords, dtype=np.float64).reshape(-1, 2 if geom.is_empty else len(geom.coords[0]))[:, :2]
     elif type(polygon) is np.ndarray and polygon.dtype == np.float64:
         pts = polygon.copy() if copy else polygon

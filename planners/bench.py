@@ -2,8 +2,10 @@
 
 This module owns the benchmark sweep: scenarios x planners x time budgets x seeded runs,
 each run isolated in its own process (a planner that segfaults or hangs costs one row,
-recorded as ``crashed`` or ``timeout``, never the sweep), run locally by ``--workers``
-threads that each wait on one child process, or on a Dask cluster (``--scheduler``).
+recorded as ``crashed`` or ``timeout``, never the sweep): locally a forked child of this
+process, which built each scenario's C-space once (:mod:`planners.bench_pool`, at most
+``--workers`` at a time), a fresh process where fork is missing, or on a Dask cluster
+(``--scheduler``). Each run calls :func:`planners.plan.plan`, as ``cspace plan`` does.
 It also owns the outputs: ``results.csv``, ``results.json``, one OMPL benchmark log per
 (scenario, budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns
 them into the Planner Arena database) and the ``error_vs_time.png`` figure.
@@ -19,6 +21,7 @@ their first solution are).
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -38,11 +41,7 @@ DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
 # C-space build, simplification and verification all fit many times over).
 HARD_FACTOR = 2.0
 HARD_MARGIN = 30.0
-# Anytime planners are solved in slices (MIN_SLICE s, doubling up to budget / SLICES) to
-# time their first solution and record the best raw cost along the run.
-SLICES = 20
-MIN_SLICE = 0.002
-SLICED = {"rrtstar", "informedrrtstar", "sorrtstar", "bitstar", "prm", "prmstar"}  # not AORRTC: it crashes
+MAX_BUDGET = 1e6  # seconds per run (11 days); OMPL's clock overflows near 8e9 s
 # Fields of a row, in CSV order. Times in seconds; lengths in scenario units.
 FIELDS = (
     "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
@@ -121,6 +120,8 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
             raise InputError(source, "--times", f"not a number: {s!r}") from None
         if not (math.isfinite(t) and t > 0):
             raise InputError(source, "--times", f"must be positive seconds, got {s!r}")
+        if t > MAX_BUDGET:
+            raise InputError(source, "--times", f"at most {MAX_BUDGET:g} s per run, got {s!r}")
         if t in out:
             raise InputError(source, "--times", f"budget {s} given twice")
         out.append(t)
@@ -128,8 +129,13 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
 
 
 def run(args) -> int:
+    from .ompl_glue import OMPL_HINT, ompl_available
+
     planners = parse_planners(args.planners)
     times = parse_times(args.times)
+    if not ompl_available():
+        raise InputError("bench", "--planners", f"the bench runs OMPL's planners, and OMPL is not installed "
+                                                f"({OMPL_HINT})")
     if args.runs < 1:
         raise InputError("bench", "--runs", f"must be at least 1, got {args.runs}")
     if args.workers < 1:
@@ -144,16 +150,19 @@ def run(args) -> int:
     from .output import check_folder
 
     check_folder(out, "--out")
-    scenarios = reference(args.scenario, quiet=args.quiet)
+    held: dict = {}
+    scenarios = reference(args.scenario, quiet=args.quiet, held=held)
     os.makedirs(out, exist_ok=True)
+    _clear_outputs(out)  # never mix two sweeps in one folder
     tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on)
     t0 = time.perf_counter()
-    rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet)
+    rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
+                              held=held)
     meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
             "iterations": args.iterations, "workers": args.workers, "scheduler": args.scheduler,
             "wall_s": time.perf_counter() - t0, "complete": not interrupted,
             "hard_limit": f"budget * {HARD_FACTOR:g} + {HARD_MARGIN:g} s"}
-    write_outputs(rows, out, meta, plot=not args.no_plot)
+    interrupted = _write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
     if not args.quiet:
         sys.stderr.write(summary(rows) + "\n")
         sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
@@ -161,13 +170,55 @@ def run(args) -> int:
     return 130 if interrupted else 0
 
 
+def _write_deferring_sigint(rows, out, meta, plot) -> bool:
+    """Write the outputs with Ctrl-C held until they are consistent; True if it came.
+
+    results.json is written last; if Ctrl-C came meanwhile it is written again with
+    ``"complete": false`` (a figure or a log may be missing), never ``true``.
+    """
+    import signal
+
+    hit = []
+    try:
+        prev = signal.signal(signal.SIGINT, lambda *_: hit.append(1))
+    except ValueError:  # not the main thread: no handler to swap
+        prev = None
+    try:
+        write_outputs(rows, out, meta, plot=plot, stop=lambda: bool(hit))
+        if hit:
+            write_outputs(rows, out, {**meta, "complete": False}, plot=False, only_json=True)
+    finally:
+        if prev is not None:
+            signal.signal(signal.SIGINT, prev)
+    return bool(hit)
+
+
+OUTPUTS = ("results.json", "results.csv", "error_vs_time.png")
+
+
+def _clear_outputs(out: str) -> None:
+    """Remove an earlier sweep's outputs from ``out`` (our own file names only)."""
+    for name in OUTPUTS:
+        with contextlib.suppress(FileNotFoundError):
+            os.remove(os.path.join(out, name))
+    logs = os.path.join(out, "ompl")
+    if os.path.isdir(logs):
+        for name in os.listdir(logs):
+            if name.endswith(".log"):
+                with contextlib.suppress(FileNotFoundError):
+                    os.remove(os.path.join(logs, name))
+
+
 # ---------------------------------------------------------------- the reference
 
-def reference(files: list[str], quiet: bool = True) -> list[dict]:
+def reference(files: list[str], quiet: bool = True, held: dict | None = None) -> list[dict]:
     """Load each scenario and compute its exact shortest path length once.
 
     Returns ``[{"file", "scenario", "optimum"}]`` (``optimum`` None if no path exists).
-    A missing or malformed file is a ScenarioError (exit 2).
+    ``scenario`` is the scenario's name, made unique when two files share a name (the
+    file's name is added), so that the summary, the figure and the logs keep them
+    apart. With ``held``, ``held[file] = (scenario, cspace)`` keeps each built C-space
+    for the runs. A missing or malformed file is a ScenarioError (exit 2).
     """
     from cspace.scenario import load_scenario
 
@@ -175,12 +226,20 @@ def reference(files: list[str], quiet: bool = True) -> list[dict]:
 
     out = []
     for f in files:
+        full = os.path.abspath(f)
+        if any(o["file"] == full for o in out):
+            raise InputError(f, "scenario", "given twice")
         sc = load_scenario(f)
         res = plan(sc, planner="exact")
-        out.append({"file": os.path.abspath(f), "scenario": sc.name,
-                    "optimum": float(res.length) if res.solved else None})
+        out.append({"file": full, "scenario": sc.name, "optimum": float(res.length) if res.solved else None})
+        if held is not None:
+            held[full] = (sc, res.cspace)
         if not quiet:
             sys.stderr.write(f"{sc.name}: exact shortest path {res.length:.6g} ({res.message})\n")
+    names = [o["scenario"] for o in out]
+    for i, o in enumerate(out):
+        if names.count(o["scenario"]) > 1:
+            o["scenario"] = f"{o['scenario']} ({os.path.relpath(files[i])}, #{i + 1})"
     return out
 
 
@@ -199,71 +258,37 @@ def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None)
 
 # ---------------------------------------------------------------- one run (in the child)
 
-def run_one(task: dict) -> dict:
+def run_one(task: dict, scenario=None, cspace=None) -> dict:
     """Plan one seeded run in this process and return its row (status ``ok``).
 
-    The path is simplified and verified exactly as ``cspace plan`` does; a run is
-    solved only if the final path passes the exact segment test.
+    The run goes through :func:`planners.plan.plan`, the routine of ``cspace plan``
+    (anytime planners solved in slices to time the first solution): the path is
+    simplified and verified exactly, and a run is solved only if it passes.
+    ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space.
     """
-    from cspace.cspace import CSpace
     from cspace.scenario import load_scenario
 
-    from .ompl_glue import frame_exponent, make_setup, ompl, path_states, set_query, termination
-    from .plan import _snap, _verify, path_length
+    from .plan import plan
 
     if task.get("abort"):
         os.abort()
-    ob = ompl()[0]
-    sc = load_scenario(task["file"])
-    cs = CSpace.from_scenario(sc)
-    q = sc.all_queries()[0]
+    sc = scenario if scenario is not None else load_scenario(task["file"])
     planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
-    k = frame_exponent(cs.bounds)
-    ss, space, _checker, _validator = make_setup(cs, planner, int(task["seed"]), k)
-    set_query(ss, space, q.start, q.goal, k)
-    p0, m0 = cs.point_count(), cs.checks["segments"]
-    first, progress = None, []
-    t0 = time.perf_counter()
-    if planner.lower() in SLICED and not iters:
-        # Continue the same search slice by slice: same total budget, plus the time
-        # of the first solution (to within one slice) and the best cost along the run.
-        # Slices double from MIN_SLICE up to budget / SLICES, so an early first
-        # solution is timed finely and a long run still takes few slices.
-        step, k = max(budget / SLICES, MIN_SLICE), 0
-        while (left := budget - (time.perf_counter() - t0)) > 0:
-            ss.solve(ob.timedPlannerTerminationCondition(min(step, MIN_SLICE * 2 ** k, left)))
-            k += 1
-            if ss.haveExactSolutionPath():
-                t = time.perf_counter() - t0
-                first = t if first is None else first
-                progress.append([t, ss.getSolutionPath().length()])
-    else:
-        ptc, _keep = termination(budget, iters)
-        ss.solve(ptc)
-        if ss.haveExactSolutionPath():
-            first = time.perf_counter() - t0
-            progress.append([first, ss.getSolutionPath().length()])
-    solve_s = time.perf_counter() - t0
-    checks = cs.point_count() - p0, cs.checks["segments"] - m0
-    found = ss.haveExactSolutionPath()
-    raw = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
-    t1 = time.perf_counter()
-    if found:
-        ss.simplifySolution()
-    simplify_s = time.perf_counter() - t1 if found else 0.0
-    path = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
-    ok, message = _verify(cs, path, q) if found else (False, "no exact solution within the budget")
+    res = plan(sc, planner=planner, time=budget, seed=int(task["seed"]), iterations=iters,
+               cspace=cspace, slices=True)
+    ok = bool(res.solved)
     opt = task["optimum"]
-    length = path_length(path) if ok else None
-    raw_len = path_length(raw) if ok else None
+    length = float(res.length) if ok else None
+    raw_len = res.length_unsimplified if ok else None
     return {
         "scenario": task["scenario"], "file": task["file"], "planner": planner, "time_budget": budget,
-        "seed": int(task["seed"]), "status": "ok", "solved": bool(ok),
+        "seed": int(task["seed"]), "status": "ok", "solved": ok,
         "length": length, "length_unsimplified": raw_len, "optimum": opt,
         "error": _error(length, opt), "error_unsimplified": _error(raw_len, opt),
-        "first_solution_s": first if ok else None, "solve_s": solve_s, "simplify_s": simplify_s,
-        "state_checks": int(checks[0]), "motion_checks": int(checks[1]), "wall_s": None,
-        "message": message, "progress": progress,
+        "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings["solve"],
+        "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
+        "motion_checks": int(res.checks["motions"]), "wall_s": None,
+        "message": res.message, "progress": res.progress,
     }
 
 
@@ -283,7 +308,8 @@ def _child_main() -> None:  # pragma: no cover - runs in the child process
     import signal
 
     task = json.loads(sys.stdin.read())
-    signal.alarm(int(task["hard_limit"]) + 5)  # backstop if the parent died without killing us
+    if hasattr(signal, "alarm"):  # a backstop only: the parent kills us at the hard limit
+        signal.alarm(int(task["hard_limit"]) + 5)
     try:
         row = run_one(task)
     except Exception as exc:  # a Python error in the run: recorded, the sweep goes on
@@ -364,18 +390,34 @@ def _complete(task: dict, row: dict, wall: float) -> dict:
 # ---------------------------------------------------------------- the sweep
 
 def sweep(tasks: list[dict], workers: int = 1, scheduler: str | None = None,
-          progress: bool = False) -> tuple[list[dict], bool]:
+          progress: bool = False, held: dict | None = None) -> tuple[list[dict], bool]:
     """Run every task; returns ``(rows sorted in task order, interrupted)``.
 
-    Ctrl-C stops the sweep: running children are killed, finished rows are kept.
+    With ``held`` (file -> (scenario, cspace), from :func:`reference`) and ``os.fork``,
+    runs are forked children of this process (:mod:`planners.bench_pool`); otherwise
+    (or on a Dask cluster) each run is a fresh process. Ctrl-C stops the sweep:
+    running children are killed, finished rows are kept.
     """
+    from .bench_pool import CAN_FORK, run_forked
+
     _stop.clear()
     rows: list[dict] = []
     bar = _Progress(len(tasks), progress)
     interrupted = False
+
+    def on_row(task, row, wall):
+        rows.append(_complete(task, row, wall))
+        bar.step(rows[-1])
+
     try:
         if scheduler:
             _sweep_dask(tasks, scheduler, rows, bar)
+        elif held is not None and CAN_FORK and all(t["file"] in held for t in tasks):
+            from . import plan as _plan  # noqa: F401  (imported once, before forking)
+            from .ompl_glue import ompl
+
+            ompl()
+            run_forked(tasks, held, workers, lambda t: hard_limit(t["time_budget"]), on_row)
         else:
             _sweep_local(tasks, workers, rows, bar)
     except KeyboardInterrupt:
@@ -462,19 +504,29 @@ class _Progress:
 
 # ---------------------------------------------------------------- outputs
 
-def write_outputs(rows: list[dict], out: str, meta: dict, plot: bool = True) -> None:
-    """Write results.csv, results.json, the OMPL logs and (optionally) the figure, each atomically."""
+def write_outputs(rows: list[dict], out: str, meta: dict, plot: bool = True, stop=None,
+                  only_json: bool = False) -> None:
+    """Write results.csv, the OMPL logs, (optionally) the figure and results.json, each atomically.
+
+    results.json comes last: its ``complete`` is the sweep's word on everything else.
+    ``stop()`` true (Ctrl-C came) skips what is left before it.
+    """
     from .output import write_json, write_text
 
-    write_text(os.path.join(out, "results.csv"), to_csv(rows))
+    stop = stop or (lambda: False)
+    if not only_json:
+        write_text(os.path.join(out, "results.csv"), to_csv(rows))
+        logs = os.path.join(out, "ompl")
+        os.makedirs(logs, exist_ok=True)
+        for name, text in ompl_logs(rows, meta).items():
+            if not stop():
+                write_text(os.path.join(logs, name), text)
+        if plot and rows and not stop():
+            plot_error_vs_time(rows, os.path.join(out, "error_vs_time.png"))
+    if stop():
+        meta = {**meta, "complete": False}
     write_json(os.path.join(out, "results.json"), {"meta": _clean(meta), "fields": list(FIELDS),
                                                    "rows": [_clean(r) for r in rows]})
-    logs = os.path.join(out, "ompl")
-    os.makedirs(logs, exist_ok=True)
-    for name, text in ompl_logs(rows, meta).items():
-        write_text(os.path.join(logs, name), text)
-    if plot and rows:
-        plot_error_vs_time(rows, os.path.join(out, "error_vs_time.png"))
 
 
 def _clean(x):
@@ -577,21 +629,31 @@ def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
                 for r in prs:
                     lines.append("".join(f"{t!r},{c!r},;" for t, c in (r.get("progress") or [])))
             lines.append(".")
-        out[f"{_token(scen)}_t{budget:g}.log"] = "\n".join(lines) + "\n"
+        fname = f"{_token(scen)}_t{budget:g}.log"
+        n = 2
+        while fname in out:  # two labels that differ only in characters a file name cannot keep
+            fname = f"{_token(scen)}-{n}_t{budget:g}.log"
+            n += 1
+        out[fname] = "\n".join(lines) + "\n"
     return out
 
 
+TOKEN_MAX = 80  # characters of a scenario's name kept in log and experiment names
+
+
 def _token(name: str) -> str:
-    """A name safe as one whitespace-free token and file name.
+    """A name safe as one whitespace-free token and file name (long names: cut, plus a hash).
 
     >>> _token("maze 8x8/a")
     'maze_8x8_a'
+    >>> len(_token("x" * 300)) <= TOKEN_MAX + 9
+    True
     """
-    tok = "".join(c if (c.isascii() and c.isalnum()) or c in "-_." else "_" for c in str(name)) or "scenario"
-    if len(tok) > 80:  # a file name has at most 255 bytes: keep a prefix, and a digest for distinctness
-        import hashlib
+    import hashlib
 
-        tok = tok[:80] + "_" + hashlib.sha256(str(name).encode("utf-8", "replace")).hexdigest()[:10]
+    tok = "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name)) or "scenario"
+    if len(tok) > TOKEN_MAX:
+        tok = tok[:TOKEN_MAX] + "-" + hashlib.sha256(str(name).encode()).hexdigest()[:8]
     return tok
 
 

@@ -31,8 +31,44 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
+def version_line() -> str:
+    """``cspace X.Y.Z (Python ..., numpy ..., shapely ..., ompl ...)``: what a bug report needs.
+
+    The versions come from the installed packages' metadata, so OMPL is not imported.
+
+    >>> version_line().startswith("cspace ")
+    True
+    """
+    import platform
+    from importlib import metadata
+
+    import cspace
+
+    deps = []
+    for dist in ("numpy", "shapely", "ompl"):
+        try:
+            deps.append(f"{dist} {metadata.version(dist)}")
+        except metadata.PackageNotFoundError:
+            deps.append(f"{dist} not installed")
+    return f"cspace {cspace.__version__} (Python {platform.python_version()}, {', '.join(deps)})"
+
+
+class _Version(argparse.Action):
+    """``--version``: computed only when asked for."""
+
+    def __init__(self, option_strings, dest, **kw):
+        super().__init__(option_strings, dest, nargs=0, help="print the version (and its dependencies') and exit")
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        sys.stdout.write(version_line() + "\n")
+        parser.exit(0)
+
+
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
-    parser = _Parser(prog="cspace", description="2-D configuration-space motion planning")
+    parser = _Parser(prog="cspace", description="2-D configuration-space motion planning",
+                     epilog="Run `cspace COMMAND --help` for a command's options. A bare `cspace` prints this "
+                            "help and exits with status 0.")
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name, module in COMMANDS.items():
@@ -51,6 +87,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    if not argv:  # a bare `cspace`: what it can do, not an error
+        build_parser().print_help(sys.stdout)
+        return 0
     first = next((a for a in argv if not a.startswith("-")), None)
     parser = build_parser(first if first in COMMANDS else None)
     args = parser.parse_args(argv)

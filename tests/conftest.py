@@ -8,8 +8,10 @@ import textwrap
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PEER = os.path.join(os.path.dirname(ROOT), "shared", "peer-scenarios", "ompl")
 SCENARIOS = os.path.join(ROOT, "scenarios")
+# OMPL's planning-benchmark scenes, bundled (converted copies; see scenarios/ompl/README.md).
+# Tests read only files inside the repository: a user's clone has nothing beside it.
+OMPL_SCENES = os.path.join(SCENARIOS, "ompl")
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
-from conftest import PEER
+from conftest import OMPL_SCENES
 
 BASIC = """
 name = "cli"
@@ -133,7 +133,7 @@ def test_bad_input_exits_2_with_one_line(write_toml, tmp_path, name, text, field
 
 
 @pytest.mark.parametrize("args, field", [
-    (["--planner", "NoSuchPlanner"], "planner"),
+    (["--planner", "NoSuchPlanner"], "--planner"),
     (["--time", "0"], "--time"),
     (["--time", "-2"], "--time"),
     (["--plot", "x.gif"], "--plot"),
@@ -149,13 +149,13 @@ def test_bad_options_exit_2_with_one_line(write_toml, args, field):
 
 
 def test_non_numeric_option_is_one_line():
-    r = cspace("plan", os.path.join(PEER, "env1.toml"), "--time", "abc")
+    r = cspace("plan", os.path.join(OMPL_SCENES, "env1.toml"), "--time", "abc")
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
 
 
 def test_show_prints_the_stages(tmp_path):
     out = tmp_path / "scene.png"
-    r = cspace("show", os.path.join(PEER, "circles.toml"), "--plot", out)
+    r = cspace("show", os.path.join(OMPL_SCENES, "circles.toml"), "--plot", out)
     assert r.returncode == 0, r.stderr
     assert "minkowski" in r.stdout and "skipped" in r.stdout
     assert out.exists()
@@ -175,3 +175,51 @@ def test_closed_pipe_is_quiet():
     r = subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True, timeout=120)
     assert r.returncode == 141, r.stderr
     assert r.stderr == ""
+
+
+def test_version_is_one_line_naming_the_dependencies():
+    import cspace as pkg
+    from importlib import metadata
+
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    r = cspace("--version")
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    line = r.stdout.strip()
+    assert "\n" not in line and line.startswith(f"cspace {pkg.__version__} (Python ")
+    for dep in ("numpy", "shapely", "ompl"):
+        assert f"{dep} " in line
+    # One version, three places: pyproject.toml, the package, the installed metadata.
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with open(os.path.join(root, "pyproject.toml"), "rb") as fh:
+        assert tomllib.load(fh)["project"]["version"] == pkg.__version__ == metadata.version("cspace")
+
+
+def test_bare_command_lists_the_commands_and_exits_0():
+    from planners.cli import COMMANDS
+
+    r = cspace()
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    assert r.stdout.startswith("usage: cspace")
+    for name in COMMANDS:
+        assert f"\n    {name} " in r.stdout or f"\n    {name}\n" in r.stdout, name
+    assert "--version" in r.stdout
+
+
+def test_a_disk_below_the_ulp_of_its_centre_is_refused_in_one_line(write_toml):
+    # Radius 1e-200 at (5, 5): the disk rounds to the point (5, 5). Its C-obstacle used to
+    # be placed at the origin (a point operand dropped by the vectorised sum, a false
+    # "free" at (5, 5)) and the broad phase printed a RuntimeWarning about the piece's
+    # zero-length edges. Such a disk cannot be represented: bad input, exit 2.
+    text = BASIC.replace("[[obstacles]]\npolygon = [[4, 0], [6, 0], [6, 7], [4, 7]]",
+                         "[[obstacles]]\ncenter = [5, 5]\nradius = 1e-200")
+    r = cspace("plan", write_toml(text), "--planner", "exact")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "obstacles[0].radius: 1e-200 is too small for a disk centred at (5.0, 5.0)" in r.stderr
+    # Small but representable, and a tiny disk robot (centred on the origin): planned, quietly.
+    r = cspace("plan", write_toml(text.replace("radius = 1e-200", "radius = 1e-12")
+                                  .replace("[robot]\npolygon = [[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]]",
+                                           "[robot]\nradius = 1e-200")), "--planner", "exact")
+    assert r.returncode == 0 and r.stderr == "", r.stderr

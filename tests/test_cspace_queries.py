@@ -17,7 +17,7 @@ from cspace import load_scenario
 from cspace.cspace import CSpace
 from cspace.scenario import CollisionProbe
 
-from conftest import PEER, SCENARIOS
+from conftest import OMPL_SCENES, SCENARIOS
 
 
 def _robot_swept(sc, a, b):
@@ -30,7 +30,7 @@ def _robot_swept(sc, a, b):
 
 
 def _scenes():
-    names = [os.path.join(PEER, f) for f in ("circles.toml", "env1.toml", "normal.toml")]
+    names = [os.path.join(OMPL_SCENES, f) for f in ("circles.toml", "env1.toml", "normal.toml")]
     if os.path.isdir(SCENARIOS):
         names += sorted(os.path.join(SCENARIOS, f) for f in os.listdir(SCENARIOS) if f.endswith(".toml"))
     return names
@@ -111,7 +111,7 @@ def test_pruning_drops_outside_and_contained_pieces():
 
 def test_clearance_matches_shapely_distance():
     pytest.importorskip("cspace.gjk")
-    sc = load_scenario(os.path.join(PEER, "circles.toml"))
+    sc = load_scenario(os.path.join(OMPL_SCENES, "circles.toml"))
     cs = CSpace.from_scenario(sc)
     union = shapely.union_all([shapely.Polygon(p) for p in cs.pieces])
     rng = np.random.default_rng(3)

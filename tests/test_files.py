@@ -268,7 +268,7 @@ def test_generate_gives_up_after_a_few_candidates_and_says_why(monkeypatch):
 
     calls = []
 
-    def never(scene):
+    def never(scene, bar=None):
         calls.append(1)
         return "start and goal not connected"
 

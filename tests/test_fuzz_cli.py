@@ -278,7 +278,7 @@ OUTPUT_KINDS = ["new", "new", "existing", "empty", "input", "link to input", "ha
                 "under a file", "missing folder", "proc", "fifo", "dangling link", "link to file", "long name",
                 "newline", "nul byte", "dot", "same as other output"]
 NUMBERS = ["0", "-1", "1", "0.05", "nan", "inf", "-inf", "1e300", "1e-300", "abc", "", "9" * 5000,
-           str(2**64), str(2**63), str(2**63 - 1), "0x10", " 1", "1e", "-0"]
+           str(2**64), str(2**63), str(2**32 - 2), str(2**32 - 1), "0x10", " 1", "1e", "-0"]
 
 
 def output_path(kind: str, d: str, scene: str, ext: str, other: str | None, tag: str = "") -> str:

@@ -27,59 +27,57 @@ NAN, INF = float("nan"), float("inf")
 # ------------------------------------------------------------------ degenerate pieces in the exact planner
 
 
-def _agrees_with_the_pieces(cs, sp):
-    """Every returned edge: its open part is free by the C-space's own exact segment
-    test (the edge shrunk to its open part is checked through its midpoint halves)."""
-    assert not path_violations(sp.path, cs.pieces, cs.bounds)
+def _agrees_with_the_pieces(pieces, bounds, sp):
+    """No returned edge passes through a piece (exact), checked again by dense
+    rational sampling of the open edges against the zero-area pieces."""
+    assert not path_violations(sp.path, pieces, bounds)
+    flat = [p for p in pieces if len(np.unique(p, axis=0)) <= 2]
     for a, b in zip(sp.path[:-1], sp.path[1:]):
-        m = (a + b) / 2
-        # each half minus its touching end: the open edge meets no obstacle but at bends
-        if not (cs.segment_free(a + (m - a) * 1e-9, m) or cs.segment_free(m, b + (m - b) * 1e-9)):
-            pytest.fail(f"edge {a} -> {b} is blocked inside")
+        for p in flat:
+            c, d = p.min(axis=0), p.max(axis=0)
+            assert not open_meets(a, b, c, d)
 
 
-def test_a_collapsed_disk_is_still_an_obstacle(tmp_path):
-    """A disk of radius 1e-9 at (5e7, 5e7) collapses to a point: the straight path
-    through it was returned although segment_free says blocked."""
+def test_a_collapsed_disk_is_refused_or_avoided(tmp_path):
+    """A disk of radius 1e-9 at (5e7, 5e7) collapses to a point: the exact planner went
+    straight through it. The loader now refuses such a disk; given as a C-obstacle
+    piece directly, the point still blocks the straight path."""
     f = tmp_path / "deg.toml"
     f.write_text("[bounds]\nxmin = 49999990.0\nxmax = 50000010.0\nymin = 49999990.0\nymax = 50000010.0\n"
                  "[[obstacles]]\ncenter = [50000000.0, 50000000.0]\nradius = 1e-9\n"
                  "[start]\nx = 49999995.0\ny = 50000000.0\n[goal]\nx = 50000005.0\ny = 50000000.0\n")
-    cs = CSpace.from_scenario(str(f))
-    s, g = cs.scenario.start, cs.scenario.goal
-    assert not cs.segment_free(s, g)
-    sp = shortest_path(cs.pieces, cs.bounds, s, g)
-    assert not path_violations(np.array([s, g]), cs.pieces)  == []  # the straight segment is refused
-    if sp.solved:  # it may only bend at the collapsed disk's point, touching it like any corner
-        assert len(sp.path) > 2 and not path_violations(sp.path, cs.pieces, cs.bounds)
-        assert sp.length == pytest.approx(10.0)
+    with pytest.raises(cspace.ScenarioError):
+        cspace.load_scenario(str(f))
+    dot = np.full((8, 2), 5e7)  # the disk's polygon, rounded: one point
+    bounds, s, g = (5e7 - 10, 5e7 + 10, 5e7 - 10, 5e7 + 10), (5e7 - 5, 5e7), (5e7 + 5, 5e7)
+    assert path_violations(np.array([s, g]), [dot]) == [(0, 0)]  # the straight segment is refused
+    sp = shortest_path([dot], bounds, s, g)
+    if sp.solved:  # it may only bend at the point, touching it like any corner
+        assert len(sp.path) > 2 and sp.length == pytest.approx(10.0)
+        _agrees_with_the_pieces([dot], bounds, sp)
 
 
 def test_a_wall_thinner_than_an_ulp_blocks():
     wall = np.array([[5, 0], [5 + 5e-324, 0], [5 + 5e-324, 10], [5, 10]])  # x + 5e-324 == x: a segment
-    cs = CSpace((0, 10, 0, 10), [wall])
-    assert not cs.segment_free((1, 5), (9, 5))
-    sp = shortest_path(cs.pieces, cs.bounds, (1, 5), (9, 5))
+    sp = shortest_path([wall], (0, 10, 0, 10), (1, 5), (9, 5))
     assert not sp.solved and sp.path.size == 0  # cut in two: there is no path at all
 
 
 def test_a_zero_width_wall_with_a_gap_is_walked_around():
     wall = np.array([[5, 0], [5, 0], [5, 8], [5, 8]], dtype=float)
-    cs = CSpace((0, 10, 0, 10), [wall])
-    sp = shortest_path(cs.pieces, cs.bounds, (1, 5), (9, 5))
+    sp = shortest_path([wall], (0, 10, 0, 10), (1, 5), (9, 5))
     assert sp.solved and sp.path[1].tolist() == [5.0, 8.0]
     assert sp.length == pytest.approx(2 * math.hypot(4, 3))
-    _agrees_with_the_pieces(cs, sp)
+    _agrees_with_the_pieces([wall], (0, 10, 0, 10), sp)
 
 
 def test_a_zero_width_wall_touching_an_obstacle_cannot_be_passed_at_the_joint():
     # the wall's top tip touches a block: no wrapping there; the way is round the bottom
     wall = np.array([[5, 2], [5, 2], [5, 8], [5, 8]], dtype=float)
     block = np.array([[4, 8], [6, 8], [6, 10], [4, 10]], dtype=float)
-    cs = CSpace((0, 10, 0, 10), [wall, block])
-    sp = shortest_path(cs.pieces, cs.bounds, (1, 5), (9, 5))
+    sp = shortest_path([wall, block], (0, 10, 0, 10), (1, 5), (9, 5))
     assert sp.solved and [5.0, 8.0] not in sp.path.tolist() and [5.0, 2.0] in sp.path.tolist()
-    _agrees_with_the_pieces(cs, sp)
+    _agrees_with_the_pieces([wall, block], (0, 10, 0, 10), sp)
 
 
 @settings(max_examples=60, deadline=None)
@@ -227,6 +225,6 @@ def test_empty_or_collinear_hole_is_a_value_error_not_a_segfault(hole):
 
 def test_no_runtime_warning_from_a_degenerate_piece():
     with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        cs = CSpace((0, 10, 0, 10), [np.array([[5.0, 5], [5, 5], [5, 5]])])
-        assert not cs.is_free((5, 5))
+        warnings.simplefilter("error")  # a warning would be raised here instead of the ValueError
+        with pytest.raises(ValueError, match="area|vertices"):
+            CSpace((0, 10, 0, 10), [np.array([[5.0, 5], [5, 5], [5, 5]])])

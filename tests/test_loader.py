@@ -86,11 +86,11 @@ goal = {x = 7, y = 7}
 
 
 def test_peer_scenarios_load():
-    from conftest import PEER
+    from conftest import OMPL_SCENES
 
-    for f in sorted(os.listdir(PEER)):
+    for f in sorted(os.listdir(OMPL_SCENES)):
         if f.endswith(".toml"):
-            sc = load_scenario(os.path.join(PEER, f))
+            sc = load_scenario(os.path.join(OMPL_SCENES, f))
             assert sc.is_point_robot
 
 
@@ -145,3 +145,62 @@ def test_loading_does_not_modify_the_file(write_toml):
     before = open(path, "rb").read()
     load_scenario(path)
     assert open(path, "rb").read() == before
+
+
+TRI = "[[0, 0], [1, 0], [0, 1]]"
+
+
+@pytest.mark.parametrize(
+    "extra, field, message",
+    [
+        (f"[robot]\npolgon = {TRI}\n", "robot.polgon", "unknown field (did you mean polygon?)"),
+        ("[robot]\nraduis = 0.5\n", "robot.raduis", "unknown field (did you mean radius?)"),
+        (f"[robot]\n[[robot.parts]]\npolgyon = {TRI}\n", "robot.parts[0].polgyon",
+         "unknown field (did you mean polygon?)"),
+        ("[[obstacles]]\ncenter = [5, 5]\nraduis = 1\n", "obstacles[0].raduis", "unknown field (did you mean radius?)"),
+        ("[planer]\nname = 'RRT'\n", "planer", "unknown field (did you mean planner?)"),
+        ("[planner]\nnmae = 'RRT'\n", "planner.nmae", "unknown field (did you mean name?)"),
+        ("[[obstacle]]\ncenter = [5, 5]\nradius = 1\n", "obstacle", "unknown field (did you mean obstacles?)"),
+        # Nothing close: the whole list, so the user still learns what is allowed.
+        ("colour = 3\n", "colour", "unknown field (expected one of: bounds, disk_tolerance, expect, goal, name, "
+                                   "obstacles, planner, queries, robot, start)"),
+        ("[robot]\nholes = []\n", "robot.holes", "unknown field (expected one of: parts, polygon, radius)"),
+        # Two forms in one table.
+        (f"[[obstacles]]\ncenter = [5, 5]\npolygon = {TRI}\n", "obstacles[0]", "center and polygon exclude each other"),
+        (f"[[obstacles]]\nradius = 1\npolygon = {TRI}\n", "obstacles[0]", "polygon and radius exclude each other"),
+        (f"[robot]\nradius = 0.5\npolygon = {TRI}\n", "robot", "polygon and radius exclude each other"),
+        (f"[robot]\npolygon = {TRI}\n[[robot.parts]]\npolygon = {TRI}\n", "robot", "parts and polygon exclude each other"),
+        ("[robot]\nradius = 0.5\ncenter = [0, 0]\n", "robot.center", "a disk robot is centred on its reference point"),
+        ("[[obstacles]]\nradius = 1\n", "obstacles[0].center", "missing"),
+    ],
+)
+def test_messages_name_the_key_and_what_to_do(write_toml, extra, field, message):
+    # Tables go at the end, plain keys at the top (after a table they would belong to it).
+    path = write_toml(BASE + extra if extra.startswith("[") else extra + BASE)
+    with pytest.raises(ScenarioError) as exc:
+        load_scenario(path)
+    assert exc.value.field == field
+    assert str(exc.value).startswith(f"{path}: {field}: {message}")
+    assert "\n" not in str(exc.value)
+
+
+def test_the_known_keys_are_one_set_to_extend(write_toml, monkeypatch):
+    # A new top-level section (say `space`) is one entry in TOP_LEVEL_KEYS; suggestions follow it.
+    from cspace import scenario
+
+    path = write_toml("spcae = 'se2'\n" + BASE)
+    with pytest.raises(ScenarioError, match="expected one of"):
+        load_scenario(path)
+    monkeypatch.setattr(scenario, "TOP_LEVEL_KEYS", scenario.TOP_LEVEL_KEYS | {"space"})
+    with pytest.raises(ScenarioError, match=r"spcae: unknown field \(did you mean space\?\)"):
+        load_scenario(path)
+
+
+def test_validity_is_checked_at_a_scale_geos_can_compute(write_toml):
+    # GEOS's own arithmetic underflows on a triangle 1e-300 wide and called it
+    # self-intersecting; the check now runs on an exact power-of-two copy near 1.
+    sc = load_scenario(write_toml(BASE + "[robot]\npolygon = [[0, 0], [1e-300, 0], [0, 1e-300]]\n"))
+    assert sc.robot[0].polygon.shape == (3, 2)
+    bow = "[[0, 0], [2e-300, 2e-300], [2e-300, 0], [0, 2e-300]]"
+    with pytest.raises(ScenarioError, match=r"robot.polygon: not a simple polygon \(Self-intersection"):
+        load_scenario(write_toml(BASE + f"[robot]\npolygon = {bow}\n"))

@@ -11,7 +11,7 @@ import shapely
 import planners
 from cspace import load_scenario
 
-from conftest import PEER
+from conftest import OMPL_SCENES
 
 U_ROBOT = """
 name = "u-robot"
@@ -98,7 +98,7 @@ def test_unsolvable_returns_not_solved_within_the_limit(write_toml):
 
 def test_multi_query_circles_meets_ompls_own_bar():
     # OMPL's 2denvs test: >= 95 of the 100 circle queries at 1 s each, mean simplified length < 100
-    res = planners.plan(os.path.join(PEER, "circles.toml"), time=1.0, all_queries=True)
+    res = planners.plan(os.path.join(OMPL_SCENES, "circles.toml"), time=1.0, all_queries=True)
     solved = [q for q in res.queries if q.solved]
     assert len(res.queries) == 100
     assert len(solved) >= 95
@@ -108,7 +108,7 @@ def test_multi_query_circles_meets_ompls_own_bar():
 
 
 def test_point_robot_stages_skip_the_sum():
-    res = planners.plan(os.path.join(PEER, "env1.toml"), seed=0)
+    res = planners.plan(os.path.join(OMPL_SCENES, "env1.toml"), seed=0)
     assert res.solved
     ran = {s["stage"]: s["ran"] for s in res.cspace_report["stages"]}
     assert ran["minkowski"] is False and ran["decompose_robot"] is False
