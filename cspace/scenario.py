@@ -30,6 +30,7 @@ from __future__ import annotations
 import difflib
 import math
 import os
+import stat
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,11 +46,50 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 
 
 class ScenarioError(ValueError):
-    """A fault in a scenario: ``str(err)`` is ``FILE: FIELD: message``."""
+    """A fault in a scenario: ``str(err)`` is ``FILE: FIELD: message``, one short line.
+
+    Each part is clipped (:func:`clip`): an echoed value is never longer than a line.
+    """
 
     def __init__(self, file: str, field: str, message: str):
-        self.file, self.field, self.message = file, field, message
-        super().__init__(f"{file}: {field}: {message}")
+        self.file, self.field, self.message = clip(str(file)), clip(str(field)), clip(str(message), 240)
+        super().__init__(f"{self.file}: {self.field}: {self.message}")
+
+
+def clip(text: str, limit: int = 120) -> str:
+    """``text`` on one line, at most about ``limit`` characters (the rest counted, not shown).
+
+    >>> clip("x" * 1000, 10)
+    'xxxxxxxxxx... (990 more characters)'
+    """
+    text = text.replace("\n", "\\n").replace("\r", "\\r")
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text) - limit} more characters)"
+
+
+def show(x) -> str:
+    """A value as echoed in a message: short, and safe for integers of any size.
+
+    >>> show(10**5000), show([1.5] * 100)[:20]
+    ('an integer of 5001 digits', '[1.5, 1.5, 1.5, 1.5,')
+    """
+    if isinstance(x, int) and not isinstance(x, bool) and x.bit_length() > 200:
+        return f"an integer of {len(format(abs(x), 'x')) * 4 * 30103 // 100000 + 1} digits" \
+            if x.bit_length() > 14000 else f"an integer of {len(str(abs(x)))} digits"
+    if isinstance(x, (list, dict)) and len(x) > 40:  # do not even build a huge repr
+        x = x[:40] if isinstance(x, list) else dict(list(x.items())[:40])
+        return clip(repr(x)[:-1] + ", ...]" if isinstance(x, list) else repr(x)[:-1] + ", ...}", 80)
+    try:
+        return clip(repr(x), 80)
+    except (ValueError, RecursionError):
+        return f"a {type(x).__name__}"
+
+
+# The largest scenario file read: a scene of about a million vertices. Bigger files
+# (or /dev/zero) are refused before reading, as is anything that is not a regular file
+# (a FIFO would block the open, a device could be read forever).
+MAX_FILE_BYTES = 64 * 2**20
+# Seeds: OMPL's are 32-bit and never 0 (planners.ompl_glue.SEED_LIMIT); a seed s is used as s + 1.
+MAX_SEED = 2**32 - 2
 
 
 @dataclass
@@ -148,18 +188,66 @@ def load_scenario(path, space: str | None = None) -> Scenario:
     (0.9, 0.9)
     """
     path = os.fspath(path)
+    raw = read_input(path)
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in raw[:4096]:
+        raise ScenarioError(path, "file", "UTF-16 or binary, not UTF-8 text (save the file as UTF-8)")
     try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise ScenarioError(path, "file", f"cannot read ({exc.strerror or exc})") from None
+        text = raw.decode("utf-8-sig")  # a byte-order mark is allowed and skipped
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise ScenarioError(path, "file", "not UTF-8 text") from None
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
+    except ValueError as exc:  # an integer of more digits than Python converts
+        raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
+    except RecursionError:
+        raise ScenarioError(path, "toml", "invalid TOML (arrays or tables nested too deeply)") from None
     return scenario_from_dict(data, path, space=space)
+
+
+def check_input(path) -> os.stat_result:
+    """Refuse, without opening it, what cannot be a scenario file: a missing path, a
+    folder, a FIFO or device (whose open or read may never end), a file over
+    :data:`MAX_FILE_BYTES`. Returns the file's ``os.stat``.
+
+    >>> check_input("/dev/zero")
+    Traceback (most recent call last):
+    ...
+    cspace.scenario.ScenarioError: /dev/zero: file: is not a regular file (a FIFO, device or socket)
+    """
+    path = os.fspath(path)
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        raise ScenarioError(path, "file", f"cannot read ({getattr(exc, 'strerror', None) or exc})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ScenarioError(path, "file", "is a folder, not a scenario file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ScenarioError(path, "file", "is not a regular file (a FIFO, device or socket)")
+    if st.st_size > MAX_FILE_BYTES:
+        raise ScenarioError(path, "file", f"is {st.st_size} bytes, over the {MAX_FILE_BYTES >> 20} MiB limit")
+    return st
+
+
+def read_input(path: str) -> bytes:
+    """The bytes of a scenario file, read only once :func:`check_input` accepts it.
+
+    Opened without blocking and checked again on the open file (the path may have
+    been swapped for a FIFO in between); never more than the limit is read.
+    """
+    check_input(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+        with os.fdopen(fd, "rb") as fh:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise ScenarioError(path, "file", "is not a regular file (a FIFO, device or socket)")
+            raw = fh.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ScenarioError(path, "file", f"cannot read ({exc.strerror or exc})") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ScenarioError(path, "file", f"is over the {MAX_FILE_BYTES >> 20} MiB limit")
+    return raw
 
 
 # The scenes the C-space supports: products of two coordinates (or of two extents)
@@ -313,22 +401,22 @@ class _Validator:
         if x is None:
             raise self.err(field, "missing (a number is required)")
         if isinstance(x, bool) or not isinstance(x, (int, float)):
-            raise self.err(field, f"must be a number, got {type(x).__name__} {x!r}")
+            raise self.err(field, f"must be a number, got {type(x).__name__} {show(x)}")
         try:
             xf = float(x)
         except OverflowError:
-            raise self.err(field, f"{x} is too large for a double") from None
+            raise self.err(field, f"{show(x)} is too large for a double") from None
         if not math.isfinite(xf):
             raise self.err(field, f"must be finite, got {x}")
         if abs(xf) > MAX_MAGNITUDE:
-            raise self.err(field, f"{x} is beyond the supported magnitude 2^400 (about {MAX_MAGNITUDE:.2g})")
+            raise self.err(field, f"{show(x)} is beyond the supported magnitude 2^400 (about {MAX_MAGNITUDE:.2g})")
         if positive and not xf > 0.0:
             raise self.err(field, f"must be positive, got {x}")
         return xf
 
     def point(self, p, field: str) -> tuple[float, float]:
         if not isinstance(p, list) or len(p) != 2:
-            raise self.err(field, f"must be a point [x, y], got {p!r}")
+            raise self.err(field, f"must be a point [x, y], got {show(p)}")
         return self.number(p[0], f"{field}[0]"), self.number(p[1], f"{field}[1]")
 
     def pose(self, t: dict, field: str) -> tuple[tuple[float, float], float | None]:
@@ -437,8 +525,8 @@ class _Validator:
         if "time" in t:
             out["time"] = self.number(t["time"], "planner.time", positive=True)
         if "seed" in t:
-            if isinstance(t["seed"], bool) or not isinstance(t["seed"], int) or t["seed"] < 0:
-                raise self.err("planner.seed", "must be a non-negative integer")
+            if isinstance(t["seed"], bool) or not isinstance(t["seed"], int) or not 0 <= t["seed"] <= MAX_SEED:
+                raise self.err("planner.seed", f"must be an integer in [0, 2^32 - 1), got {show(t['seed'])}")
             out["seed"] = t["seed"]
         return out
 

@@ -150,8 +150,9 @@ def run(args) -> int:
         name, _, seed = args.abort_on.partition(":")
         abort_on = (parse_planners(name)[0], int(seed or 0))
     out = args.out
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise InputError(out, "--out", "exists and is not a folder")
+    from .output import check_folder
+
+    check_folder(out, "--out")
     held: dict = {}
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")

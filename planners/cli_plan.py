@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from .ompl_glue import OMPL_HINT, ompl_available
-from .output import PLOT_FORMATS, check_output, write_json
+from .output import PLOT_FORMATS, check_distinct, check_output, write_json
 
 
 def register(sub) -> None:
@@ -44,6 +44,8 @@ def integer(s: str) -> int:
 
 
 def run(args) -> int:
+    from cspace.scenario import check_input
+
     from .errors import InputError
 
     src = args.scenario
@@ -70,11 +72,13 @@ def run(args) -> int:
         sys.stderr.write("note: OMPL is not installed: planning with the exact planner instead "
                          f"({OMPL_HINT})\n")
         args.planner = "exact"
-    fmt = check_output(args.plot, "--plot", PLOT_FORMATS) if args.plot else None
-    if args.animate:
-        check_output(args.animate, "--animate", {".gif": "gif"})
-    if args.json:
-        check_output(args.json, "--json")
+    check_input(src)
+    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[src]) if args.plot is not None else None
+    if args.animate is not None:
+        check_output(args.animate, "--animate", {".gif": "gif"}, inputs=[src])
+    if args.json is not None:
+        check_output(args.json, "--json", inputs=[src])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate")])
     from .plan import plan
 
     if args.verbose and args.planner != "exact":
@@ -85,9 +89,9 @@ def run(args) -> int:
                simplify=not args.no_simplify, all_queries=args.all_queries,
                space=args.space, slabs=args.slabs)
     print(summary(res, verbose=args.verbose))
-    if args.json:
-        write_json(args.json, res.as_dict())
-    if args.plot:
+    if args.json is not None:
+        write_json(args.json, res.as_dict(), "--json")
+    if args.plot is not None:
         from .plot import plot_result
 
         plot_result(res, args.plot, fmt=fmt)

@@ -1,7 +1,7 @@
 """``cspace show``: draw a scene's workspace, C-obstacles and convex pieces without planning."""
 from __future__ import annotations
 
-from .output import PLOT_FORMATS, check_output
+from .output import PLOT_FORMATS, check_distinct, check_output
 
 
 def register(sub) -> None:
@@ -20,11 +20,14 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    fmt = check_output(args.plot, "--plot", PLOT_FORMATS) if args.plot else None
-    if args.json:
-        check_output(args.json, "--json")
+    from cspace.scenario import check_input, load_scenario
+
+    check_input(args.scenario)
+    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[args.scenario]) if args.plot is not None else None
+    if args.json is not None:
+        check_output(args.json, "--json", inputs=[args.scenario])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot")])
     from cspace.cspace import CSpace
-    from cspace.scenario import load_scenario
 
     sc = load_scenario(args.scenario, space=args.space)
     if sc.space == "se2":
@@ -37,11 +40,11 @@ def run(args) -> int:
         counts = {k: v for k, v in s.items() if k not in ("stage", "ran", "seconds", "note")}
         note = f" ({s['note']})" if s.get("note") else ""
         print(f"  {s['stage']:<20} {'ran' if s['ran'] else 'skipped':<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
-    if args.json:
+    if args.json is not None:
         from .output import write_json
 
-        write_json(args.json, {"scenario": sc.name, **rep})
-    if args.plot:
+        write_json(args.json, {"scenario": sc.name, **rep}, "--json")
+    if args.plot is not None:
         from .plot import plot_scene
 
         plot_scene(sc, cs, args.plot, fmt=fmt)
@@ -71,12 +74,12 @@ def _show_se2(sc, args, fmt) -> int:
     print(f"{sc.name}: {len(sc.obstacles)} obstacles, robot {sc.robot_kind}, SE(2) with {rep['slabs_reason']}")
     print(f"  slab {k} of {se2.slabs}: theta in [{math.degrees(a):.4g}, {math.degrees(b):.4g}] deg, "
           f"{len(slab.pieces)} C-obstacle pieces, built in {rep['build_seconds'] * 1e3:.1f} ms")
-    if args.json:
+    if args.json is not None:
         from .output import write_json
 
         write_json(args.json, {"scenario": sc.name, "slab": k, "slab_range": [a, b], **rep,
-                               "slab_report": slab.report()})
-    if args.plot:
+                               "slab_report": slab.report()}, "--json")
+    if args.plot is not None:
         from .plot import plot_scene
 
         plot_scene(sc, slab, args.plot, fmt=fmt, theta=th,

@@ -934,9 +934,9 @@ def register(sub) -> None:
 def run(args) -> int:
     from .output import check_output, write_json
 
-    if args.json:
+    if args.json is not None:  # "" is refused by check_output, not skipped
         check_output(args.json, "--json")
-    if args.plot:
+    if args.plot is not None:
         check_output(args.plot, "--plot", {".png": "png"})
     import textwrap
 
@@ -946,9 +946,9 @@ def run(args) -> int:
     print("\n" + textwrap.fill(f"{len(rows) - len(failed)}/{len(rows)} cases pass"
                                + (f"; FAILED: {', '.join(failed)}" if failed else ""), WIDTH,
                                subsequent_indent="  ", break_on_hyphens=False))
-    if args.json:
+    if args.json is not None:
         write_json(args.json, {"cases": rows, "guarantees": GUARANTEES, "passed": not failed})
-    if args.plot:
+    if args.plot is not None:
         plot(rows, args.plot)
     sys.stdout.flush()
     return 0 if not failed else 1
