@@ -27,6 +27,7 @@ import numpy as np
 
 from .broadphase import BLOCKED, FREE, GridIndex
 from .pieces import PieceSet
+from .inputs import query_points
 from .predicates import orient2d_many
 from .scenario import MAX_MAGNITUDE, MIN_EXTENT, Scenario, load_scenario
 
@@ -58,6 +59,58 @@ def _check_range(bounds: tuple, shapes: list) -> None:
         raise ValueError(f"CSpace: the bounds' extent {max(xmax - xmin, ymax - ymin):.3g} is below the supported 2^-400")
 
 
+def decompose_obstacles(obstacles: list[np.ndarray], holes: list[list[np.ndarray]] | None = None,
+                        of: list[int] | None = None) -> tuple[list[np.ndarray], np.ndarray, int]:
+    """Convex pieces of the obstacles: (pieces, owning obstacle of each piece, obstacles split).
+
+    Convex obstacles without holes are kept as they are; the others go through
+    :func:`cspace.decompose.convex_decompose`. ``of[k]``, if given, is the input obstacle
+    shell k came from (a MultiPolygon gives several shells). Shared by :class:`CSpace`
+    and the SE(2) C-space, which decomposes once for all its slabs.
+
+    >>> p, owner, split = decompose_obstacles([np.array([[0., 0], [2, 0], [2, 2], [0, 2]])])
+    >>> len(p), owner.tolist(), split
+    (1, [0], 0)
+    """
+    from .polygon import is_convex
+
+    holes = holes or [[] for _ in obstacles]
+    pieces, owner, split = [], [], 0
+    for k, (poly, hs) in enumerate(zip(obstacles, holes)):
+        i = k if of is None else of[k]
+        if not hs and is_convex(poly):
+            parts = [np.asarray(poly, dtype=np.float64)]
+        else:
+            from .decompose import convex_decompose
+
+            parts = convex_decompose(poly, hs)
+            split += 1
+        pieces += parts
+        owner += [i] * len(parts)
+    return pieces, np.array(owner, dtype=np.int64), split
+
+
+def decompose_robot(robot: list[np.ndarray], is_disk: bool = False) -> tuple[list[np.ndarray], int]:
+    """Convex pieces of the robot parts: (pieces, parts split). A disk's polygon is convex.
+
+    >>> p, split = decompose_robot([np.array([[0., 0], [2, 0], [2, 2], [1, 1], [0, 2]])])
+    >>> len(p) > 1, split
+    (True, 1)
+    """
+    from .polygon import is_convex
+
+    pieces, split = [], 0
+    for part in robot:
+        if is_disk or is_convex(part):
+            pieces.append(np.asarray(part, dtype=np.float64))
+        else:
+            from .decompose import convex_decompose
+
+            pieces += convex_decompose(part)
+            split += 1
+    return pieces, split
+
+
 class CSpace:
     """Convex C-obstacle pieces of a scenario behind a broad phase.
 
@@ -76,14 +129,25 @@ class CSpace:
         obstacle_holes: list[list[np.ndarray]] | None = None,
         robot_is_disk: bool = False,
         grid_cells: int | None = None,
+        normalized: bool = False,
     ):
+        # Obstacles and robot parts: (N, 2) arrays in either orientation or shapely Polygons /
+        # MultiPolygons (cspace.inputs); ``normalized`` says they are already the loader's
+        # CCW, cleaned, validated arrays (from_scenario), so that work is not done twice.
         self.bounds = tuple(float(v) for v in bounds)
         self.stages: list[Stage] = []
-        obstacles = obstacles or []
-        _check_range(self.bounds, obstacles + (robot or []))
-        holes = obstacle_holes or [[] for _ in obstacles]
-        self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes)
-        self.robot_pieces = self._decompose_robot(robot or [], robot_is_disk)
+        owner = None
+        if normalized:
+            obstacles, robot = list(obstacles or []), list(robot or [])
+            holes = obstacle_holes or [[] for _ in obstacles]
+        else:
+            from .inputs import obstacle_shapes, robot_parts
+
+            obstacles, holes, owner = obstacle_shapes(obstacles, obstacle_holes)
+            robot = robot_parts(robot)
+        _check_range(self.bounds, obstacles + robot)
+        self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes, owner)
+        self.robot_pieces = self._decompose_robot(robot, robot_is_disk)
         raw, raw_owner = self._sum()
         self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
         t = time.perf_counter()
@@ -95,7 +159,9 @@ class CSpace:
                                  {**self.index.stats(), "segment_grid": [self.coarse.nx, self.coarse.ny]}))
         self.checks = {"points": 0, "segments": 0, "exact_points": 0, "exact_segments": 0}
         self._points = itertools.count()
+        self._batch_points = 0  # points answered by is_free on arrays
         self.is_free_xy = self.point_test(self._points.__next__)
+        self._is_free_q = self.is_free_xy.by_state  # the same test, on one indexable (x, y)
         self._point_uncounted = self.point_test(None)
 
     # -- construction --------------------------------------------------------------
@@ -121,50 +187,29 @@ class CSpace:
             obstacle_holes=[o.holes for o in sc.obstacles],
             robot_is_disk=sc.robot_kind == "disk",
             grid_cells=grid_cells,
+            normalized=True,
         )
         cs.scenario = sc
         if not isinstance(scenario, Scenario):
             cs.stages.insert(0, Stage("load", True, load_s, {"obstacles": len(sc.obstacles)}))
         return cs
 
-    def _decompose_obstacles(self, obstacles, holes):
-        from .polygon import is_convex
-
+    def _decompose_obstacles(self, obstacles, holes, of=None):
         t = time.perf_counter()
-        pieces, owner, split = [], [], 0
-        for i, (poly, hs) in enumerate(zip(obstacles, holes)):
-            if not hs and is_convex(poly):
-                parts = [np.asarray(poly, dtype=np.float64)]
-            else:
-                from .decompose import convex_decompose
-
-                parts = convex_decompose(poly, hs)
-                split += 1
-            pieces += parts
-            owner += [i] * len(parts)
+        pieces, owner, split = decompose_obstacles(obstacles, holes, of)
         self.stages.append(
             Stage("decompose_obstacles", split > 0, time.perf_counter() - t,
                   {"obstacles": len(obstacles), "decomposed": split, "pieces": len(pieces)},
                   "" if split else "all obstacles convex: nothing to decompose")
         )
-        return pieces, np.array(owner, dtype=np.int64)
+        return pieces, owner
 
     def _decompose_robot(self, robot, is_disk):
-        from .polygon import is_convex
-
         t = time.perf_counter()
         if not robot:
             self.stages.append(Stage("decompose_robot", False, 0.0, {"parts": 0}, "point robot"))
             return []
-        pieces, split = [], 0
-        for part in robot:
-            if is_disk or is_convex(part):
-                pieces.append(np.asarray(part, dtype=np.float64))
-            else:
-                from .decompose import convex_decompose
-
-                pieces += convex_decompose(part)
-                split += 1
+        pieces, split = decompose_robot(robot, is_disk)
         note = "disk robot: its polygon is convex" if is_disk else ("" if split else "robot parts convex")
         self.stages.append(Stage("decompose_robot", split > 0, time.perf_counter() - t,
                                  {"parts": len(robot), "pieces": len(pieces)}, note))
@@ -175,21 +220,30 @@ class CSpace:
         if not self.robot_pieces:
             self.stages.append(Stage("minkowski", False, 0.0, {"pieces": len(self.obstacle_pieces)},
                                      "point robot: C-obstacles are the obstacles"))
+            n = len(self.obstacle_pieces)
+            self._raw_pairs = [(i, -1) for i in range(n)]
             return list(self.obstacle_pieces), self.obstacle_of
         from .minkowski import minkowski_sum, reflect
 
         neg = [reflect(r) for r in self.robot_pieces]
-        out, owner = [], []
-        for p, o in zip(self.obstacle_pieces, self.obstacle_of):
-            for r in neg:
+        out, owner, pairs = [], [], []
+        for i, (p, o) in enumerate(zip(self.obstacle_pieces, self.obstacle_of)):
+            for j, r in enumerate(neg):
                 out.append(minkowski_sum(p, r))
                 owner.append(o)
+                pairs.append((i, j))
+        self._raw_pairs = pairs
         self.stages.append(Stage("minkowski", True, time.perf_counter() - t,
                                  {"pairs": len(out), "robot_pieces": len(neg)}))
         return out, np.array(owner, dtype=np.int64)
 
     def _prune(self, pieces, owner):
-        """Drop pieces that cannot meet the bounds, and pieces inside another piece."""
+        """Drop pieces that cannot meet the bounds, and pieces inside another piece.
+
+        ``self.piece_pairs[k]`` lists the (obstacle piece, robot piece) pairs whose sum
+        is kept piece k or lies inside it (robot piece -1 for a point robot): a point in
+        the sum of a pair is in the piece the pair is listed under.
+        """
         t = time.perf_counter()
         xmin, xmax, ymin, ymax = self.bounds
         before = len(pieces)
@@ -199,13 +253,21 @@ class CSpace:
         ]
         outside = before - len(keep)
         pieces = [pieces[k] for k in keep]
+        pairs = [[self._raw_pairs[k]] for k in keep]
         owner = owner[keep] if len(owner) else owner
         contained = _contained_pieces(pieces)
         if contained:
+            for p in sorted(contained):
+                q = contained[p]
+                while q in contained:  # a container may itself lie in another piece
+                    q = contained[q]
+                pairs[q] += pairs[p]
             mask = np.ones(len(pieces), dtype=bool)
             mask[list(contained)] = False
             pieces = [p for p, m in zip(pieces, mask) if m]
+            pairs = [pr for pr, m in zip(pairs, mask) if m]
             owner = owner[mask]
+        self.piece_pairs = pairs
         self.stages.append(Stage("prune", True, time.perf_counter() - t,
                                  {"pieces_before": before, "outside_bounds": outside,
                                   "inside_another": len(contained), "pieces_after": len(pieces)}))
@@ -217,9 +279,52 @@ class CSpace:
         xmin, xmax, ymin, ymax = self.bounds
         return xmin <= x <= xmax and ymin <= y <= ymax
 
-    def is_free(self, q) -> bool:
-        """Is the reference point at q a valid state (in bounds, robot touching nothing)?"""
-        return self.is_free_xy(float(q[0]), float(q[1]))
+    def is_free(self, q):
+        """Is the reference point at q a valid state (in bounds, robot touching nothing)?
+
+        ``q`` is ``(x, y)`` (a bool comes back) or an ``(N, 2)`` array of states (a bool
+        array comes back; FREE and BLOCKED grid cells answered vectorised, the others
+        exactly, one by one). NaN or infinite coordinates, and ``(x, y, theta)`` (the
+        orientation is fixed when the C-space is built), are a ``ValueError``.
+
+        >>> import numpy as np
+        >>> cs = CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])])
+        >>> cs.is_free((1, 1)), cs.is_free([[1, 1], [5, 5]]).tolist()
+        (True, [True, False])
+        """
+        try:
+            if type(q) is tuple and len(q) == 2:  # the common call: straight to the hot path
+                free = self._is_free_q(q)
+            else:
+                x, y = q  # three numbers (x, y, theta) do not unpack
+                free = self.is_free_xy(float(x), float(y))
+        except (TypeError, ValueError):  # rows (a batch), or a fault query_points names
+            return self._is_free_many(q)
+        if free:
+            return True
+        x, y = q
+        if x - x == 0.0 and y - y == 0.0:  # NaN or inf: checked off the free path only
+            return False
+        query_points(q, 2, "is_free")  # raises
+
+    def _is_free_many(self, q) -> np.ndarray:
+        """:meth:`is_free` of an (N, 2) batch: the grid's FREE/BLOCKED cells at once,
+        the same per-point arithmetic as :meth:`point_test`, so the same answers."""
+        pts = query_points(q, 2, "is_free")
+        self._batch_points += len(pts)
+        idx = self.index
+        x, y = pts[:, 0], pts[:, 1]
+        i = x * idx.inv_w - idx.x0 * idx.inv_w
+        j = y * idx.inv_h - idx.y0 * idx.inv_h
+        on_grid = (i >= 0.0) & (j >= 0.0) & (i < idx.nx) & (j < idx.ny)
+        cell = np.where(on_grid, np.floor(j) * idx.nx + np.floor(i), 0).astype(np.int64)
+        state = np.where(on_grid, idx.state[cell], -1)
+        out = state == FREE
+        rest = np.flatnonzero((state != FREE) & (state != BLOCKED))
+        test = self._point_uncounted
+        for k in rest.tolist():
+            out[k] = test(float(x[k]), float(y[k]))
+        return out
 
     def point_test(self, tick=None, state: bool = False):
         """A fast ``(x, y) -> bool`` free-state test: the validity checker's hot path.
@@ -284,6 +389,7 @@ class CSpace:
         def is_free_xy(x: float, y: float) -> bool:
             return is_free_q((x, y))
 
+        is_free_xy.by_state = is_free_q
         return is_free_xy
 
     def _mixed_cell_test(self):
@@ -346,7 +452,7 @@ class CSpace:
     def point_count(self) -> int:
         """Point queries answered so far."""
         n = self._points.__reduce__()[1][0]
-        return int(n)
+        return int(n) + self._batch_points
 
     def _is_free_exact(self, x: float, y: float) -> bool:
         """Bounds check, then the exact test against the cell's candidate pieces."""
@@ -366,11 +472,30 @@ class CSpace:
                 return False
         return True
 
-    def segment_free(self, a, b) -> bool:
-        """Is every state on the closed segment a-b valid? Exact: no sampling along it."""
-        ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+    def segment_free(self, a, b=None):
+        """Is every state on the closed segment a-b valid? Exact: no sampling along it.
+
+        ``segment_free(a, b)`` with two points gives a bool; ``segment_free(S)`` with an
+        ``(N, 2, 2)`` array of segments (or ``a``, ``b`` as two ``(N, 2)`` arrays) gives a
+        bool array. Non-finite coordinates and ``(x, y, theta)`` are a ``ValueError``.
+
+        >>> import numpy as np
+        >>> cs = CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])])
+        >>> cs.segment_free((1, 1), (9, 1)), cs.segment_free([[(1, 1), (9, 1)], [(1, 5), (9, 5)]]).tolist()
+        (True, [True, False])
+        """
+        if b is None:
+            return self._segments_free(a)
+        try:
+            ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+        except (TypeError, IndexError):  # rows: a batch
+            return self._segments_free(np.stack([np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)], 1))
+        if len(a) != 2 or len(b) != 2:
+            query_points([a, b], 2, "segment_free")  # raises: (x, y, theta) or a wrong length
         self.checks["segments"] += 1
         if not (self.in_bounds(ax, ay) and self.in_bounds(bx, by)):
+            if not (ax - ax == 0.0 and ay - ay == 0.0 and bx - bx == 0.0 and by - by == 0.0):
+                query_points([a, b], 2, "segment_free")  # raises: NaN or inf
             return False  # the bounds box is convex: both ends inside => whole segment inside
         # Motions mostly fail at their far end (an RRT extension into an obstacle).
         if not (self._point_uncounted(bx, by) and self._point_uncounted(ax, ay)):
@@ -389,13 +514,35 @@ class CSpace:
         cands -= blockers
         return not (cands and hits(np.fromiter(cands, np.int64, len(cands)), a2, b2).any())
 
-    def clearance(self, q) -> float:
+    def _segments_free(self, s) -> np.ndarray:
+        """:meth:`segment_free` of an (N, 2, 2) batch, each segment by the exact scalar test."""
+        arr = np.asarray(s, dtype=np.float64)
+        if arr.ndim != 3 or arr.shape[1] != 2:
+            raise ValueError(f"segment_free: expected two points or an (N, 2, 2) array of segments, "
+                             f"got shape {arr.shape}")
+        pts = query_points(arr.reshape(-1, arr.shape[2]), 2, "segment_free").reshape(-1, 2, 2)
+        one = self.segment_free
+        return np.array([one((a[0], a[1]), (b[0], b[1])) for a, b in pts.tolist()], dtype=bool)
+
+    def clearance(self, q):
         """Distance from q to the nearest C-obstacle piece (0 when not free), via GJK.
 
         Pieces are visited in order of their bounding-box distance, a lower bound,
         and the search stops once that bound exceeds the best distance found.
+        ``q`` is ``(x, y)`` (a float) or an ``(N, 2)`` array (a float array); non-finite
+        coordinates and ``(x, y, theta)`` are a ``ValueError``.
+
+        >>> import numpy as np
+        >>> cs = CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])])
+        >>> cs.clearance((1, 5)), cs.clearance([[1, 5], [5, 5]]).tolist()
+        (3.0, [3.0, 0.0])
         """
-        x, y = float(q[0]), float(q[1])
+        try:
+            x, y = float(q[0]), float(q[1])
+        except (TypeError, IndexError):  # rows: a batch
+            return np.array([self.clearance(p) for p in query_points(q, 2, "clearance").tolist()], dtype=np.float64)
+        if len(q) != 2 or not (x - x == 0.0 and y - y == 0.0):
+            query_points(q, 2, "clearance")  # raises: (x, y, theta), a wrong length, NaN or inf
         if not self.is_free_xy(x, y) or not len(self.pieces):
             return 0.0 if len(self.pieces) or not self.in_bounds(x, y) else float("inf")
         from .gjk import gjk_distance
@@ -423,8 +570,8 @@ class CSpace:
         }
 
 
-def _contained_pieces(pieces: list[np.ndarray]) -> set[int]:
-    """Indices of convex pieces lying inside another piece (exact containment test).
+def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
+    """Convex pieces lying inside another piece (exact containment test): removed -> container.
 
     Candidate pairs come from bounding-box containment; a convex piece P lies in a
     convex piece Q iff every vertex of P is on or left of every edge of Q. Of two
@@ -432,11 +579,11 @@ def _contained_pieces(pieces: list[np.ndarray]) -> set[int]:
     """
     n = len(pieces)
     if n < 2:
-        return set()
+        return {}
     lo = np.array([p.min(axis=0) for p in pieces])
     hi = np.array([p.max(axis=0) for p in pieces])
     order = np.argsort(lo[:, 0], kind="stable")
-    removed: set[int] = set()
+    removed: dict[int, int] = {}
     lo_sorted = lo[order, 0]
     for q in range(n):
         if q in removed:
@@ -458,5 +605,5 @@ def _contained_pieces(pieces: list[np.ndarray]) -> set[int]:
                 continue  # identical: keep the earlier one, drop q when it is visited as p
             sides = orient2d_many(s[None, :, :], e[None, :, :], P[:, None, :])
             if (sides >= 0).all():
-                removed.add(p)
+                removed[p] = q
     return removed

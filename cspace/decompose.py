@@ -45,6 +45,8 @@ def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
     """
     if hasattr(polygon, "geom_type") and polygon.geom_type == "Polygon" and holes is None:
         holes = [as_array(r) for r in polygon.interiors]
+    if len(as_array(polygon, copy=False)) == 0:
+        raise ValueError("convex_decompose: the polygon has no vertices")
     shell = normalize(polygon)
     if len(shell) < 3:  # no area: the point or segment it spans, a convex piece itself
         return [collinear_extent(as_array(polygon))]
@@ -92,10 +94,13 @@ def _triangulate(rings: list, pts: np.ndarray) -> np.ndarray:
     if rescaled:
         rings = rescaled[1]
         pts = np.concatenate(rings) if len(rings) > 1 else rings[0]
+    geom = shapely.Polygon(rings[0], rings[1:])
     try:
-        tri = shapely.constrained_delaunay_triangles(shapely.Polygon(rings[0], rings[1:]))
+        tri = shapely.constrained_delaunay_triangles(geom)
     except shapely.errors.GEOSException as e:
-        raise ValueError(f"convex_decompose: GEOS could not triangulate the polygon ({e})") from None
+        # Say what is wrong with the input, in the loader's words, rather than GEOS's exception.
+        reason = "" if shapely.is_valid(geom) else f"not a simple polygon ({shapely.is_valid_reason(geom)}); "
+        raise ValueError(f"convex_decompose: {reason}GEOS could not triangulate it ({type(e).__name__})") from None
     corners = shapely.get_coordinates(tri).reshape(-1, 4, 2)[:, :3].reshape(-1, 2)
     # Each corner's vertex index: look the (x, y) pairs up as complex numbers, which
     # numpy sorts by x, then y.

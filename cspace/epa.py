@@ -44,6 +44,8 @@ def epa_penetration(A, B) -> Penetration:
     """
     a = as_array(A)
     b = as_array(B)
+    if not (len(a) and len(b)):
+        raise ValueError("epa_penetration: an operand has no vertices")
     with np.errstate(over="ignore", invalid="ignore"):
         extent = max(float(np.abs(a - a[0]).max()), float(np.abs(b - a[0]).max()))
     rescaled = scaled_copies([a, b], extent)

@@ -64,6 +64,8 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
     """
     a = as_array(A)
     b = as_array(B)
+    if not (len(a) and len(b)):
+        raise ValueError("gjk_distance: an operand has no vertices")
     origin = a[0].copy()
     ox, oy = origin.tolist()
     if len(a) + len(b) <= 80:  # Python floats (an overflow is inf, silently): cheaper when small

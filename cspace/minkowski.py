@@ -57,6 +57,8 @@ def minkowski_sum(P, Q, *more) -> np.ndarray:
     [[0.0, 0.0], [3.0, 0.0], [3.0, 1.0], [1.0, 3.0], [0.0, 3.0]]
     """
     ops = [as_array(x, copy=False) for x in (P, Q) + more]  # only read
+    if any(len(o) == 0 for o in ops):
+        raise ValueError("minkowski_sum: an operand has no vertices")
     try:
         return _minkowski_sum(ops)
     except (OverflowError, NonFiniteError):  # an exact step met a NaN or an infinity
@@ -527,6 +529,10 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
     # once per addition; the count of an operand's edges taken so far is its index.
     vx = np.zeros(len(keep))
     vy = np.zeros(len(keep))
+    for p in polys:
+        if len(p) == 1:  # an operand that is one point (no edges): it translates every vertex
+            vx += p[0, 0]
+            vy += p[0, 1]
     owner = np.repeat(np.arange(len(edged)), sizes)[order]
     for i, p in enumerate(edged):
         cnt = (np.cumsum(owner == i)[keep] + rot[i]) % sizes[i]

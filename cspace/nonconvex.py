@@ -40,34 +40,74 @@ def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
 
 
 def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
-    """A ⊕ B for simple polygons with holes, as a shapely Polygon or MultiPolygon.
+    """A ⊕ B for polygons with holes, always as a shapely ``MultiPolygon``.
 
-    ``A`` and ``B`` are vertex arrays (either orientation) or shapely Polygons
-    (whose interiors are their holes). An operand whose vertices are collinear is
-    the point or segment they span (a segment sweeps the other operand).
+    ``A`` and ``B`` are vertex arrays (either orientation), shapely Polygons (whose
+    interiors are their holes) or shapely MultiPolygons (the sum distributes over their
+    parts). The result is one type whatever the input: a MultiPolygon with one part per
+    connected component of the sum (``.geoms[0]`` when it is connected); it is empty only
+    when the sum has no area (two parallel segments). An operand whose vertices are
+    collinear is the point or segment they span (a segment sweeps the other operand).
+    A polygon that is not simple, or a non-finite coordinate, is a ``ValueError``.
 
     >>> L = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
     >>> minkowski_sum_nonconvex(L, [[0, 0], [1, 0], [1, 1], [0, 1]]).area
     8.0
-    >>> minkowski_sum_nonconvex(L, L).area  # the convolution route
-    13.0
+    >>> region = minkowski_sum_nonconvex(L, L)  # the convolution route
+    >>> region.geom_type, len(region.geoms), region.area
+    ('MultiPolygon', 1, 13.0)
     """
     import shapely
 
-    (A, holes_a), (B, holes_b) = _operand(A, holes_a), _operand(B, holes_b)
+    parts_a, parts_b = _parts(A, holes_a, "A"), _parts(B, holes_b, "B")
+    sums = [_sum(a, ha, b, hb) for a, ha in parts_a for b, hb in parts_b]
+    return _multipolygon(sums[0] if len(sums) == 1 else shapely.union_all(sums))
+
+
+def _parts(P, holes, name: str) -> list:
+    """[(polygon, holes)] of one operand: a MultiPolygon gives one entry per part."""
+    if hasattr(P, "geom_type") and P.geom_type != "Polygon":
+        import shapely
+
+        parts = list(shapely.get_parts(P))
+        if P.is_empty or not all(p.geom_type == "Polygon" for p in parts):
+            raise ValueError(f"minkowski_sum_nonconvex: {name} is a {P.geom_type}, not a (Multi)Polygon with area")
+        if holes is not None:
+            raise ValueError(f"minkowski_sum_nonconvex: holes_{name.lower()} given with a MultiPolygon "
+                             f"(its parts bring their own holes)")
+        return [(p, None) for p in parts]
+    return [(P, holes)]
+
+
+def _multipolygon(region):
+    """The region as a MultiPolygon (its polygons; nothing of lower dimension)."""
+    import shapely
+
+    if region.geom_type == "MultiPolygon":
+        return region
+    polys = [g for g in shapely.get_parts(region) if g.geom_type == "Polygon" and not g.is_empty]
+    return shapely.MultiPolygon(polys)
+
+
+def _sum(A, holes_a, B, holes_b):
+    """A ⊕ B of two simple polygons with holes (a Polygon or a MultiPolygon)."""
+    import shapely
+
+    (A, holes_a), (B, holes_b) = _operand(A, holes_a, "A"), _operand(B, holes_b, "B")
     # GEOS's overlay multiplies coordinates: far from 1 in magnitude, sum a power-of-two
     # copy of the operands (exact) and scale the region back.
     rings = [A, B] + holes_a + holes_b
     rescaled = scaled_copies(rings, max(float(np.abs(p).max()) for p in rings if len(p)))
     if rescaled:
         k, scaled = rescaled
-        region = minkowski_sum_nonconvex(scaled[0], scaled[1], scaled[2:2 + len(holes_a)],
-                                         scaled[2 + len(holes_a):])
+        region = _sum(scaled[0], scaled[2:2 + len(holes_a)], scaled[1], scaled[2 + len(holes_a):])
         with np.errstate(over="ignore"):
             region = shapely.transform(region, lambda c: np.ldexp(c, -k))
         if not np.isfinite(shapely.get_coordinates(region)).all():
             raise ValueError("minkowski_sum_nonconvex: the sum's coordinates overflow the double range")
         return region
+    _check_simple(A, holes_a, "A")
+    _check_simple(B, holes_b, "B")
     route = _convolution_roles(A, holes_a, B, holes_b)
     if route is not None:
         X, holes_x, x_convex, Q = route
@@ -77,15 +117,29 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
     return _union_of_pairwise_sums(A, holes_a, B, holes_b)
 
 
-def _operand(P, holes):
+def _operand(P, holes, name: str = "operand"):
     """(normalised CCW shell, list of holes) of an array or a shapely Polygon."""
     if hasattr(P, "geom_type") and P.geom_type == "Polygon" and holes is None:
         holes = [as_array(r) for r in P.interiors]
     holes = [normalize(h, ccw=False) for h in (holes or [])]
-    shell = normalize(P)
+    if len(as_array(P, copy=False)) == 0:
+        raise ValueError(f"minkowski_sum_nonconvex: {name} has no vertices")
+    shell = normalize(P)  # non-finite coordinates raise here, before GEOS sees them
     if len(shell) < 3:  # no area: the point or segment it spans (swept along the other operand)
-        shell = collinear_extent(as_array(P))
+        return collinear_extent(as_array(P)), []
     return shell, [h for h in holes if len(h) >= 3]
+
+
+def _check_simple(shell, holes, name: str) -> None:
+    """ValueError unless a shell with area is a simple polygon with its holes inside it
+    (GEOS's validity; run on coordinates near 1, where its arithmetic cannot underflow)."""
+    if len(shell) < 3:
+        return
+    import shapely
+
+    geom = shapely.Polygon(shell, holes)
+    if not shapely.is_valid(geom):
+        raise ValueError(f"minkowski_sum_nonconvex: {name} is not a simple polygon ({shapely.is_valid_reason(geom)})")
 
 
 def _convolution_roles(A, holes_a, B, holes_b):

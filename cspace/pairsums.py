@@ -38,6 +38,8 @@ def pairwise_sums(pa: list, pb: list) -> list[np.ndarray]:
     """
     pa = [np.asarray(p, dtype=np.float64) for p in pa]
     pb = [np.asarray(p, dtype=np.float64) for p in pb]
+    if any(p.ndim != 2 or p.shape[1:] != (2,) or len(p) == 0 for p in pa + pb):
+        raise ValueError("pairwise_sums: every piece must be a non-empty (N, 2) array of vertices")
     if not pa or not pb:
         return []
     A, B = PackedPieces(pa), PackedPieces(pb)

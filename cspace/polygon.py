@@ -29,6 +29,8 @@ def as_array(polygon, copy: bool = True) -> np.ndarray:
         geom = polygon
         if geom.geom_type == "Polygon":
             geom = geom.exterior
+        elif geom.geom_type not in ("LinearRing", "LineString", "Point"):  # not one sequence of points
+            raise ValueError(f"expected one polygon, got a {geom.geom_type} (pass its parts, .geoms, one by one)")
         pts = np.array(geom.coords, dtype=np.float64)[:, :2]
     else:
         pts = np.array(polygon, dtype=np.float64) if copy else np.asarray(polygon, dtype=np.float64)
@@ -307,6 +309,29 @@ def is_convex(polygon, *, strict: bool = False) -> bool:
     return bool(abs(abs(d.sum()) - 2 * math.pi) < 1.0)
 
 
+def invalid_reason(shell, holes=()) -> str | None:
+    """GEOS's reason why the polygon (shell and holes) is not valid, or None if it is.
+
+    GEOS's arithmetic multiplies coordinates: at extreme magnitudes (a triangle 1e-300
+    wide) it underflows and calls a fine polygon self-intersecting, so it runs on an
+    exact power-of-two copy near 1 (the reason's coordinates are then that copy's).
+    Coordinates must be finite (GEOS would warn about NaN).
+
+    >>> invalid_reason([[0, 0], [2, 2], [2, 0], [0, 2]]), invalid_reason(np.array([[0, 0], [1, 0], [0, 1]]) * 1e-300)
+    ('Self-intersection[1 1]', None)
+    """
+    import shapely
+
+    from .scaling import scaled_copies
+
+    rings = [as_array(shell, copy=False)] + [as_array(h, copy=False) for h in holes]
+    rescaled = scaled_copies(rings, max(float(np.abs(r).max()) for r in rings if len(r)))
+    if rescaled:
+        rings = rescaled[1]
+    geom = shapely.Polygon(rings[0], rings[1:])
+    return None if shapely.is_valid(geom) else shapely.is_valid_reason(geom)
+
+
 def is_simple(polygon) -> bool:
     """True when the closed polygon has non-zero area and does not cross itself.
 
@@ -316,10 +341,10 @@ def is_simple(polygon) -> bool:
     import shapely
 
     p = as_array(polygon)
-    if len(p) < 3:
+    if len(p) < 3 or not np.isfinite(p).all():  # GEOS would warn about NaN; not simple anyway
         return False
     # Area decided exactly (a float area underflows to 0 for coordinates near 1e-160).
-    return bool(shapely.Polygon(p).is_valid) and len(normalize(p)) >= 3
+    return invalid_reason(p) is None and len(normalize(p)) >= 3
 
 
 def point_in_convex(p: np.ndarray, x: float, y: float) -> int:

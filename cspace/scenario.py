@@ -18,9 +18,12 @@ Schema (all lengths in one unit, angles in radians)::
     [[obstacles]] polygon = [[x, y], ...], holes = [[[x, y], ...], ...]  (holes optional)
                 | center = [x, y], radius = r
     [start]    x, y, theta (optional; the fixed orientation while translating)
-    [goal]     x, y, theta (optional; must equal the start's)
+    [goal]     x, y, theta (optional; must equal the start's unless space = "se2")
     [planner]  name, time, seed        # optional defaults
-    [[queries]] start = [x, y], goal = [x, y]   # optional extra queries
+    [[queries]] start = [x, y], goal = [x, y]   # optional extra queries ([x, y, theta] in SE(2))
+    space = "translation" | "se2"      # optional: "se2" lets the robot rotate (theta is free;
+                                       # pose angles are taken into [-pi, pi), as OMPL's SO(2))
+    slabs = K                          # optional, SE(2) only: angle slabs of the sliced C-space
 """
 from __future__ import annotations
 
@@ -32,7 +35,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
-from .polygon import is_convex, normalize
+from .polygon import invalid_reason, is_convex, normalize
+from .slab import wrap_angle
 
 try:  # Python >= 3.11
     import tomllib
@@ -70,18 +74,21 @@ class Shape:
 
 @dataclass
 class Query:
-    """A start and goal of the reference point."""
+    """A start and goal: (x, y) of the reference point, or poses (x, y, theta) in SE(2)."""
 
-    start: tuple[float, float]
-    goal: tuple[float, float]
+    start: tuple
+    goal: tuple
 
 
 @dataclass
 class Scenario:
-    """A planning problem: a translating robot, obstacles, bounds and queries.
+    """A planning problem: a robot, obstacles, bounds and queries.
 
-    ``robot`` holds the parts in the world orientation (already rotated by
-    ``theta``), relative to the reference point; an empty list is a point robot.
+    ``space`` is ``"translation"`` (the robot translates at the fixed orientation
+    ``theta``; ``robot`` holds the parts already rotated by it, relative to the
+    reference point) or ``"se2"`` (the robot also rotates; ``robot`` holds the parts
+    in the body frame, ``theta`` is 0, and start, goal and queries are poses
+    ``(x, y, theta)``). An empty ``robot`` is a point robot.
     """
 
     name: str
@@ -97,6 +104,13 @@ class Scenario:
     path: str | None = None
     robot_kind: str = "point"  # "point", "polygon", "parts" or "disk"
     disk_tolerance: float = DEFAULT_RELATIVE_ERROR
+    space: str = "translation"  # or "se2"
+    slabs: int | None = None  # SE(2): angle slabs of the sliced C-space (None: derived)
+
+    @property
+    def dim(self) -> int:
+        """Numbers in a state: 2 for translation, 3 for SE(2)."""
+        return 3 if self.space == "se2" else 2
 
     @property
     def is_point_robot(self) -> bool:
@@ -108,8 +122,13 @@ class Scenario:
         rest = [q for q in self.queries if (q.start, q.goal) != (main.start, main.goal)]
         return [main] + rest
 
-    def robot_at(self, x: float, y: float) -> list[np.ndarray]:
-        """The robot's part polygons with the reference point at (x, y)."""
+    def robot_at(self, x: float, y: float, theta: float = 0.0) -> list[np.ndarray]:
+        """The robot's part polygons with the reference point at (x, y), turned by theta
+        (in SE(2); a translating robot is already at its fixed orientation)."""
+        if theta:
+            from .slab import rotate
+
+            return [rotate(s.polygon, theta) + np.array([x, y]) for s in self.robot]
         return [s.polygon + np.array([x, y]) for s in self.robot]
 
 
@@ -117,8 +136,9 @@ class Scenario:
 # Loading
 
 
-def load_scenario(path) -> Scenario:
-    """Read and validate a TOML scenario file.
+def load_scenario(path, space: str | None = None) -> Scenario:
+    """Read and validate a TOML scenario file; ``space`` (``"translation"`` or ``"se2"``)
+    overrides the file's ``space`` (``--space`` on the command line).
 
     >>> import tempfile, os
     >>> d = tempfile.mkdtemp(); f = os.path.join(d, "s.toml")
@@ -139,7 +159,7 @@ def load_scenario(path) -> Scenario:
         raise ScenarioError(path, "file", "not UTF-8 text") from None
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
-    return scenario_from_dict(data, path)
+    return scenario_from_dict(data, path, space=space)
 
 
 # The scenes the C-space supports: products of two coordinates (or of two extents)
@@ -152,7 +172,7 @@ MIN_EXTENT = 2.0**-400
 
 # The keys a scenario may have at its top level (a new section adds its key here).
 TOP_LEVEL_KEYS = frozenset({"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal",
-                            "planner", "queries"})
+                            "planner", "queries", "space", "slabs"})
 # The forms of a robot table and of a shape (obstacle or robot part), by their keys: keys of two
 # different forms in one table exclude each other.
 ROBOT_FORMS = {"polygon": {"polygon"}, "parts": {"parts"}, "disk": {"radius"}}
@@ -173,8 +193,9 @@ def unknown_field_message(key: str, allowed) -> str:
     return f"unknown field (expected one of: {', '.join(sorted(allowed))})"
 
 
-def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
-    """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`."""
+def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None = None) -> Scenario:
+    """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`.
+    ``space``, if given, overrides the document's ``space``."""
     v = _Validator(path)
     v.no_extra(data, "", TOP_LEVEL_KEYS)
     name = data.get("name", os.path.splitext(os.path.basename(path))[0])
@@ -198,23 +219,42 @@ def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
                               f"2^-400 (about {MIN_EXTENT:.2g})")
     bounds = (xmin, xmax, ymin, ymax)
 
+    if space is not None and space not in SPACES:
+        raise ScenarioError("--space", "space", f"must be one of {', '.join(SPACES)}, got {_short(space)}")
+    space = space or data.get("space", "translation")
+    if space not in SPACES:
+        raise v.err("space", f"must be one of {', '.join(repr(s) for s in SPACES)}, got {_short(space)}")
+    slabs = data.get("slabs")
+    if slabs is not None:
+        if space != "se2":
+            raise v.err("slabs", 'applies to space = "se2" only')
+        if isinstance(slabs, bool) or not isinstance(slabs, int) or not 4 <= slabs <= MAX_SLABS:
+            raise v.err("slabs", f"must be an integer from 4 to {MAX_SLABS} (a slab spans at most a quarter "
+                                 f"turn), got {_short(slabs)}")
+    se2 = space == "se2"
+
     start_t = v.table(data, "start", required=True)
     goal_t = v.table(data, "goal", required=True)
     start, theta = v.pose(start_t, "start")
     goal, goal_theta = v.pose(goal_t, "goal")
-    if goal_theta is not None and theta is not None and goal_theta != theta:
-        raise v.err("goal.theta", "must equal start.theta (the robot translates at a fixed orientation)")
-    theta = theta if theta is not None else (goal_theta or 0.0)
+    if se2:  # angles as OMPL's SO(2) holds them: in [-pi, pi) (pi itself is -pi)
+        start, goal = (*start, wrap_angle(theta or 0.0)), (*goal, wrap_angle(goal_theta or 0.0))
+        theta = 0.0  # the robot stays in its body frame; poses carry the angle
+    else:
+        if goal_theta is not None and theta is not None and goal_theta != theta:
+            raise v.err("goal.theta", f"{goal_theta} differs from start.theta ({theta}), but the robot only "
+                                      'translates here: add space = "se2" to let it rotate')
+        theta = theta if theta is not None else (goal_theta or 0.0)
 
     robot, kind = v.robot(data.get("robot"), theta, tol)
     obstacles = v.obstacles(data.get("obstacles", []), tol)
     planner = v.planner(data.get("planner", {}))
-    queries = v.queries(data.get("queries", []))
+    queries = v.queries(data.get("queries", []), se2)
 
     sc = Scenario(
         name=name, bounds=bounds, robot=robot, obstacles=obstacles, start=start, goal=goal,
         theta=theta, planner=planner, queries=queries, expect=expect, path=path,
-        robot_kind=kind, disk_tolerance=tol,
+        robot_kind=kind, disk_tolerance=tol, space=space, slabs=slabs,
     )
     probe = CollisionProbe(sc)
     labelled = [(start, "start"), (goal, "goal")]
@@ -223,6 +263,17 @@ def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
     for pt, fld in labelled:
         v.placement(sc, probe, pt, fld)
     return sc
+
+
+# The state spaces a scenario can ask for, and the largest number of angle slabs.
+SPACES = ("translation", "se2")
+MAX_SLABS = 4096
+
+
+def _short(x, limit: int = 60) -> str:
+    """repr(x), cut to ``limit`` characters (messages stay one short line)."""
+    r = repr(x)
+    return r if len(r) <= limit else r[: limit - 3] + "..."
 
 
 class _Validator:
@@ -295,8 +346,6 @@ class _Validator:
         return arr
 
     def shape(self, t: dict, field: str, tol: float, allow_holes: bool) -> Shape:
-        import shapely
-
         if not isinstance(t, dict):
             raise self.err(field, "must be a table")
         if field == "robot":  # the robot table's forms are checked by robot()
@@ -310,28 +359,34 @@ class _Validator:
             if not isinstance(holes_raw, list):
                 raise self.err(f"{field}.holes", "must be a list of polygons")
             holes = [self.polygon(h, f"{field}.holes[{i}]") for i, h in enumerate(holes_raw)]
-            shell = shapely.Polygon(ext)
-            if not shell.is_valid:
-                raise self.err(f"{field}.polygon", f"not a simple polygon ({shapely.is_valid_reason(shell)})")
+            reason = invalid_reason(ext)  # GEOS's check, on a copy near 1 at extreme scales
+            if reason:
+                raise self.err(f"{field}.polygon", f"not a simple polygon ({reason})")
             ext_n = normalize(ext, ccw=True)
             if len(ext_n) < 3:  # exact: a float area underflows near 1e-160
                 raise self.err(f"{field}.polygon", "has zero area")
             holes_n = []
             for i, h in enumerate(holes):
                 holes_n.append(normalize(h, ccw=False))
-                if not shapely.Polygon(h).is_valid or len(holes_n[-1]) < 3:
+                if invalid_reason(h) or len(holes_n[-1]) < 3:
                     raise self.err(f"{field}.holes[{i}]", "not a simple polygon of non-zero area")
             if holes:
-                whole = shapely.Polygon(ext, holes)
-                if not whole.is_valid:
-                    raise self.err(f"{field}.holes", f"holes do not fit the polygon ({shapely.is_valid_reason(whole)})")
+                reason = invalid_reason(ext, holes)
+                if reason:
+                    raise self.err(f"{field}.holes", f"holes do not fit the polygon ({reason})")
             return Shape(ext_n, holes_n, None, convex=not holes_n and is_convex(ext_n))
         if "radius" in t:
             if field != "robot" and "center" not in t:
                 raise self.err(f"{field}.center", "missing (a disk needs center = [x, y] with its radius)")
             r = self.number(t.get("radius"), f"{field}.radius", positive=True)
             c = self.point(t.get("center", [0.0, 0.0] if field == "robot" else None), f"{field}.center")
-            return Shape(disk_polygon(c, r, max_error=tol * r), [], (c[0], c[1], r), convex=True)
+            poly = disk_polygon(c, r, max_error=tol * r)
+            # A disk far below the spacing of doubles at its centre rounds to a point or a
+            # segment, which the C-space cannot represent: refuse it rather than misplace it.
+            if r < 1e-6 * max(abs(c[0]), abs(c[1])) and len(normalize(poly)) < 3:
+                raise self.err(f"{field}.radius", f"{r} is too small for a disk centred at ({c[0]}, {c[1]}): "
+                                                  f"its polygon rounds to a point or a segment in doubles")
+            return Shape(poly, [], (c[0], c[1], r), convex=True)
         raise self.err(field, "needs polygon = [[x, y], ...] or center = [x, y] with radius = r")
 
     def robot(self, t, theta: float, tol: float) -> tuple[list[Shape], str]:
@@ -357,10 +412,10 @@ class _Validator:
         else:
             raise self.err("robot", "needs polygon, [[robot.parts]] or radius")
         if theta:
-            c, s = math.cos(theta), math.sin(theta)
-            rot = np.array([[c, s], [-s, c]])  # row vectors: p @ rot rotates by +theta
+            from .slab import rotate  # the one rotation used for "the robot at theta"
+
             for sh in shapes:
-                sh.polygon = sh.polygon @ rot
+                sh.polygon = rotate(sh.polygon, theta)
                 if sh.disk is not None:
                     sh.disk = (0.0, 0.0, sh.disk[2])
         return shapes, kind
@@ -387,7 +442,9 @@ class _Validator:
             out["seed"] = t["seed"]
         return out
 
-    def queries(self, lst) -> list[Query]:
+    def queries(self, lst, se2: bool = False) -> list[Query]:
+        """``start``/``goal`` as ``[x, y]`` or ``{x, y}``; in SE(2) ``[x, y, theta]`` or
+        ``{x, y, theta}`` (theta defaults to 0)."""
         if not isinstance(lst, list):
             raise self.err("queries", "must be an array of tables [[queries]]")
         out = []
@@ -398,26 +455,40 @@ class _Validator:
             self.no_extra(q, f, {"start", "goal"})
             pts = []
             for key in ("start", "goal"):
-                p = q.get(key)
+                p, fk = q.get(key), f"{f}.{key}"
                 if isinstance(p, dict):
-                    self.no_extra(p, f"{f}.{key}", {"x", "y"})
-                    pts.append((self.number(p.get("x"), f"{f}.{key}.x"), self.number(p.get("y"), f"{f}.{key}.y")))
+                    xy, th = self.pose(p, fk)
+                    if th is not None and not se2:
+                        raise self.err(f"{fk}.theta", 'the robot only translates here: add space = "se2" to give '
+                                                      "queries an angle")
+                    pts.append((*xy, wrap_angle(th or 0.0)) if se2 else xy)
                 elif p is None:
-                    raise self.err(f"{f}.{key}", "missing")
+                    raise self.err(fk, "missing")
+                elif se2 and isinstance(p, list) and len(p) == 3:
+                    pts.append((*self.point(p[:2], fk), wrap_angle(self.number(p[2], f"{fk}[2]"))))
+                elif not se2 and isinstance(p, list) and len(p) == 3:
+                    raise self.err(fk, 'has an angle, but the robot only translates here: add space = "se2" '
+                                       "to let it rotate")
                 else:
-                    pts.append(self.point(p, f"{f}.{key}"))
+                    if se2 and not (isinstance(p, list) and len(p) == 2):
+                        raise self.err(fk, f"must be a pose [x, y, theta] (or [x, y]), got {_short(p)}")
+                    xy = self.point(p, fk)
+                    pts.append((*xy, 0.0) if se2 else xy)
             out.append(Query(pts[0], pts[1]))
         return out
 
-    def placement(self, sc: Scenario, probe: "CollisionProbe", pt: tuple[float, float], field: str) -> None:
-        """The reference point must be in bounds and the robot there must touch no obstacle."""
+    def placement(self, sc: Scenario, probe: "CollisionProbe", pt: tuple, field: str) -> None:
+        """The reference point must be in bounds and the robot there (turned by the
+        pose's theta in SE(2)) must touch no obstacle."""
         xmin, xmax, ymin, ymax = sc.bounds
-        x, y = pt
+        x, y = pt[0], pt[1]
+        theta = pt[2] if len(pt) > 2 else 0.0
+        where = f"({x}, {y})" if len(pt) == 2 else f"({x}, {y}, theta {theta})"
         if not (xmin <= x <= xmax and ymin <= y <= ymax):
-            raise self.err(field, f"({x}, {y}) is outside the bounds [{xmin}, {xmax}] x [{ymin}, {ymax}]")
-        hit = probe.first_hit(x, y)
+            raise self.err(field, f"{where} is outside the bounds [{xmin}, {xmax}] x [{ymin}, {ymax}]")
+        hit = probe.first_hit(x, y, theta)
         if hit is not None:
-            raise self.err(field, f"({x}, {y}) puts the robot in collision with obstacles[{hit}]")
+            raise self.err(field, f"{where} puts the robot in collision with obstacles[{hit}]")
 
 
 class CollisionProbe:
@@ -435,12 +506,12 @@ class CollisionProbe:
         self._geoms = [ob.to_shapely() for ob in sc.obstacles]
         self._tree = shapely.STRtree(self._geoms) if self._geoms else None
 
-    def first_hit(self, x: float, y: float) -> int | None:
+    def first_hit(self, x: float, y: float, theta: float = 0.0) -> int | None:
         shapely = self._shapely
         if self._tree is None:
             return None
         if self._sc.robot:
-            body = shapely.union_all([shapely.Polygon(p) for p in self._sc.robot_at(x, y)])
+            body = shapely.union_all([shapely.Polygon(p) for p in self._sc.robot_at(x, y, theta)])
         else:
             body = shapely.Point(x, y)
         hits = self._tree.query(body, predicate="intersects")

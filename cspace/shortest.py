@@ -31,6 +31,7 @@ import heapq
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -72,16 +73,25 @@ def _orient(geom):
     return shapely.MultiPolygon(parts) if len(parts) != 1 else parts[0]
 
 
-def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = None) -> ShortestPath:
+def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = None,
+                  on_progress: Callable[[int, int, float], None] | None = None) -> ShortestPath:
     """The shortest path from start to goal through the free C-space.
 
     ``time_limit`` (seconds) bounds the search: past it the result is unsolved with
     ``stats["reason"] == "time limit"`` (never a silent wrong answer, never a hang).
+    ``on_progress(settled, nodes, bound)``, when given, is called every
+    :data:`PROGRESS_EVERY` settled nodes and once at the end: nodes settled so far,
+    nodes of the graph, and a lower bound on the shortest length (the f value of the
+    last settled node, which never decreases with a consistent heuristic).
 
     >>> sq = np.array([[1., 0], [2, 0], [2, 2], [1, 2]])
     >>> sp = shortest_path([sq], (0, 3, 0, 3), (0, 1), (3, 1))
     >>> sp.solved, round(sp.length, 12), sp.path.tolist()
     (True, 3.828427124746, [[0.0, 1.0], [1.0, 2.0], [2.0, 2.0], [3.0, 1.0]])
+    >>> calls = []
+    >>> _ = shortest_path([sq], (0, 3, 0, 3), (0, 1), (3, 1), on_progress=lambda *a: calls.append(a))
+    >>> calls[-1][:2], round(calls[-1][2], 12)  # all 4 nodes settled; the bound reached the length
+    ((4, 4), 3.828427124746)
     """
     import shapely
 
@@ -109,7 +119,7 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
     nodes, tangent_dirs = _reflex_vertices(region)
     pts = np.array([s, g] + nodes, dtype=np.float64).reshape(-1, 2)
     deadline = None if time_limit is None else t0 + float(time_limit)
-    path, length, counts = _lazy_astar(pts, tangent_dirs, region, deadline)
+    path, length, counts = _lazy_astar(pts, tangent_dirs, region, deadline, on_progress)
     stats["counts"].update(counts, nodes=len(pts))
     stats["time"] = time.perf_counter() - t0
     if path is None:  # cannot happen for a connected region; reported, never hidden
@@ -143,7 +153,11 @@ def _reflex_vertices(region) -> tuple[list, list]:
     return nodes, nbrs
 
 
-def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None) -> tuple:
+PROGRESS_EVERY = 64  # settled nodes between two progress reports
+
+
+def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None,
+                on_progress: Callable[[int, int, float], None] | None = None) -> tuple:
     """A* from node 0 to node 1 over bitangent candidate edges, each checked when popped."""
     import shapely
 
@@ -160,6 +174,8 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
     na = np.array([x[0] for x in nbrs]).reshape(-1, 2)
     nb = np.array([x[1] for x in nbrs]).reshape(-1, 2)
     stopped = None
+    settled = 0
+    bound = float(h[0])
     while heap:
         if deadline is not None and time.perf_counter() > deadline:
             stopped = "time limit"
@@ -175,6 +191,10 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
         closed[v] = True
         g_best[v] = gv
         parent[v] = par
+        settled += 1
+        bound = f
+        if on_progress is not None and settled % PROGRESS_EVERY == 0:
+            on_progress(settled, n, bound)
         if v == 1:
             break
         cand = np.flatnonzero(~closed)
@@ -188,6 +208,8 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
         for fw, gw_, w in zip((gw + h[cand[keep]]).tolist(), gw.tolist(), cand[keep].tolist()):
             heapq.heappush(heap, (fw, gw_, w, v))
         pushed += int(keep.sum())
+    if on_progress is not None:
+        on_progress(settled, n, bound)
     counts = {"edges_tested": tested, "edges_pushed": pushed}
     if stopped:
         counts["stopped"] = stopped

@@ -9,7 +9,8 @@ from .output import PLOT_FORMATS, check_output, write_json
 
 def register(sub) -> None:
     p = sub.add_parser("plan", help="plan a collision-free path for a scenario",
-                       description="Plan a path for a translating robot; exit 0 solved, 1 not solved, 2 bad input.")
+                       description="Plan a path for a translating (or, with --space se2, rotating) robot; "
+                                   "exit 0 solved, 1 not solved, 2 bad input.")
     p.add_argument("scenario", help="scenario TOML file")
     p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, else RRTConnect")
     p.add_argument("--time", type=number, help="time limit in seconds; default: the scenario's, else 1")
@@ -17,10 +18,21 @@ def register(sub) -> None:
     p.add_argument("--iterations", type=integer, help="also stop after this many planner iterations (deterministic budget)")
     p.add_argument("--all-queries", action="store_true", help="plan every [[queries]] entry on one C-space")
     p.add_argument("--no-simplify", action="store_true", help="keep the planner's raw path")
+    add_space_options(p)
     p.add_argument("--plot", help="save a picture of the path (.png, .svg or .pdf)")
+    p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
     p.add_argument("--json", help="write the result as JSON")
     p.add_argument("--verbose", "-v", action="store_true", help="print the C-space report and OMPL's messages")
     p.set_defaults(run=run)
+
+
+def add_space_options(p) -> None:
+    """``--space`` and ``--slabs`` (plan, show and bench share them)."""
+    p.add_argument("--space", choices=("translation", "se2"),
+                   help="state space: translation (the robot keeps its angle) or se2 (it also rotates); "
+                        "default: the scenario's, else translation")
+    p.add_argument("--slabs", type=integer, help="SE(2): angle slabs of the sliced C-space (default: derived "
+                                                 "from the robot and the scene)")
 
 
 def number(s: str) -> float:
@@ -41,6 +53,8 @@ def run(args) -> int:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
+    if args.slabs is not None and not 4 <= args.slabs <= 4096:
+        raise InputError(src, "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     from .ompl_glue import MAX_TIME, SEED_LIMIT, planner_name
 
     if args.time is not None and args.time > MAX_TIME:
@@ -57,6 +71,8 @@ def run(args) -> int:
                          f"({OMPL_HINT})\n")
         args.planner = "exact"
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS) if args.plot else None
+    if args.animate:
+        check_output(args.animate, "--animate", {".gif": "gif"})
     if args.json:
         check_output(args.json, "--json")
     from .plan import plan
@@ -66,7 +82,8 @@ def run(args) -> int:
 
         ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
     res = plan(src, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
-               simplify=not args.no_simplify, all_queries=args.all_queries)
+               simplify=not args.no_simplify, all_queries=args.all_queries,
+               space=args.space, slabs=args.slabs)
     print(summary(res, verbose=args.verbose))
     if args.json:
         write_json(args.json, res.as_dict())
@@ -74,6 +91,12 @@ def run(args) -> int:
         from .plot import plot_result
 
         plot_result(res, args.plot, fmt=fmt)
+    if args.animate and res.solved:
+        from .animate import animate_path
+
+        animate_path(res, args.animate)
+    elif args.animate:
+        sys.stderr.write(f"note: --animate {args.animate}: nothing to animate (not solved)\n")
     results = res.queries or [res]
     return 0 if all(r.solved for r in results) else 1
 

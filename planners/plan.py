@@ -93,12 +93,18 @@ MAX_TIME = 1e8  # seconds (about three years); OMPL's steady clock overflows nea
 SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit
 
 
-def _resolve(scenario, planner, time_limit, seed, iterations=None):
+def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
     """Scenario object plus the effective planner, time and seed (arguments over file defaults)."""
     from .ompl_glue import planner_name
 
     t0 = time.perf_counter()
-    sc = scenario if isinstance(scenario, Scenario) else load_scenario(os.fspath(scenario))
+    if isinstance(scenario, Scenario):
+        sc = scenario
+        if space is not None and space != sc.space:
+            raise ScenarioError("plan()", "space", f"the scenario was loaded as {sc.space!r}; load it with "
+                                                   f"load_scenario(path, space={space!r}) or pass its path")
+    else:
+        sc = load_scenario(os.fspath(scenario), space=space)
     load_s = time.perf_counter() - t0
     src = sc.path or "<scenario>"
     opts = sc.planner
@@ -126,7 +132,8 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None):
 
 def plan(scenario, planner: str | None = None, time: float | None = None, seed: int | None = None,
          *, simplify: bool = True, iterations: int | None = None, cspace: CSpace | None = None,
-         all_queries: bool = False, slices: bool = False, on_progress=None) -> PlanResult:
+         all_queries: bool = False, slices: bool = False, on_progress=None, space: str | None = None,
+         slabs: int | None = None) -> PlanResult:
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
@@ -138,14 +145,22 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     ``cspace`` reuses a C-space built from the same scenario. ``slices`` and
     ``on_progress`` are the bench's hooks (see :func:`run_planner`).
 
+    ``space="se2"`` (or ``space = "se2"`` in the file) lets the robot rotate: poses and
+    the path's rows are (x, y, theta), the C-space is the sliced
+    :class:`cspace.se2.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
+    derived from the scene) and every motion is certified along OMPL's SE(2)
+    interpolation. There is no exact planner in SE(2); ``planner="exact"`` there
+    answers only when the inscribed-disk rule proves the scene unsolvable.
+
     >>> import os
     >>> res = plan(os.path.join(os.path.dirname(__file__), "..", "scenarios", "basic.toml"), seed=3)
     >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
     (True, [1.0, 1.0], [9.0, 9.0])
     """
-    from .spaces import TranslationSpace
-
-    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations)
+    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space)
+    se2 = sc.space == "se2"
+    if slabs is not None and not se2:
+        raise ScenarioError("plan()", "slabs", 'applies to space = "se2" only')
     if name != "exact":
         from .ompl_glue import ompl
 
@@ -153,34 +168,40 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     wall0 = _now()
     if cspace is None:
         t0 = _now()
-        cspace = CSpace.from_scenario(sc)
+        cspace = _build_cspace(sc, slabs)
         build_s = _now() - t0
     else:
         build_s = 0.0
     report = cspace.report()
-    space = TranslationSpace(cspace)
+    adapter = _adapter(sc, cspace)
     queries = sc.all_queries() if all_queries else sc.all_queries()[:1]
     src = sc.path or "<scenario>"
     poses = []
     for i, q in enumerate(queries):
-        pair = (space.pose(q.start), space.pose(q.goal))
+        pair = (adapter.pose(q.start), adapter.pose(q.goal))
         for pt, fld in zip(pair, ("start", "goal")):
-            if not space.is_free(pt):
+            if not adapter.is_free(pt):
                 label = fld if i == 0 else f"queries[{i - 1}].{fld}"
-                raise ScenarioError(src, label, f"({pt[0]}, {pt[1]}) is not a free state of the C-space")
+                raise ScenarioError(src, label, f"{pt} is not a free state of the C-space")
         poses.append(pair)
-    if name == "exact":
+    if name == "exact" and se2:
+        from .exact import exact_se2
+
+        results = [exact_se2(sc, q, src, time_limit=tlim) for q in queries]
+    elif name == "exact":
         from .exact import exact_plan
 
         results = [exact_plan(sc, cspace, q, time_limit=tlim) for q in queries]
     else:
         from .routine import run_planner
 
-        results = run_planner(space, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
+        results = run_planner(adapter, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
                               slices=slices, on_progress=on_progress, scenario=sc.name)
+        if se2:
+            _explain_se2_failures(sc, queries, results)
     for r in results:
         r.timings = {"load": load_s, "cspace": build_s, **r.timings}
-        r.stages = [s["stage"] for s in report["stages"] if s["ran"]] + r.stages
+        r.stages = _stage_names(report) + r.stages
         r.cspace_report = report
     first = results[0]
     first.timings["total"] = load_s + (_now() - wall0)
@@ -194,6 +215,46 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
 
 def _now() -> float:
     return time.perf_counter()
+
+
+def _stage_names(report: dict) -> list[str]:
+    """The C-space stages that ran (a sliced SE(2) C-space builds its slabs lazily, later)."""
+    if "stages" in report:
+        return [s["stage"] for s in report["stages"] if s["ran"]]
+    return ["decompose", f"slabs (K = {report['slabs']}, lazy)"]
+
+
+def _build_cspace(sc: Scenario, slabs: int | None = None):
+    """The C-space a scenario's state space needs: translation, or sliced SE(2)."""
+    if sc.space == "se2":
+        from cspace.se2 import SE2CSpace
+
+        return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)
+    return CSpace.from_scenario(sc)
+
+
+def _adapter(sc: Scenario, cspace):
+    """The state-space adapter of :mod:`planners.spaces` for the scenario's space."""
+    if sc.space == "se2":
+        from .space_se2 import SE2Space
+
+        return SE2Space(cspace)
+    from .spaces import TranslationSpace
+
+    return TranslationSpace(cspace)
+
+
+def _explain_se2_failures(sc: Scenario, queries, results) -> None:
+    """A rotating robot's plan that failed: does the inscribed-disk rule prove it unsolvable?"""
+    from .se2_bounds import disk_bound
+
+    for q, r in zip(queries, results):
+        if not r.solved:
+            t = _now()
+            db = disk_bound(sc, q, time_limit=5.0)
+            r.timings["disk_bound"] = _now() - t
+            if db.proven_unsolvable:
+                r.message = db.message
 
 
 def run_planner(*args, **kwargs):

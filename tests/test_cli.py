@@ -206,3 +206,20 @@ def test_bare_command_lists_the_commands_and_exits_0():
     for name in COMMANDS:
         assert f"\n    {name} " in r.stdout or f"\n    {name}\n" in r.stdout, name
     assert "--version" in r.stdout
+
+
+def test_a_disk_below_the_ulp_of_its_centre_is_refused_in_one_line(write_toml):
+    # Radius 1e-200 at (5, 5): the disk rounds to the point (5, 5). Its C-obstacle used to
+    # be placed at the origin (a point operand dropped by the vectorised sum, a false
+    # "free" at (5, 5)) and the broad phase printed a RuntimeWarning about the piece's
+    # zero-length edges. Such a disk cannot be represented: bad input, exit 2.
+    text = BASIC.replace("[[obstacles]]\npolygon = [[4, 0], [6, 0], [6, 7], [4, 7]]",
+                         "[[obstacles]]\ncenter = [5, 5]\nradius = 1e-200")
+    r = cspace("plan", write_toml(text), "--planner", "exact")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "obstacles[0].radius: 1e-200 is too small for a disk centred at (5.0, 5.0)" in r.stderr
+    # Small but representable, and a tiny disk robot (centred on the origin): planned, quietly.
+    r = cspace("plan", write_toml(text.replace("radius = 1e-200", "radius = 1e-12")
+                                  .replace("[robot]\npolygon = [[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]]",
+                                           "[robot]\nradius = 1e-200")), "--planner", "exact")
+    assert r.returncode == 0 and r.stderr == "", r.stderr

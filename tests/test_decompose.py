@@ -96,8 +96,8 @@ def test_small_hole_of_the_sum_survives():
     ring = shapely.Polygon([[0, 0], [10, 0], [10, 10], [0, 10]], [[[3, 3], [3, 7], [7, 7], [7, 3]]])
     sq = np.array([[0.0, 0.0], [3.9, 0.0], [3.9, 3.9], [0.0, 3.9]]) - 1.95
     got = minkowski_sum_nonconvex(ring, sq)
-    assert got.geom_type == "Polygon" and len(got.interiors) == 1
-    assert shapely.Polygon(got.interiors[0]).area == pytest.approx(0.01, rel=1e-9)
+    assert got.geom_type == "MultiPolygon" and len(got.geoms) == 1 and len(got.geoms[0].interiors) == 1
+    assert shapely.Polygon(got.geoms[0].interiors[0]).area == pytest.approx(0.01, rel=1e-9)
 
 
 def test_pieces_are_pairwise_sums():
@@ -106,3 +106,51 @@ def test_pieces_are_pairwise_sums():
     pieces = minkowski_pieces(L, tri)
     assert len(pieces) == 2
     assert sorted(map(len, pieces)) == sorted(len(minkowski_sum(p, tri)) for p in convex_decompose(L))
+
+
+# One return type, MultiPolygon operands, and bad operands refused before GEOS.
+SQ1 = [[0, 0], [1, 0], [1, 1], [0, 1]]
+
+
+@pytest.mark.parametrize("A, B, parts", [
+    (SQ1, SQ1, 1),                                                   # convex: pairwise route
+    ([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], SQ1, 1),      # convolution route
+    (shapely.MultiPolygon([shapely.box(0, 0, 1, 1), shapely.box(5, 0, 6, 1)]), SQ1, 2),
+    (shapely.MultiPolygon([shapely.box(0, 0, 1, 1), shapely.box(1.5, 0, 2.5, 1)]), SQ1, 1),  # parts merge
+    ([[0, 0], [1, 0]], [[0, 0], [2, 0]], 0),                         # two parallel segments: no area
+    ([[0, 0], [1, 0]], [[0, 0], [0, 2]], 1),                         # two segments: a parallelogram
+])
+def test_nonconvex_sum_is_always_a_multipolygon(A, B, parts):
+    got = minkowski_sum_nonconvex(A, B)
+    assert got.geom_type == "MultiPolygon" and len(got.geoms) == parts
+    # Oracle: the union of the sums of shapely's parts, by brute force (convex hull of the
+    # vertex sums of each triangle pair would do; here the operands are convex or an L).
+    ga = A if hasattr(A, "geom_type") else shapely.Polygon(A) if len(A) > 2 else shapely.LineString(A)
+    gb = B if hasattr(B, "geom_type") else shapely.Polygon(B) if len(B) > 2 else shapely.LineString(B)
+    if parts:
+        ref = reference_sum(ga, gb) if ga.geom_type != "LineString" else shapely.MultiPoint(
+            [(p[0] + q[0], p[1] + q[1]) for p in ga.coords for q in gb.coords]).convex_hull
+        assert got.symmetric_difference(ref).area <= 1e-12 * ref.area
+
+
+def test_multipolygon_operand_equals_the_union_of_its_parts_sums():
+    a1, a2 = shapely.Polygon([[0, 0], [3, 0], [3, 1], [1, 1], [1, 3], [0, 3]]), shapely.box(6, 6, 7, 9)
+    B = [[0, 0], [1, 0], [1, 2], [0.5, 0.5], [0, 2]]
+    got = minkowski_sum_nonconvex(shapely.MultiPolygon([a1, a2]), B)
+    want = shapely.union_all([minkowski_sum_nonconvex(a1, B), minkowski_sum_nonconvex(a2, B)])
+    assert got.symmetric_difference(want).area <= 1e-12 * want.area and len(got.geoms) == 2
+
+
+@pytest.mark.parametrize("A, match", [
+    ([[0, 0], [2, 2], [2, 0], [0, 2]], r"A is not a simple polygon \(Self-intersection"),
+    ([[0, 0], [np.nan, 0], [1, 1]], "finite"),
+    (shapely.LineString([(0, 0), (1, 1)]), "not a \\(Multi\\)Polygon"),
+])
+def test_bad_nonconvex_operands_raise_value_error_without_geos_noise(A, match, capfd):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=match):
+            minkowski_sum_nonconvex(A, SQ1)
+    assert capfd.readouterr() == ("", "")

@@ -13,6 +13,8 @@ docs/guide.md works as shown.
   listed in ``SKIP`` (and, unless ``CSPACE_DOCS_SLOW=1``, in ``SLOW``) are not run, each with its
   reason; a command that is neither run nor listed fails the test, so new sections are picked up.
   Usage synopses (``cspace plan SCENARIO [--planner NAME] ...``) are ```text blocks, not commands.
+* Every ```python block of the README that starts with ``import`` (a whole program, not a listing
+  of signatures) runs from the repository root (docs/guide.md's run in tests/test_guide.py).
 * Every inline `cspace ...` / `python scripts/... ` span names a subcommand or script that exists,
   and each option it shows is one its ``--help`` offers.
 """
@@ -190,3 +192,14 @@ def _help(argv: tuple) -> str:
     proc = subprocess.run(list(argv) + ["--help"], capture_output=True, text=True, timeout=60, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     return proc.stdout
+
+
+README_PYTHON = [(d, n, b) for d, n, b in _blocks("python") if d == "README.md" and b.startswith("import")]
+
+
+@pytest.mark.parametrize("doc, line, body", README_PYTHON, ids=[f"{d}:{n}" for d, n, _ in README_PYTHON])
+def test_readme_python_programs_run(doc, line, body, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    env: dict = {}
+    exec(compile(body, f"{doc}:{line}", "exec"), env)
+    assert env["res"].solved and env["cs"].is_free([(1, 1), (2.7, 3)]).tolist() == [True, False]

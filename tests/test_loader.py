@@ -194,3 +194,13 @@ def test_the_known_keys_are_one_set_to_extend(write_toml, monkeypatch):
     monkeypatch.setattr(scenario, "TOP_LEVEL_KEYS", scenario.TOP_LEVEL_KEYS | {"space"})
     with pytest.raises(ScenarioError, match=r"spcae: unknown field \(did you mean space\?\)"):
         load_scenario(path)
+
+
+def test_validity_is_checked_at_a_scale_geos_can_compute(write_toml):
+    # GEOS's own arithmetic underflows on a triangle 1e-300 wide and called it
+    # self-intersecting; the check now runs on an exact power-of-two copy near 1.
+    sc = load_scenario(write_toml(BASE + "[robot]\npolygon = [[0, 0], [1e-300, 0], [0, 1e-300]]\n"))
+    assert sc.robot[0].polygon.shape == (3, 2)
+    bow = "[[0, 0], [2e-300, 2e-300], [2e-300, 0], [0, 2e-300]]"
+    with pytest.raises(ScenarioError, match=r"robot.polygon: not a simple polygon \(Self-intersection"):
+        load_scenario(write_toml(BASE + f"[robot]\npolygon = {bow}\n"))

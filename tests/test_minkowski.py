@@ -337,3 +337,23 @@ def test_vectorised_route_finds_the_leftmost_of_a_flat_bottom(reverse, shift):
     assert S.tolist() == [list(v) for v in _scalar_reference(P, Q)]
     assert as_fr(S) == exact_sum(P, Q)
     assert S[0].tolist() == (P[np.lexsort((P[:, 0], P[:, 1]))[0]] + Q[0]).tolist()
+
+
+@pytest.mark.parametrize("n", [3, 40, 200])
+@pytest.mark.parametrize("scale", [1.0, 1e-5, 1e-200])
+def test_a_point_given_as_many_equal_vertices_translates_a_large_operand(n, scale):
+    # A disk of radius 1e-200 at (5, 5) rounds to n copies of (5, 5). The vectorised float
+    # route used to drop a point operand from every vertex but the first: the sum of
+    # (5, 5) and a 71-gon came out at the origin. Oracle: Q + (5, 5), vertex for vertex
+    # (each a single rounded addition, which the sum's certification keeps).
+    t = np.linspace(0.0, 2 * np.pi, 72)[:-1]
+    Q = np.column_stack([np.cos(t), np.sin(t)]) * scale
+    for P in (np.full((n, 2), 5.0), np.array([[5.0, 5.0]])):
+        got = minkowski_sum(P, Q)
+        want = lowest_first(Q + 5.0)
+        if scale < 1e-100:  # 5 + 1e-200 rounds to 5: the sum is the point itself
+            want = np.array([[5.0, 5.0]])
+        assert got.shape == want.shape and np.array_equal(got, want), (n, scale)
+    # Several operands, two of them points.
+    got = minkowski_sum(np.full((n, 2), 5.0), Q, np.full((30, 2), 1.0), [[0.5, 0.25]])
+    assert np.allclose(got.mean(axis=0), (6.5, 6.25), rtol=0, atol=1e-12)
