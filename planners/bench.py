@@ -6,9 +6,10 @@ recorded as ``crashed`` or ``timeout``, never the sweep): locally a forked child
 process, which built each scenario's C-space once (:mod:`planners.bench_pool`, at most
 ``--workers`` at a time), a fresh process where fork is missing, or on a Dask cluster
 (``--scheduler``). Each run calls :func:`planners.plan.plan`, as ``cspace plan`` does.
-It also owns the outputs: ``results.csv``, ``results.json``, one OMPL benchmark log per
-(scenario, budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns
-them into the Planner Arena database) and the ``error_vs_time.png`` figure.
+Its outputs: ``results.csv``, ``results.json`` and one OMPL benchmark log per (scenario,
+budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns them into the
+Planner Arena database) are written by :mod:`planners.bench_outputs`; the
+``error_vs_time.png`` figure is drawn here.
 
 The reference is the exact shortest path (:mod:`cspace.shortest`), computed once per
 scenario in the parent. It is an infimum (it touches C-obstacle boundaries), so every
@@ -21,14 +22,8 @@ their first solution are).
 """
 from __future__ import annotations
 
-import contextlib
-import csv
-import io
-import json
 import math
 import os
-import socket
-import subprocess
 import sys
 import threading
 import time
@@ -175,44 +170,9 @@ def run(args) -> int:
     return 130 if interrupted else 0
 
 
-def _write_deferring_sigint(rows, out, meta, plot) -> bool:
-    """Write the outputs with Ctrl-C held until they are consistent; True if it came.
-
-    results.json is written last; if Ctrl-C came meanwhile it is written again with
-    ``"complete": false`` (a figure or a log may be missing), never ``true``.
-    """
-    import signal
-
-    hit = []
-    try:
-        prev = signal.signal(signal.SIGINT, lambda *_: hit.append(1))
-    except ValueError:  # not the main thread: no handler to swap
-        prev = None
-    try:
-        write_outputs(rows, out, meta, plot=plot, stop=lambda: bool(hit))
-        if hit:
-            write_outputs(rows, out, {**meta, "complete": False}, plot=False, only_json=True)
-    finally:
-        if prev is not None:
-            signal.signal(signal.SIGINT, prev)
-    return bool(hit)
-
-
-OUTPUTS = ("results.json", "results.csv", "error_vs_time.png")
-
-
-def _clear_outputs(out: str) -> None:
-    """Remove an earlier sweep's outputs from ``out`` (our own file names only)."""
-    for name in OUTPUTS:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(os.path.join(out, name))
-    logs = os.path.join(out, "ompl")
-    if os.path.isdir(logs):
-        for name in os.listdir(logs):
-            if name.endswith(".log"):
-                with contextlib.suppress(FileNotFoundError):
-                    os.remove(os.path.join(logs, name))
-
+from .bench_outputs import (  # noqa: E402,F401  (the outputs live there; re-exported)
+    OUTPUTS, _clear_outputs, _write_deferring_sigint, ompl_logs, to_csv, write_outputs,
+)
 
 # ---------------------------------------------------------------- the reference
 
@@ -332,22 +292,6 @@ def _error(length, optimum):
     return length / optimum - 1.0
 
 
-def _child_main() -> None:  # pragma: no cover - runs in the child process
-    """Entry of a child process: task JSON on stdin, one marked row line on stdout."""
-    import signal
-
-    task = json.loads(sys.stdin.read())
-    if hasattr(signal, "alarm"):  # a backstop only: the parent kills us at the hard limit
-        signal.alarm(int(task["hard_limit"]) + 5)
-    try:
-        row = run_one(task)
-    except Exception as exc:  # a Python error in the run: recorded, the sweep goes on
-        row = {"status": "crashed", "message": f"{type(exc).__name__}: {exc}"}
-    sys.stdout.write(_MARK + json.dumps(row) + "\n")
-    sys.stdout.flush()
-    os._exit(0)  # skip the bindings' "nanobind: leaked" report at exit
-
-
 # ---------------------------------------------------------------- one run (isolated)
 
 _live: set = set()  # child processes running now, killed on Ctrl-C
@@ -364,44 +308,10 @@ def hard_limit(budget: float) -> float:
 
 
 def isolated_run(task: dict, limit: float | None = None) -> dict | None:
-    """Run one task in a fresh child process; the row records ``ok``, ``crashed`` or ``timeout``.
+    """Run one task in a fresh process (see :func:`planners.bench_pool.isolated_run`)."""
+    from .bench_pool import isolated_run as run
 
-    A child that dies by a signal, exits without a row or raises is ``crashed``; one
-    still running after ``limit`` seconds (default :func:`hard_limit`) is killed and is
-    ``timeout``. Returns None if the sweep was interrupted meanwhile.
-    """
-    limit = hard_limit(task["time_budget"]) if limit is None else limit
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
-    t0 = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-c", "from planners.bench import _child_main; _child_main()"],
-                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            env=env, start_new_session=True, text=True)
-    _live.add(proc)
-    try:
-        out, err = proc.communicate(json.dumps({**task, "hard_limit": limit}), timeout=limit)
-        status = None
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        out, err = proc.communicate()
-        status = "timeout"
-    finally:
-        _live.discard(proc)
-    if _stop.is_set():
-        return None
-    wall = time.perf_counter() - t0
-    row = None
-    for line in (out or "").splitlines():
-        if line.startswith(_MARK):
-            row = json.loads(line[len(_MARK):])
-    if status == "timeout":
-        row = {"status": "timeout", "message": f"killed after {limit:g} s"}
-    elif row is None:
-        code = proc.returncode
-        how = f"signal {-code}" if code < 0 else f"exit code {code}"
-        tail = (err or "").strip().splitlines()
-        row = {"status": "crashed", "message": f"child died ({how})" + (f": {tail[-1][:200]}" if tail else "")}
-    return _complete(task, row, wall)
+    return run(task, limit)
 
 
 def _complete(task: dict, row: dict, wall: float) -> dict:
@@ -529,161 +439,6 @@ class _Progress:
     def close(self) -> None:
         if self.tty:
             sys.stderr.write("\n")
-
-
-# ---------------------------------------------------------------- outputs
-
-def write_outputs(rows: list[dict], out: str, meta: dict, plot: bool = True, stop=None,
-                  only_json: bool = False) -> None:
-    """Write results.csv, the OMPL logs, (optionally) the figure and results.json, each atomically.
-
-    results.json comes last: its ``complete`` is the sweep's word on everything else.
-    ``stop()`` true (Ctrl-C came) skips what is left before it.
-    """
-    from .output import write_json, write_text
-
-    stop = stop or (lambda: False)
-    if not only_json:
-        write_text(os.path.join(out, "results.csv"), to_csv(rows))
-        logs = os.path.join(out, "ompl")
-        os.makedirs(logs, exist_ok=True)
-        for name, text in ompl_logs(rows, meta).items():
-            if not stop():
-                write_text(os.path.join(logs, name), text)
-        if plot and rows and not stop():
-            plot_error_vs_time(rows, os.path.join(out, "error_vs_time.png"))
-    if stop():
-        meta = {**meta, "complete": False}
-    write_json(os.path.join(out, "results.json"), {"meta": _clean(meta), "fields": list(FIELDS),
-                                                   "rows": [_clean(r) for r in rows]})
-
-
-def _clean(x):
-    """JSON-safe copy: non-finite floats become None."""
-    if isinstance(x, float):
-        return x if math.isfinite(x) else None
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    return x
-
-
-def to_csv(rows: list[dict]) -> str:
-    """The rows as CSV text with the :data:`FIELDS` header (missing values empty).
-
-    >>> to_csv([]).strip() == ",".join(FIELDS)
-    True
-    """
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(FIELDS)
-    for r in rows:
-        w.writerow(["" if r.get(f) is None else (repr(r[f]) if isinstance(r[f], float) else r[f]) for f in FIELDS])
-    return buf.getvalue()
-
-
-# OMPL's benchmark log (the format ompl_benchmark_statistics.py parses): one
-# experiment per file, so one file per (scenario, time budget).
-_ENUM = ("status|Unknown status|Invalid start|Invalid goal|Unrecognized goal type|Timeout|"
-         "Approximate solution|Exact solution|Crash|Abort|Infeasible")
-_RUN_PROPS = (
-    ("time", "REAL", "solve_s"), ("solved", "BOOLEAN", "solved"), ("status", "ENUM", None),
-    ("correct solution", "BOOLEAN", "solved"), ("solution length", "REAL", "length_unsimplified"),
-    ("simplified solution length", "REAL", "length"), ("simplification time", "REAL", "simplify_s"),
-    ("optimum", "REAL", "optimum"), ("error", "REAL", "error"), ("first solution time", "REAL", "first_solution_s"),
-    ("state checks", "INTEGER", "state_checks"), ("motion checks", "INTEGER", "motion_checks"),
-    ("seed", "INTEGER", "seed"), ("wall time", "REAL", "wall_s"),
-)
-
-
-def _status_code(row: dict) -> int:
-    """Index into the status enum: exact solution, timeout, crash or abort (killed)."""
-    if row["status"] == "crashed":
-        return 7
-    if row["status"] == "timeout":
-        return 8
-    return 6 if row["solved"] else 4
-
-
-def _val(v) -> str:
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "nan"
-    if isinstance(v, bool):
-        return str(int(v))
-    return repr(v) if isinstance(v, float) else str(v)
-
-
-def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
-    """OMPL benchmark logs ``{file name: text}``, one per (scenario, time budget).
-
-    Planners appear as ``geometric_NAME``; the runs table gets the columns of
-    ``_RUN_PROPS``; anytime runs add a progress table (time, best raw cost).
-    """
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        ver = version("ompl")
-    except PackageNotFoundError:  # pragma: no cover
-        ver = "0.0.0"
-    groups: dict = {}
-    for r in rows:
-        groups.setdefault((r["scenario"], r["time_budget"]), []).append(r)
-    out = {}
-    date = time.strftime("%Y-%m-%d %H:%M:%S")
-    for (scen, budget), rs in groups.items():
-        planners: dict = {}
-        for r in rs:
-            planners.setdefault(r["planner"], []).append(r)
-        opt = rs[0]["optimum"]
-        lines = [f"OMPL version {ver}", f"Experiment {_token(scen)}_t{budget:g}",
-                 "2 experiment properties", f"optimum REAL = {_val(opt)}", f"budget REAL = {budget!r}",
-                 f"Running on {socket.gethostname()}", f"Starting at {date}",
-                 "<<<|", f"cspace bench: scenario {scen} ({rs[0]['file']}), budget {budget:g} s, "
-                         f"error against the exact shortest path", "|>>>",
-                 "<<<|", "|>>>", "0 is the random seed", f"{budget!r} seconds per run", "0 MB per run",
-                 f"{max(len(v) for v in planners.values())} runs per planner",
-                 f"{sum(r['wall_s'] or 0.0 for r in rs)!r} seconds spent to collect the data",
-                 "1 enum types", _ENUM, f"{len(planners)} planners"]
-        for p, prs in planners.items():
-            lines += [f"geometric_{p}", "0 common properties", f"{len(_RUN_PROPS)} properties for each run"]
-            lines += [f"{name} {kind}" for name, kind, _ in _RUN_PROPS]
-            lines.append(f"{len(prs)} runs")
-            for r in prs:
-                vals = [str(_status_code(r)) if key is None and name == "status" else _val(r.get(key))
-                        for name, _, key in _RUN_PROPS]
-                lines.append("; ".join(vals) + "; ")
-            if any(r.get("progress") for r in prs):
-                lines += ["2 progress properties", "time REAL", "best cost REAL", f"{len(prs)} runs"]
-                for r in prs:
-                    lines.append("".join(f"{t!r},{c!r},;" for t, c in (r.get("progress") or [])))
-            lines.append(".")
-        fname = f"{_token(scen)}_t{budget:g}.log"
-        n = 2
-        while fname in out:  # two labels that differ only in characters a file name cannot keep
-            fname = f"{_token(scen)}-{n}_t{budget:g}.log"
-            n += 1
-        out[fname] = "\n".join(lines) + "\n"
-    return out
-
-
-TOKEN_MAX = 80  # characters of a scenario's name kept in log and experiment names
-
-
-def _token(name: str) -> str:
-    """A name safe as one whitespace-free token and file name (long names: cut, plus a hash).
-
-    >>> _token("maze 8x8/a")
-    'maze_8x8_a'
-    >>> len(_token("x" * 300)) <= TOKEN_MAX + 9
-    True
-    """
-    import hashlib
-
-    tok = "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name)) or "scenario"
-    if len(tok) > TOKEN_MAX:
-        tok = tok[:TOKEN_MAX] + "-" + hashlib.sha256(str(name).encode()).hexdigest()[:8]
-    return tok
 
 
 # ---------------------------------------------------------------- statistics and the figure

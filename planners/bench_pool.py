@@ -28,6 +28,7 @@ import json
 import os
 import select
 import signal
+import subprocess
 import sys
 import time
 
@@ -223,3 +224,66 @@ def call_in_child(fn, limit: float):
             return pickle.loads(buf)
     how = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else f"exit code {os.WEXITSTATUS(status)}"
     return False, f"child died ({how})"
+
+
+# ---------------------------------------------------------------- without fork: a fresh process per run
+
+def isolated_run(task: dict, limit: float | None = None) -> dict | None:
+    """Run one task in a fresh child process; the row records ``ok``, ``crashed`` or ``timeout``.
+
+    A child that dies by a signal, exits without a row or raises is ``crashed``; one
+    still running after ``limit`` seconds (default :func:`hard_limit`) is killed and is
+    ``timeout``. Returns None if the sweep was interrupted meanwhile.
+    """
+    from .bench import _complete, _live, _MARK, _stop, hard_limit
+
+    limit = hard_limit(task["time_budget"]) if limit is None else limit
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-c", "from planners.bench_pool import _child_main; _child_main()"],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env=env, start_new_session=True, text=True)
+    _live.add(proc)
+    try:
+        out, err = proc.communicate(json.dumps({**task, "hard_limit": limit}), timeout=limit)
+        status = None
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        out, err = proc.communicate()
+        status = "timeout"
+    finally:
+        _live.discard(proc)
+    if _stop.is_set():
+        return None
+    wall = time.perf_counter() - t0
+    row = None
+    for line in (out or "").splitlines():
+        if line.startswith(_MARK):
+            row = json.loads(line[len(_MARK):])
+    if status == "timeout":
+        row = {"status": "timeout", "message": f"killed after {limit:g} s"}
+    elif row is None:
+        code = proc.returncode
+        how = f"signal {-code}" if code < 0 else f"exit code {code}"
+        tail = (err or "").strip().splitlines()
+        row = {"status": "crashed", "message": f"child died ({how})" + (f": {tail[-1][:200]}" if tail else "")}
+    return _complete(task, row, wall)
+
+
+def _child_main() -> None:  # pragma: no cover - runs in the child process
+    """Entry of a child process: task JSON on stdin, one marked row line on stdout."""
+    import signal
+
+    from .bench import _MARK, run_one
+
+    task = json.loads(sys.stdin.read())
+    if hasattr(signal, "alarm"):  # a backstop only: the parent kills us at the hard limit
+        signal.alarm(int(task["hard_limit"]) + 5)
+    try:
+        row = run_one(task)
+    except Exception as exc:  # a Python error in the run: recorded, the sweep goes on
+        row = {"status": "crashed", "message": f"{type(exc).__name__}: {exc}"}
+    sys.stdout.write(_MARK + json.dumps(row) + "\n")
+    sys.stdout.flush()
+    os._exit(0)  # skip the bindings' "nanobind: leaked" report at exit
