@@ -46,6 +46,9 @@ class Stage:
         return {"stage": self.name, "ran": self.ran, "seconds": self.seconds, **self.counts, "note": self.note}
 
 
+SMALL_GRID = 4096  # cells: a grid this small is also the segment walk's grid
+
+
 def _check_range(bounds: tuple, shapes: list) -> None:
     """ValueError unless the scene lies in the range the C-space supports (its
     classification multiplies two coordinates): see :data:`cspace.scenario.MAX_MAGNITUDE`."""
@@ -153,8 +156,11 @@ class CSpace:
         t = time.perf_counter()
         self.packed = PieceSet(self.pieces)
         self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells)
-        # Segments walk a 4x coarser grid: fewer cells per motion, same exact answer.
-        self.coarse = GridIndex(self.pieces, self.bounds, cells=max(self.index.nx * self.index.ny // 16, 64))
+        # Segments walk a 4x coarser grid: fewer cells per motion, same exact answer. A grid
+        # of at most 64 x 64 cells (an SE(2) slab's) is walked as it is.
+        cells = self.index.nx * self.index.ny
+        self.coarse = (self.index if cells <= SMALL_GRID
+                       else GridIndex(self.pieces, self.bounds, cells=max(cells // 16, 64)))
         self.stages.append(Stage("index", True, time.perf_counter() - t,
                                  {**self.index.stats(), "segment_grid": [self.coarse.nx, self.coarse.ny]}))
         self.checks = {"points": 0, "segments": 0, "exact_points": 0, "exact_segments": 0}

@@ -137,7 +137,7 @@ class SE2CSpace(SE2Motions):
     def _build(self, k: int) -> None:
         t = time.perf_counter()
         if self.slabs == 1:  # point robot: one C-space, the obstacles themselves
-            outer = CSpace(self.bounds, self.obstacle_pieces, [], grid_cells=self.grid_cells)
+            outer = CSpace(self.bounds, self.obstacle_pieces, [], grid_cells=self.grid_cells, normalized=True)
             self._outer[k], self._inner[k] = outer, False
             self._tests[k] = (outer.point_test(), None)
             self._grids[k] = self._combined_grid(k, outer, None)
@@ -146,7 +146,8 @@ class SE2CSpace(SE2Motions):
             return
         a, b = self._lo[k], self._hi[k]
         hulls = [slab_hull(p, a, b, scale=self.scale) for p in self.robot_pieces]
-        outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells or SLAB_GRID_CELLS)
+        outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells or SLAB_GRID_CELLS,
+                       normalized=True)  # decomposed, CCW pieces: no input conversion per slab
         t_outer = time.perf_counter() - t
         if len(outer.obstacle_pieces) != len(self.obstacle_pieces) or len(outer.robot_pieces) != len(hulls):
             # piece_pairs index our pieces: the slab must keep them as given (they are convex)
