@@ -81,23 +81,40 @@ class GridIndex:
         cand_cells: list[np.ndarray] = []
         cand_piece: list[np.ndarray] = []
         cand_mask: list[np.ndarray] = []
+        # Pieces of up to 62 edges are classified together, in blocks of (piece, cell)
+        # pairs (one numpy pass instead of one per piece); wider ones one by one (their
+        # edge masks are Python ints).
+        narrow = [k for k, p in enumerate(pieces) if len(p) <= 62]
+        if narrow:
+            pid, cells_k, inside, masks = self._classify_many(pieces, narrow)
+            cand_cells.append(cells_k)
+            cand_piece.append(pid)
+            inside_parts = [inside]
+            cand_mask.append(masks)
+        else:
+            inside_parts = []
         for k, p in enumerate(pieces):
-            cells_k, inside, masks = self._classify(p)
-            if cells_k.size == 0:
+            if len(p) <= 62:
                 continue
-            blk = cells_k[inside]
-            state[blk] = BLOCKED
-            blocker[blk] = k
-            mixed = cells_k[~inside]
-            cand_cells.append(mixed)
-            cand_piece.append(np.full(mixed.size, k, dtype=np.int64))
-            cand_mask.append(masks[~inside])
-        # A cell touched by any piece but not wholly inside one is MIXED.
+            cells_k, inside, masks = self._classify(p)
+            cand_cells.append(cells_k)
+            cand_piece.append(np.full(cells_k.size, k, dtype=np.int64))
+            inside_parts.append(inside)
+            cand_mask.append(masks)
         if cand_cells:
             cc = np.concatenate(cand_cells)
             cp = np.concatenate(cand_piece)
             cm = np.concatenate(cand_mask)
-            order = np.argsort(cc, kind="stable")
+            inside = np.concatenate(inside_parts)
+            # A cell inside a piece is BLOCKED, its blocker the last such piece.
+            blk = cc[inside]
+            state[blk] = BLOCKED
+            np.maximum.at(blocker, blk, cp[inside])
+            cc, cp, cm = cc[~inside], cp[~inside], cm[~inside]
+        if cand_cells and cc.size:
+            # A cell touched by any piece but not wholly inside one is MIXED; its
+            # candidates in piece order.
+            order = np.lexsort((cp, cc))
             cc, cp, cm = cc[order], cp[order], cm[order]
             touched = np.zeros(nx * ny, dtype=bool)
             touched[cc] = True
@@ -128,6 +145,70 @@ class GridIndex:
         self._sat = sat.tolist()
 
     # -- build -------------------------------------------------------------------
+
+    def _classify_many(self, pieces: list[np.ndarray], ks: list[int]):
+        """:meth:`_classify` for the pieces ``ks`` (each of at most 62 edges) at once:
+        ``(piece, cell, inside, mask)`` per (piece, cell) pair that may meet, piece-major,
+        each piece's cells in :meth:`_classify`'s order, with the same arithmetic.
+
+        Edges are padded to the widest piece with a dummy edge (zero normal, offset
+        +inf) that every cell lies strictly inside and no cell is separated by.
+        """
+        m = self.margin
+        sizes = np.array([len(pieces[k]) for k in ks], dtype=np.int64)
+        E = int(sizes.max())
+        K = len(ks)
+        Q = np.zeros((K, E, 2))
+        for r, k in enumerate(ks):
+            Q[r, : sizes[r]] = pieces[k]
+        Q -= (self.ox, self.oy)
+        slot = np.arange(E)
+        valid = slot[None, :] < sizes[:, None]
+        nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
+        e = np.take_along_axis(Q, nxt[:, :, None], axis=1) - Q
+        nrm = np.stack([e[:, :, 1], -e[:, :, 0]], axis=2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
+        nrm[~valid] = 0.0
+        c = np.einsum("kij,kij->ki", nrm, Q)
+        c[~valid] = np.inf
+        hi = np.maximum(nrm[:, :, 0], 0.0) * self.cw + np.maximum(nrm[:, :, 1], 0.0) * self.ch
+        lo = np.minimum(nrm[:, :, 0], 0.0) * self.cw + np.minimum(nrm[:, :, 1], 0.0) * self.ch
+        # Bit e stands for the edge ending at vertex e: slot i (edge i -> i+1) is bit (i + 1) % n.
+        weights = np.where(valid, np.left_shift(np.int64(1), (slot[None, :] + 1) % sizes[:, None]), 0)
+        # Each piece's box of cells (widened by the margin), clipped to the grid.
+        lo_xy = np.array([pieces[k].min(axis=0) for k in ks])
+        hi_xy = np.array([pieces[k].max(axis=0) for k in ks])
+        i0 = np.maximum(np.floor((lo_xy[:, 0] - m - self.x0) * self.inv_w), 0).astype(np.int64)
+        i1 = np.minimum(np.floor((hi_xy[:, 0] + m - self.x0) * self.inv_w), self.nx - 1).astype(np.int64)
+        j0 = np.maximum(np.floor((lo_xy[:, 1] - m - self.y0) * self.inv_h), 0).astype(np.int64)
+        j1 = np.minimum(np.floor((hi_xy[:, 1] + m - self.y0) * self.inv_h), self.ny - 1).astype(np.int64)
+        W = np.maximum(i1 - i0 + 1, 0)
+        H = np.maximum(j1 - j0 + 1, 0)
+        counts = W * H
+        total = int(counts.sum())
+        row = np.repeat(np.arange(K), counts)
+        t = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+        ii = i0[row] + t % W[row]
+        jj = j0[row] + t // W[row]
+        inside = np.empty(total, dtype=bool)
+        separated = np.empty(total, dtype=bool)
+        masks = np.empty(total, dtype=np.int64)
+        step = max(1, (1 << 21) // E)
+        for s in range(0, total, step):
+            r = row[s : s + step]
+            cx0 = (self.x0 - self.ox) + ii[s : s + step] * self.cw
+            cy0 = (self.y0 - self.oy) + jj[s : s + step] * self.ch
+            d = cx0[:, None] * nrm[r, :, 0]
+            d += cy0[:, None] * nrm[r, :, 1]
+            d -= c[r]
+            strictly_in = d <= -m - hi[r]
+            inside[s : s + step] = strictly_in.all(axis=1)
+            masks[s : s + step] = ((~strictly_in) * weights[r]).sum(axis=1)
+            separated[s : s + step] = (d >= m - lo[r]).any(axis=1)
+        keep = ~separated
+        pid = np.asarray(ks, dtype=np.int64)[row]
+        return pid[keep], (jj * self.nx + ii)[keep], inside[keep], masks[keep]
 
     def _classify(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cells that closed convex ``p`` may meet, which of them lie inside ``p``, and for
