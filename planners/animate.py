@@ -97,8 +97,15 @@ def animate_path(res, out: str, frames: int = 80, fps: int = 20, scenario=None) 
         trail.set_data(poses[: i + 1, 0], poses[: i + 1, 1])
         return [*patches, dot, trail]
 
+    class GifWriter(PillowWriter):
+        """Pillow's GIF writer, told the format (the atomic temporary has no extension)."""
+
+        def finish(self):
+            self._frames[0].save(self.outfile, format="GIF", save_all=True, append_images=self._frames[1:],
+                                 duration=int(1000 / self.fps), loop=0)
+
     anim = FuncAnimation(fig, frame, frames=len(poses), blit=False)
     fig.tight_layout()
-    with atomic_path(out) as tmp:
-        anim.save(tmp, writer=PillowWriter(fps=fps), dpi=80)
+    with atomic_path(out, "--animate") as tmp:
+        anim.save(tmp, writer=GifWriter(fps=fps), dpi=80)
     plt.close(fig)

@@ -29,6 +29,10 @@ import threading
 import time
 
 from .errors import InputError
+# The figure and the progress bar live in their own modules (matplotlib and tqdm are
+# imported only when drawn); the bench keeps these names for its callers.
+from .plot_bench import curves, plot_error_vs_time  # noqa: F401
+from .progress import BenchBar as _Progress
 
 DEFAULT_PLANNERS = ("RRTConnect", "RRTstar", "PRMstar", "BITstar")
 DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
@@ -412,66 +416,7 @@ def _sweep_dask(tasks, scheduler, rows, bar) -> None:
         client.close()
 
 
-class _Progress:
-    """One self-overwriting progress line on stderr (plain lines when stderr is not a terminal)."""
-
-    def __init__(self, total: int, enabled: bool):
-        self.total, self.enabled, self.n, self.t0 = total, enabled, 0, time.perf_counter()
-        self.tty = enabled and sys.stderr.isatty()
-        self.bad = 0
-
-    def step(self, row: dict) -> None:
-        self.n += 1
-        self.bad += row["status"] != "ok"
-        if not self.enabled:
-            return
-        pct = 100 * self.n // max(self.total, 1)
-        fill = "#" * (pct // 5)
-        line = (f"[{fill:<20}] {self.n}/{self.total} {time.perf_counter() - self.t0:6.1f} s  "
-                f"{row['scenario']} {row['planner']} {row['time_budget']:g}s seed {row['seed']}: {row['status']}"
-                + (f"  ({self.bad} crashed/timeout)" if self.bad else ""))
-        if self.tty:
-            sys.stderr.write("\r\x1b[K" + line)
-        elif self.n == self.total or self.n % max(1, self.total // 20) == 0 or row["status"] != "ok":
-            sys.stderr.write(line + "\n")
-        sys.stderr.flush()
-
-    def close(self) -> None:
-        if self.tty:
-            sys.stderr.write("\n")
-
-
-# ---------------------------------------------------------------- statistics and the figure
-
-def curves(rows: list[dict]) -> dict:
-    """Per (scenario, planner): budgets, median / 25% / 75% error over solved runs, success rate.
-
-    >>> r = [{"scenario": "s", "planner": "P", "time_budget": 1.0, "status": "ok", "solved": True, "error": e}
-    ...      for e in (0.1, 0.2, 0.3)]
-    >>> curves(r)[("s", "P")]["median"]
-    [0.2]
-    """
-    import numpy as np
-
-    groups: dict = {}
-    for r in rows:
-        groups.setdefault((r["scenario"], r["planner"]), {}).setdefault(r["time_budget"], []).append(r)
-    out = {}
-    for key, by_t in groups.items():
-        c = {"time": [], "median": [], "q25": [], "q75": [], "success": [], "runs": []}
-        for t in sorted(by_t):
-            rs = by_t[t]
-            errs = [r["error"] for r in rs if r["solved"] and r["error"] is not None]
-            c["time"].append(t)
-            c["runs"].append(len(rs))
-            c["success"].append(sum(bool(r["solved"]) for r in rs) / len(rs))
-            q = np.percentile(errs, [50, 25, 75]).tolist() if errs else [None] * 3
-            c["median"].append(q[0])
-            c["q25"].append(q[1])
-            c["q75"].append(q[2])
-        out[key] = c
-    return out
-
+# ---------------------------------------------------------------- statistics
 
 def summary(rows: list[dict]) -> str:
     """A table: median error and success rate at the largest budget, per scenario and planner."""
@@ -486,55 +431,3 @@ def summary(rows: list[dict]) -> str:
         lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
                      "bound on the error")
     return "\n".join(lines)
-
-
-ERROR_FLOOR = 1e-6  # errors below this are drawn at it (log axis); an exact 0 is essentially impossible
-
-
-def plot_error_vs_time(rows: list[dict], path: str) -> None:
-    """Median error (25-75 % band) and success rate against the time budget, one column per scenario."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .output import atomic_path
-
-    cs = curves(rows)
-    scens = list(dict.fromkeys(r["scenario"] for r in rows))
-    planners = list(dict.fromkeys(r["planner"] for r in rows))
-    colors = {p: f"C{i % 10}" for i, p in enumerate(planners)}
-    fig, axes = plt.subplots(2, len(scens), figsize=(3.6 * len(scens) + 0.6, 6.4), squeeze=False,
-                             sharex=True, gridspec_kw={"height_ratios": [2, 1]})
-    for j, scen in enumerate(scens):
-        top, bot = axes[0][j], axes[1][j]
-        for p in planners:
-            c = cs.get((scen, p))
-            if c is None:
-                continue
-            pts = [(t, m, a, b) for t, m, a, b in zip(c["time"], c["median"], c["q25"], c["q75"]) if m is not None]
-            if pts:
-                t, m, a, b = (list(v) for v in zip(*pts))
-                fl = [max(v, ERROR_FLOOR) for v in m]
-                top.plot(t, fl, "o-", color=colors[p], label=p, ms=4)
-                top.fill_between(t, [max(v, ERROR_FLOOR) for v in a], [max(v, ERROR_FLOOR) for v in b],
-                                 color=colors[p], alpha=0.2, lw=0)
-            bot.plot(c["time"], c["success"], "o-", color=colors[p], ms=4)
-        if not any(r["solved"] for r in rows if r["scenario"] == scen):
-            top.text(0.5, 0.5, "no run solved", transform=top.transAxes, ha="center", va="center", color="0.4")
-        top.set_xscale("log")
-        top.set_yscale("log")
-        top.set_title(scen)
-        top.grid(True, which="both", alpha=0.3)
-        bot.set_xscale("log")
-        bot.set_ylim(-0.05, 1.05)
-        bot.grid(True, which="both", alpha=0.3)
-        bot.set_xlabel("time budget (s)")
-        if j == 0:
-            top.set_ylabel("length / optimum - 1\n(median, 25-75 %, solved runs)")
-            bot.set_ylabel("success rate")
-    axes[0][0].legend(fontsize=8, loc="best")
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)

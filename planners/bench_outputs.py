@@ -3,7 +3,8 @@ that a sweep is never mixed with an earlier one and Ctrl-C never leaves ``comple
 
 The OMPL logs (one per scenario and budget, under ``ompl/``) are in the format
 ``ompl_benchmark_statistics.py`` (shipped in the ompl wheel) turns into the Planner
-Arena database. The figure is drawn by :func:`planners.bench.plot_error_vs_time`.
+Arena database. The figure is drawn by :func:`planners.plot_bench.plot_error_vs_time` (through
+:mod:`planners.bench`, which re-exports it).
 """
 from __future__ import annotations
 

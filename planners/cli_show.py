@@ -83,6 +83,6 @@ def _show_se2(sc, args, fmt) -> int:
         from .plot import plot_scene
 
         plot_scene(sc, slab, args.plot, fmt=fmt, theta=th,
-                   title=f"{sc.name}: slab {k}/{se2.slabs} (theta {math.degrees(a):.3g}..{math.degrees(b):.3g} deg), "
+                   title=f"{sc.name}: slab {k}/{se2.slabs} (theta {math.degrees(a):.3g} to {math.degrees(b):.3g} deg), "
                          f"{len(slab.pieces)} pieces")
     return 0

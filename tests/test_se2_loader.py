@@ -4,10 +4,10 @@ import os
 
 import pytest
 
+from conftest import SCENARIOS
 from cspace.scenario import ScenarioError, load_scenario, scenario_from_dict
 
-HERE = os.path.dirname(__file__)
-SE2 = os.path.join(HERE, "..", "scenarios", "se2")
+SE2 = os.path.join(SCENARIOS, "se2")
 
 BASE = {
     "bounds": {"xmin": 0, "xmax": 10, "ymin": 0, "ymax": 10},
