@@ -33,11 +33,13 @@ def _polygons_of(item, what: str) -> list:
 
 
 def _shell_and_holes(shell, holes: list, what: str) -> tuple[np.ndarray, list[np.ndarray]]:
-    """Normalised shell (CCW) and holes (CW), checked finite and simple."""
-    ext = as_array(shell)
-    hs = [as_array(h) for h in holes]
-    if not all(np.isfinite(p).all() for p in [ext] + hs):
-        raise ValueError(f"{what}: coordinates must be finite")
+    """Normalised shell (CCW) and holes (CW), checked finite and simple (the array gate's
+    faults are re-raised naming the argument)."""
+    try:
+        ext = as_array(shell)
+        hs = [as_array(h) for h in holes]
+    except (ValueError, TypeError) as exc:
+        raise type(exc)(f"{what}: {exc}") from None
     if len(ext) < 3:
         raise ValueError(f"{what}: a polygon needs at least 3 vertices, got {len(ext)}")
     ext_n = normalize(ext, ccw=True)

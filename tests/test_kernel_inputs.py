@@ -82,6 +82,7 @@ def test_the_messages_say_what_is_wrong():
         C.convex_decompose(INPUTS["bowtie"])
     with pytest.raises(ValueError, match="expected one polygon, got a MultiPolygon"):
         C.convex_hull(INPUTS["multipolygon"])
-    with pytest.raises(ValueError, match="no vertices"):
+    with pytest.raises(ValueError, match="empty array|no vertices"):  # the one array gate (cspace/arrays.py)
         C.minkowski_sum(INPUTS["empty"], SQ)
-    assert is_simple(INPUTS["nan"]) is False
+    with pytest.raises(ValueError, match="finite"):  # NaN is refused by the one gate, not answered
+        is_simple(INPUTS["nan"])
