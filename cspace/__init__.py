@@ -16,7 +16,11 @@ from .decompose import convex_decompose
 from .pairsums import pairwise_sums
 from .convolution import convolution_cycles, convex_sums_with
 from .nonconvex import minkowski_pieces, minkowski_sum_nonconvex
-from .cspace import CSpace
+from .cspace import CSpace, decompose_obstacles, decompose_robot
+from .slab import (rotate, rotate_piece, wrap_angle, slab_hull, slab_inner, slab_pad, slab_of, slab_range,
+                   inscribed_radius, inscribed_polygon, default_slabs, robot_radius)
+from .se2_motion import interpolate
+from .se2 import SE2CSpace
 from .direct import DirectChecker, cspace_band
 from .shortest import ShortestPath, shortest_path
 

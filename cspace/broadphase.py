@@ -41,12 +41,16 @@ def _box_share(p: np.ndarray, xmin: float, xmax: float, ymin: float, ymax: float
 class GridIndex:
     """Uniform grid over ``bounds`` classifying cells against convex ``pieces``.
 
+    ``cells`` sets the cell count (default: from the pieces); ``shape`` = (nx, ny)
+    fixes the columns and rows instead, to share another grid's cells.
+
     >>> g = GridIndex([np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])], (0, 4, 0, 4), cells=16)
     >>> int(g.state_at(3.5, 3.5)), int(g.state_at(0.5, 0.5))
     (0, 2)
     """
 
-    def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None):
+    def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None,
+                 shape: tuple[int, int] | None = None):
         xmin, xmax, ymin, ymax = map(float, bounds)
         self.bounds = (xmin, xmax, ymin, ymax)
         n = len(pieces)
@@ -60,6 +64,8 @@ class GridIndex:
                 cells = max(int(_PAIR_BUDGET / cover), 1 << 12)
         nx = max(1, min(4096, int(round(math.sqrt(cells * w / h)))))
         ny = max(1, min(4096, int(round(cells / nx))))
+        if shape is not None:  # the same cells as another grid (the SE(2) inner grid)
+            nx, ny = int(shape[0]), int(shape[1])
         self.nx, self.ny = nx, ny
         self.x0, self.y0 = xmin, ymin
         self.cw, self.ch = w / nx, h / ny

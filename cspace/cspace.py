@@ -59,6 +59,58 @@ def _check_range(bounds: tuple, shapes: list) -> None:
         raise ValueError(f"CSpace: the bounds' extent {max(xmax - xmin, ymax - ymin):.3g} is below the supported 2^-400")
 
 
+def decompose_obstacles(obstacles: list[np.ndarray], holes: list[list[np.ndarray]] | None = None,
+                        of: list[int] | None = None) -> tuple[list[np.ndarray], np.ndarray, int]:
+    """Convex pieces of the obstacles: (pieces, owning obstacle of each piece, obstacles split).
+
+    Convex obstacles without holes are kept as they are; the others go through
+    :func:`cspace.decompose.convex_decompose`. ``of[k]``, if given, is the input obstacle
+    shell k came from (a MultiPolygon gives several shells). Shared by :class:`CSpace`
+    and the SE(2) C-space, which decomposes once for all its slabs.
+
+    >>> p, owner, split = decompose_obstacles([np.array([[0., 0], [2, 0], [2, 2], [0, 2]])])
+    >>> len(p), owner.tolist(), split
+    (1, [0], 0)
+    """
+    from .polygon import is_convex
+
+    holes = holes or [[] for _ in obstacles]
+    pieces, owner, split = [], [], 0
+    for k, (poly, hs) in enumerate(zip(obstacles, holes)):
+        i = k if of is None else of[k]
+        if not hs and is_convex(poly):
+            parts = [np.asarray(poly, dtype=np.float64)]
+        else:
+            from .decompose import convex_decompose
+
+            parts = convex_decompose(poly, hs)
+            split += 1
+        pieces += parts
+        owner += [i] * len(parts)
+    return pieces, np.array(owner, dtype=np.int64), split
+
+
+def decompose_robot(robot: list[np.ndarray], is_disk: bool = False) -> tuple[list[np.ndarray], int]:
+    """Convex pieces of the robot parts: (pieces, parts split). A disk's polygon is convex.
+
+    >>> p, split = decompose_robot([np.array([[0., 0], [2, 0], [2, 2], [1, 1], [0, 2]])])
+    >>> len(p) > 1, split
+    (True, 1)
+    """
+    from .polygon import is_convex
+
+    pieces, split = [], 0
+    for part in robot:
+        if is_disk or is_convex(part):
+            pieces.append(np.asarray(part, dtype=np.float64))
+        else:
+            from .decompose import convex_decompose
+
+            pieces += convex_decompose(part)
+            split += 1
+    return pieces, split
+
+
 class CSpace:
     """Convex C-obstacle pieces of a scenario behind a broad phase.
 
@@ -143,44 +195,21 @@ class CSpace:
         return cs
 
     def _decompose_obstacles(self, obstacles, holes, of=None):
-        from .polygon import is_convex
-
         t = time.perf_counter()
-        pieces, owner, split = [], [], 0
-        for k, (poly, hs) in enumerate(zip(obstacles, holes)):
-            i = k if of is None else of[k]  # the input obstacle (a MultiPolygon gives several)
-            if not hs and is_convex(poly):
-                parts = [np.asarray(poly, dtype=np.float64)]
-            else:
-                from .decompose import convex_decompose
-
-                parts = convex_decompose(poly, hs)
-                split += 1
-            pieces += parts
-            owner += [i] * len(parts)
+        pieces, owner, split = decompose_obstacles(obstacles, holes, of)
         self.stages.append(
             Stage("decompose_obstacles", split > 0, time.perf_counter() - t,
                   {"obstacles": len(obstacles), "decomposed": split, "pieces": len(pieces)},
                   "" if split else "all obstacles convex: nothing to decompose")
         )
-        return pieces, np.array(owner, dtype=np.int64)
+        return pieces, owner
 
     def _decompose_robot(self, robot, is_disk):
-        from .polygon import is_convex
-
         t = time.perf_counter()
         if not robot:
             self.stages.append(Stage("decompose_robot", False, 0.0, {"parts": 0}, "point robot"))
             return []
-        pieces, split = [], 0
-        for part in robot:
-            if is_disk or is_convex(part):
-                pieces.append(np.asarray(part, dtype=np.float64))
-            else:
-                from .decompose import convex_decompose
-
-                pieces += convex_decompose(part)
-                split += 1
+        pieces, split = decompose_robot(robot, is_disk)
         note = "disk robot: its polygon is convex" if is_disk else ("" if split else "robot parts convex")
         self.stages.append(Stage("decompose_robot", split > 0, time.perf_counter() - t,
                                  {"parts": len(robot), "pieces": len(pieces)}, note))
@@ -191,21 +220,30 @@ class CSpace:
         if not self.robot_pieces:
             self.stages.append(Stage("minkowski", False, 0.0, {"pieces": len(self.obstacle_pieces)},
                                      "point robot: C-obstacles are the obstacles"))
+            n = len(self.obstacle_pieces)
+            self._raw_pairs = [(i, -1) for i in range(n)]
             return list(self.obstacle_pieces), self.obstacle_of
         from .minkowski import minkowski_sum, reflect
 
         neg = [reflect(r) for r in self.robot_pieces]
-        out, owner = [], []
-        for p, o in zip(self.obstacle_pieces, self.obstacle_of):
-            for r in neg:
+        out, owner, pairs = [], [], []
+        for i, (p, o) in enumerate(zip(self.obstacle_pieces, self.obstacle_of)):
+            for j, r in enumerate(neg):
                 out.append(minkowski_sum(p, r))
                 owner.append(o)
+                pairs.append((i, j))
+        self._raw_pairs = pairs
         self.stages.append(Stage("minkowski", True, time.perf_counter() - t,
                                  {"pairs": len(out), "robot_pieces": len(neg)}))
         return out, np.array(owner, dtype=np.int64)
 
     def _prune(self, pieces, owner):
-        """Drop pieces that cannot meet the bounds, and pieces inside another piece."""
+        """Drop pieces that cannot meet the bounds, and pieces inside another piece.
+
+        ``self.piece_pairs[k]`` lists the (obstacle piece, robot piece) pairs whose sum
+        is kept piece k or lies inside it (robot piece -1 for a point robot): a point in
+        the sum of a pair is in the piece the pair is listed under.
+        """
         t = time.perf_counter()
         xmin, xmax, ymin, ymax = self.bounds
         before = len(pieces)
@@ -215,13 +253,21 @@ class CSpace:
         ]
         outside = before - len(keep)
         pieces = [pieces[k] for k in keep]
+        pairs = [[self._raw_pairs[k]] for k in keep]
         owner = owner[keep] if len(owner) else owner
         contained = _contained_pieces(pieces)
         if contained:
+            for p in sorted(contained):
+                q = contained[p]
+                while q in contained:  # a container may itself lie in another piece
+                    q = contained[q]
+                pairs[q] += pairs[p]
             mask = np.ones(len(pieces), dtype=bool)
             mask[list(contained)] = False
             pieces = [p for p, m in zip(pieces, mask) if m]
+            pairs = [pr for pr, m in zip(pairs, mask) if m]
             owner = owner[mask]
+        self.piece_pairs = pairs
         self.stages.append(Stage("prune", True, time.perf_counter() - t,
                                  {"pieces_before": before, "outside_bounds": outside,
                                   "inside_another": len(contained), "pieces_after": len(pieces)}))
@@ -524,8 +570,8 @@ class CSpace:
         }
 
 
-def _contained_pieces(pieces: list[np.ndarray]) -> set[int]:
-    """Indices of convex pieces lying inside another piece (exact containment test).
+def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
+    """Convex pieces lying inside another piece (exact containment test): removed -> container.
 
     Candidate pairs come from bounding-box containment; a convex piece P lies in a
     convex piece Q iff every vertex of P is on or left of every edge of Q. Of two
@@ -533,11 +579,11 @@ def _contained_pieces(pieces: list[np.ndarray]) -> set[int]:
     """
     n = len(pieces)
     if n < 2:
-        return set()
+        return {}
     lo = np.array([p.min(axis=0) for p in pieces])
     hi = np.array([p.max(axis=0) for p in pieces])
     order = np.argsort(lo[:, 0], kind="stable")
-    removed: set[int] = set()
+    removed: dict[int, int] = {}
     lo_sorted = lo[order, 0]
     for q in range(n):
         if q in removed:
@@ -559,5 +605,5 @@ def _contained_pieces(pieces: list[np.ndarray]) -> set[int]:
                 continue  # identical: keep the earlier one, drop q when it is visited as p
             sides = orient2d_many(s[None, :, :], e[None, :, :], P[:, None, :])
             if (sides >= 0).all():
-                removed.add(p)
+                removed[p] = q
     return removed

@@ -45,15 +45,37 @@ def convex_decompose(polygon, holes=None) -> list[np.ndarray]:
     """
     if hasattr(polygon, "geom_type") and polygon.geom_type == "Polygon" and holes is None:
         holes = [as_array(r) for r in polygon.interiors]
-    if len(as_array(polygon, copy=False)) == 0:
-        raise ValueError("convex_decompose: the polygon has no vertices")
-    shell = normalize(polygon)
+    shell = normalize(polygon if hasattr(polygon, "geom_type") else as_array(polygon, nonempty=True))
     if len(shell) < 3:  # no area: the point or segment it spans, a convex piece itself
         return [collinear_extent(as_array(polygon))]
-    hole_list = [normalize(h, ccw=False) for h in (holes or [])]
+    hole_list = []
+    for i, h in enumerate(holes or []):
+        try:
+            hole_list.append(normalize(h, ccw=False))
+        except (TypeError, ValueError) as exc:
+            raise type(exc)(f"convex_decompose: hole {i}: {exc}") from None
+        if len(hole_list[-1]) < 3:  # GEOS crashes (SIGSEGV) on such a ring: refuse it first
+            raise ValueError(f"convex_decompose: hole {i} has no area (empty, one point or collinear)")
     if not hole_list and is_convex(shell):
         return [shell]
+    if hole_list:
+        _check_simple(shell, hole_list)
     return decompose_normalized(shell, hole_list)
+
+
+def _check_simple(shell: np.ndarray, holes: list) -> None:
+    """ValueError unless the shell and its holes make a valid polygon (simple rings,
+    holes inside the shell, disjoint but for touching points): triangulating anything
+    else has no meaning, and can crash GEOS."""
+    import shapely
+
+    rings = [shell] + holes
+    rescaled = scaled_copies(rings, max(float(np.abs(r).max()) for r in rings))  # as _triangulate does
+    if rescaled:
+        rings = rescaled[1]
+    poly = shapely.Polygon(rings[0], rings[1:])
+    if not poly.is_valid:
+        raise ValueError(f"convex_decompose: not a simple polygon with holes ({shapely.is_valid_reason(poly)})")
 
 
 def decompose_normalized(shell: np.ndarray, hole_list: list) -> list[np.ndarray]:

@@ -42,10 +42,8 @@ def epa_penetration(A, B) -> Penetration:
     >>> round(p.depth, 12), p.normal.tolist(), p.status
     (0.5, [1.0, 0.0], 'overlapping')
     """
-    a = as_array(A)
-    b = as_array(B)
-    if not (len(a) and len(b)):
-        raise ValueError("epa_penetration: an operand has no vertices")
+    a = as_array(A, nonempty=True)
+    b = as_array(B, nonempty=True)
     with np.errstate(over="ignore", invalid="ignore"):
         extent = max(float(np.abs(a - a[0]).max()), float(np.abs(b - a[0]).max()))
     rescaled = scaled_copies([a, b], extent)

@@ -62,10 +62,8 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
     >>> gjk_distance([[0, 0], [1, 0], [1, 1], [0, 1]], [[1, 0], [2, 0], [2, 1], [1, 1]]).status
     'touching'
     """
-    a = as_array(A)
-    b = as_array(B)
-    if not (len(a) and len(b)):
-        raise ValueError("gjk_distance: an operand has no vertices")
+    a = as_array(A, nonempty=True)
+    b = as_array(B, nonempty=True)
     origin = a[0].copy()
     ox, oy = origin.tolist()
     if len(a) + len(b) <= 80:  # Python floats (an overflow is inf, silently): cheaper when small
@@ -329,8 +327,8 @@ def exact_relation(A, B) -> str:
     """
     from .hull import convex_hull
 
-    ga = _as_hull(as_array(A), convex_hull)
-    gb = _as_hull(as_array(B), convex_hull)
+    ga = _as_hull(as_array(A, nonempty=True), convex_hull)
+    gb = _as_hull(as_array(B, nonempty=True), convex_hull)
     if len(ga) >= 3 and len(gb) >= 3:
         return _relation_polygons(ga, gb)
     ha = [(Fraction(x), Fraction(y)) for x, y in ga.tolist()]

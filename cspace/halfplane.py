@@ -17,7 +17,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from .polygon import as_array, normalize
+from .polygon import as_array, as_point, normalize
 
 
 def halfplanes(polygon) -> tuple[np.ndarray, np.ndarray]:
@@ -29,7 +29,7 @@ def halfplanes(polygon) -> tuple[np.ndarray, np.ndarray]:
     >>> n.tolist(), c.tolist()
     ([[0.0, -2.0], [1.0, 0.0], [0.0, 2.0], [-1.0, 0.0]], [0.0, 2.0, 2.0, 0.0])
     """
-    p = normalize(polygon)
+    p = normalize(as_array(polygon, nonempty=True))
     e = np.roll(p, -1, axis=0) - p
     normals = np.column_stack([e[:, 1], -e[:, 0]]) + 0.0  # + 0.0: no negative zeros
     offsets = np.einsum("ij,ij->i", normals, p)
@@ -42,8 +42,8 @@ def support(polygon, d) -> float:
     >>> support([[0, 0], [2, 0], [0, 1]], (1, 1))
     2.0
     """
-    p = as_array(polygon)
-    return float((p @ np.asarray(d, dtype=np.float64)).max())
+    p = as_array(polygon, nonempty=True)
+    return float((p @ np.array(as_point(d))).max())
 
 
 def support_point(polygon, d) -> np.ndarray:
@@ -52,8 +52,8 @@ def support_point(polygon, d) -> np.ndarray:
     >>> support_point([[0, 0], [2, 0], [0, 1]], (0, 1)).tolist()
     [0.0, 1.0]
     """
-    p = as_array(polygon)
-    return p[int(np.argmax(p @ np.asarray(d, dtype=np.float64)))].copy()
+    p = as_array(polygon, nonempty=True)
+    return p[int(np.argmax(p @ np.array(as_point(d))))].copy()
 
 
 def erode(A, B) -> np.ndarray:

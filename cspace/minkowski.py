@@ -41,7 +41,7 @@ def reflect(polygon) -> np.ndarray:
     >>> reflect([[0, 0], [2, 0], [0, 1]]).tolist()
     [[0.0, -1.0], [0.0, 0.0], [-2.0, 0.0]]
     """
-    p = as_array(polygon)
+    p = as_array(polygon, nonempty=True)
     return lowest_first(-p + 0.0)  # + 0.0 turns -0.0 into 0.0
 
 
@@ -56,9 +56,7 @@ def minkowski_sum(P, Q, *more) -> np.ndarray:
     >>> minkowski_sum([[0, 0], [2, 0], [0, 2]], [[0, 0], [1, 0], [1, 1], [0, 1]]).tolist()
     [[0.0, 0.0], [3.0, 0.0], [3.0, 1.0], [1.0, 3.0], [0.0, 3.0]]
     """
-    ops = [as_array(x, copy=False) for x in (P, Q) + more]  # only read
-    if any(len(o) == 0 for o in ops):
-        raise ValueError("minkowski_sum: an operand has no vertices")
+    ops = [as_array(x, copy=False, nonempty=True) for x in (P, Q) + more]  # only read
     try:
         return _minkowski_sum(ops)
     except (OverflowError, NonFiniteError):  # an exact step met a NaN or an infinity

@@ -12,35 +12,8 @@ import math
 
 import numpy as np
 
+from .arrays import as_array, as_point  # noqa: F401  (the input gate, re-exported here)
 from .predicates import lower_half, orient2d_many, orient2d_xy
-
-
-def as_array(polygon, copy: bool = True) -> np.ndarray:
-    """Vertices of ``polygon`` as a fresh ``(N, 2)`` float64 array, closing repeat dropped.
-
-    Accepts an array-like of points or a shapely ``Polygon`` / ``LinearRing`` /
-    ``LineString`` / ``Point`` (a polygon's exterior is used). With ``copy=False`` a
-    float64 array comes back as a view of itself (for callers that only read it).
-
-    >>> as_array([[0, 0], [1, 0], [0, 1], [0, 0]]).tolist()
-    [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
-    """
-    if hasattr(polygon, "geom_type"):
-        geom = polygon
-        if geom.geom_type == "Polygon":
-            geom = geom.exterior
-        elif geom.geom_type not in ("LinearRing", "LineString", "Point"):  # not one sequence of points
-            raise ValueError(f"expected one polygon, got a {geom.geom_type} (pass its parts, .geoms, one by one)")
-        pts = np.array(geom.coords, dtype=np.float64)[:, :2]
-    else:
-        pts = np.array(polygon, dtype=np.float64, copy=True if copy else None)
-    if pts.ndim == 1 and pts.size == 2:
-        pts = pts.reshape(1, 2)
-    if pts.ndim != 2 or pts.shape[1] != 2:
-        raise ValueError(f"expected an (N, 2) array of points, got shape {pts.shape}")
-    if len(pts) > 1 and pts[0, 0] == pts[-1, 0] and pts[0, 1] == pts[-1, 1]:
-        pts = pts[:-1]
-    return pts
 
 
 def signed_area(polygon) -> float:

@@ -55,17 +55,56 @@ def orient2d_exact(ax: float, ay: float, bx: float, by: float, cx: float, cy: fl
 def orient2d(a, b, c) -> int:
     """Exact sign of the turn a -> b -> c: +1 left (CCW), -1 right (CW), 0 collinear.
 
-    ``a``, ``b``, ``c`` are points ``(x, y)`` with finite float coordinates.
+    ``a``, ``b``, ``c`` are points ``(x, y)`` of finite real numbers. Exact for every
+    such input: Python integers too large for a double (beyond 2^53, or beyond the
+    double range) are taken as they are, in rational arithmetic, not rounded.
+    Booleans, complex numbers and strings are refused (``TypeError``), NaN and
+    infinities too (``ValueError``).
 
     >>> orient2d((0, 0), (1, 0), (0, 1))
     1
     >>> orient2d((0, 0), (1, 1), (2, 2))
     0
+    >>> orient2d((0, 0), (2**53 + 1, 1), (2**53, 1))
+    1
     """
-    ax, ay = float(a[0]), float(a[1])
-    bx, by = float(b[0]), float(b[1])
-    cx, cy = float(c[0]), float(c[1])
-    return orient2d_xy(ax, ay, bx, by, cx, cy)
+    vals = _reals((a[0], a[1], b[0], b[1], c[0], c[1]))
+    if vals is None:  # an integer a double cannot hold: exact from the integers themselves
+        ax, ay, bx, by, cx, cy = (v if isinstance(v, int) else Fraction(v) for v in
+                                  (_exact(a[0]), _exact(a[1]), _exact(b[0]), _exact(b[1]), _exact(c[0]), _exact(c[1])))
+        det = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+        return (det > 0) - (det < 0)
+    return orient2d_xy(*vals)
+
+
+def _reals(values) -> list[float] | None:
+    """The values as floats, None if an integer among them is not exactly a double;
+    TypeError for a boolean, complex number, string or other non-number."""
+    out = []
+    for v in values:
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)):
+            raise TypeError(f"orient2d: coordinates must be real numbers, got {type(v).__name__}")
+        if isinstance(v, (int, np.integer)):
+            try:
+                f = float(v)
+            except OverflowError:
+                return None
+            if f != int(v):
+                return None
+            out.append(f)
+        else:
+            out.append(float(v))
+    return out
+
+
+def _exact(v):
+    """An int as itself, a float as its exact rational value (NaN and inf refused)."""
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    try:
+        return Fraction(float(v))
+    except (ValueError, OverflowError):
+        raise NonFiniteError() from None
 
 
 def orient2d_xy(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> int:
@@ -112,7 +151,7 @@ def cross_sign(u, v) -> int:
     >>> cross_sign((1e6, 1.0), (2e6, 2.0))
     0
     """
-    return orient2d_xy(0.0, 0.0, float(u[0]), float(u[1]), float(v[0]), float(v[1]))
+    return orient2d((0, 0), u, v)
 
 
 def lower_half(dx, dy) -> np.ndarray:

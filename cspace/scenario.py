@@ -18,21 +18,26 @@ Schema (all lengths in one unit, angles in radians)::
     [[obstacles]] polygon = [[x, y], ...], holes = [[[x, y], ...], ...]  (holes optional)
                 | center = [x, y], radius = r
     [start]    x, y, theta (optional; the fixed orientation while translating)
-    [goal]     x, y, theta (optional; must equal the start's)
+    [goal]     x, y, theta (optional; must equal the start's unless space = "se2")
     [planner]  name, time, seed        # optional defaults
-    [[queries]] start = [x, y], goal = [x, y]   # optional extra queries
+    [[queries]] start = [x, y], goal = [x, y]   # optional extra queries ([x, y, theta] in SE(2))
+    space = "translation" | "se2"      # optional: "se2" lets the robot rotate (theta is free;
+                                       # pose angles are taken into [-pi, pi), as OMPL's SO(2))
+    slabs = K                          # optional, SE(2) only: angle slabs of the sliced C-space
 """
 from __future__ import annotations
 
 import difflib
 import math
 import os
+import stat
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
 from .polygon import invalid_reason, is_convex, normalize
+from .slab import wrap_angle
 
 try:  # Python >= 3.11
     import tomllib
@@ -41,11 +46,50 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 
 
 class ScenarioError(ValueError):
-    """A fault in a scenario: ``str(err)`` is ``FILE: FIELD: message``."""
+    """A fault in a scenario: ``str(err)`` is ``FILE: FIELD: message``, one short line.
+
+    Each part is clipped (:func:`clip`): an echoed value is never longer than a line.
+    """
 
     def __init__(self, file: str, field: str, message: str):
-        self.file, self.field, self.message = file, field, message
-        super().__init__(f"{file}: {field}: {message}")
+        self.file, self.field, self.message = clip(str(file)), clip(str(field)), clip(str(message), 240)
+        super().__init__(f"{self.file}: {self.field}: {self.message}")
+
+
+def clip(text: str, limit: int = 120) -> str:
+    """``text`` on one line, at most about ``limit`` characters (the rest counted, not shown).
+
+    >>> clip("x" * 1000, 10)
+    'xxxxxxxxxx... (990 more characters)'
+    """
+    text = text.replace("\n", "\\n").replace("\r", "\\r")
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text) - limit} more characters)"
+
+
+def show(x) -> str:
+    """A value as echoed in a message: short, and safe for integers of any size.
+
+    >>> show(10**5000), show([1.5] * 100)[:20]
+    ('an integer of 5001 digits', '[1.5, 1.5, 1.5, 1.5,')
+    """
+    if isinstance(x, int) and not isinstance(x, bool) and x.bit_length() > 200:
+        return f"an integer of {len(format(abs(x), 'x')) * 4 * 30103 // 100000 + 1} digits" \
+            if x.bit_length() > 14000 else f"an integer of {len(str(abs(x)))} digits"
+    if isinstance(x, (list, dict)) and len(x) > 40:  # do not even build a huge repr
+        x = x[:40] if isinstance(x, list) else dict(list(x.items())[:40])
+        return clip(repr(x)[:-1] + ", ...]" if isinstance(x, list) else repr(x)[:-1] + ", ...}", 80)
+    try:
+        return clip(repr(x), 80)
+    except (ValueError, RecursionError):
+        return f"a {type(x).__name__}"
+
+
+# The largest scenario file read: a scene of about a million vertices. Bigger files
+# (or /dev/zero) are refused before reading, as is anything that is not a regular file
+# (a FIFO would block the open, a device could be read forever).
+MAX_FILE_BYTES = 64 * 2**20
+# Seeds: OMPL's are 32-bit and never 0 (planners.ompl_glue.SEED_LIMIT); a seed s is used as s + 1.
+MAX_SEED = 2**32 - 2
 
 
 @dataclass
@@ -70,18 +114,21 @@ class Shape:
 
 @dataclass
 class Query:
-    """A start and goal of the reference point."""
+    """A start and goal: (x, y) of the reference point, or poses (x, y, theta) in SE(2)."""
 
-    start: tuple[float, float]
-    goal: tuple[float, float]
+    start: tuple
+    goal: tuple
 
 
 @dataclass
 class Scenario:
-    """A planning problem: a translating robot, obstacles, bounds and queries.
+    """A planning problem: a robot, obstacles, bounds and queries.
 
-    ``robot`` holds the parts in the world orientation (already rotated by
-    ``theta``), relative to the reference point; an empty list is a point robot.
+    ``space`` is ``"translation"`` (the robot translates at the fixed orientation
+    ``theta``; ``robot`` holds the parts already rotated by it, relative to the
+    reference point) or ``"se2"`` (the robot also rotates; ``robot`` holds the parts
+    in the body frame, ``theta`` is 0, and start, goal and queries are poses
+    ``(x, y, theta)``). An empty ``robot`` is a point robot.
     """
 
     name: str
@@ -97,6 +144,13 @@ class Scenario:
     path: str | None = None
     robot_kind: str = "point"  # "point", "polygon", "parts" or "disk"
     disk_tolerance: float = DEFAULT_RELATIVE_ERROR
+    space: str = "translation"  # or "se2"
+    slabs: int | None = None  # SE(2): angle slabs of the sliced C-space (None: derived)
+
+    @property
+    def dim(self) -> int:
+        """Numbers in a state: 2 for translation, 3 for SE(2)."""
+        return 3 if self.space == "se2" else 2
 
     @property
     def is_point_robot(self) -> bool:
@@ -108,8 +162,13 @@ class Scenario:
         rest = [q for q in self.queries if (q.start, q.goal) != (main.start, main.goal)]
         return [main] + rest
 
-    def robot_at(self, x: float, y: float) -> list[np.ndarray]:
-        """The robot's part polygons with the reference point at (x, y)."""
+    def robot_at(self, x: float, y: float, theta: float = 0.0) -> list[np.ndarray]:
+        """The robot's part polygons with the reference point at (x, y), turned by theta
+        (in SE(2); a translating robot is already at its fixed orientation)."""
+        if theta:
+            from .slab import rotate
+
+            return [rotate(s.polygon, theta) + np.array([x, y]) for s in self.robot]
         return [s.polygon + np.array([x, y]) for s in self.robot]
 
 
@@ -117,8 +176,9 @@ class Scenario:
 # Loading
 
 
-def load_scenario(path) -> Scenario:
-    """Read and validate a TOML scenario file.
+def load_scenario(path, space: str | None = None) -> Scenario:
+    """Read and validate a TOML scenario file; ``space`` (``"translation"`` or ``"se2"``)
+    overrides the file's ``space`` (``--space`` on the command line).
 
     >>> import tempfile, os
     >>> d = tempfile.mkdtemp(); f = os.path.join(d, "s.toml")
@@ -128,18 +188,66 @@ def load_scenario(path) -> Scenario:
     (0.9, 0.9)
     """
     path = os.fspath(path)
+    raw = read_input(path)
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in raw[:4096]:
+        raise ScenarioError(path, "file", "UTF-16 or binary, not UTF-8 text (save the file as UTF-8)")
     try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise ScenarioError(path, "file", f"cannot read ({exc.strerror or exc})") from None
+        text = raw.decode("utf-8-sig")  # a byte-order mark is allowed and skipped
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise ScenarioError(path, "file", "not UTF-8 text") from None
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
-    return scenario_from_dict(data, path)
+    except ValueError as exc:  # an integer of more digits than Python converts
+        raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
+    except RecursionError:
+        raise ScenarioError(path, "toml", "invalid TOML (arrays or tables nested too deeply)") from None
+    return scenario_from_dict(data, path, space=space)
+
+
+def check_input(path) -> os.stat_result:
+    """Refuse, without opening it, what cannot be a scenario file: a missing path, a
+    folder, a FIFO or device (whose open or read may never end), a file over
+    :data:`MAX_FILE_BYTES`. Returns the file's ``os.stat``.
+
+    >>> check_input("/dev/zero")
+    Traceback (most recent call last):
+    ...
+    cspace.scenario.ScenarioError: /dev/zero: file: is not a regular file (a FIFO, device or socket)
+    """
+    path = os.fspath(path)
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        raise ScenarioError(path, "file", f"cannot read ({getattr(exc, 'strerror', None) or exc})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ScenarioError(path, "file", "is a folder, not a scenario file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ScenarioError(path, "file", "is not a regular file (a FIFO, device or socket)")
+    if st.st_size > MAX_FILE_BYTES:
+        raise ScenarioError(path, "file", f"is {st.st_size} bytes, over the {MAX_FILE_BYTES >> 20} MiB limit")
+    return st
+
+
+def read_input(path: str) -> bytes:
+    """The bytes of a scenario file, read only once :func:`check_input` accepts it.
+
+    Opened without blocking and checked again on the open file (the path may have
+    been swapped for a FIFO in between); never more than the limit is read.
+    """
+    check_input(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+        with os.fdopen(fd, "rb") as fh:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise ScenarioError(path, "file", "is not a regular file (a FIFO, device or socket)")
+            raw = fh.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ScenarioError(path, "file", f"cannot read ({exc.strerror or exc})") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ScenarioError(path, "file", f"is over the {MAX_FILE_BYTES >> 20} MiB limit")
+    return raw
 
 
 # The scenes the C-space supports: products of two coordinates (or of two extents)
@@ -152,7 +260,7 @@ MIN_EXTENT = 2.0**-400
 
 # The keys a scenario may have at its top level (a new section adds its key here).
 TOP_LEVEL_KEYS = frozenset({"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal",
-                            "planner", "queries"})
+                            "planner", "queries", "space", "slabs"})
 # The forms of a robot table and of a shape (obstacle or robot part), by their keys: keys of two
 # different forms in one table exclude each other.
 ROBOT_FORMS = {"polygon": {"polygon"}, "parts": {"parts"}, "disk": {"radius"}}
@@ -173,8 +281,9 @@ def unknown_field_message(key: str, allowed) -> str:
     return f"unknown field (expected one of: {', '.join(sorted(allowed))})"
 
 
-def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
-    """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`."""
+def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None = None) -> Scenario:
+    """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`.
+    ``space``, if given, overrides the document's ``space``."""
     v = _Validator(path)
     v.no_extra(data, "", TOP_LEVEL_KEYS)
     name = data.get("name", os.path.splitext(os.path.basename(path))[0])
@@ -198,23 +307,42 @@ def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
                               f"2^-400 (about {MIN_EXTENT:.2g})")
     bounds = (xmin, xmax, ymin, ymax)
 
+    if space is not None and space not in SPACES:
+        raise ScenarioError("--space", "space", f"must be one of {', '.join(SPACES)}, got {_short(space)}")
+    space = space or data.get("space", "translation")
+    if space not in SPACES:
+        raise v.err("space", f"must be one of {', '.join(repr(s) for s in SPACES)}, got {_short(space)}")
+    slabs = data.get("slabs")
+    if slabs is not None:
+        if space != "se2":
+            raise v.err("slabs", 'applies to space = "se2" only')
+        if isinstance(slabs, bool) or not isinstance(slabs, int) or not 4 <= slabs <= MAX_SLABS:
+            raise v.err("slabs", f"must be an integer from 4 to {MAX_SLABS} (a slab spans at most a quarter "
+                                 f"turn), got {_short(slabs)}")
+    se2 = space == "se2"
+
     start_t = v.table(data, "start", required=True)
     goal_t = v.table(data, "goal", required=True)
     start, theta = v.pose(start_t, "start")
     goal, goal_theta = v.pose(goal_t, "goal")
-    if goal_theta is not None and theta is not None and goal_theta != theta:
-        raise v.err("goal.theta", "must equal start.theta (the robot translates at a fixed orientation)")
-    theta = theta if theta is not None else (goal_theta or 0.0)
+    if se2:  # angles as OMPL's SO(2) holds them: in [-pi, pi) (pi itself is -pi)
+        start, goal = (*start, wrap_angle(theta or 0.0)), (*goal, wrap_angle(goal_theta or 0.0))
+        theta = 0.0  # the robot stays in its body frame; poses carry the angle
+    else:
+        if goal_theta is not None and theta is not None and goal_theta != theta:
+            raise v.err("goal.theta", f"{goal_theta} differs from start.theta ({theta}), but the robot only "
+                                      'translates here: add space = "se2" to let it rotate')
+        theta = theta if theta is not None else (goal_theta or 0.0)
 
     robot, kind = v.robot(data.get("robot"), theta, tol)
     obstacles = v.obstacles(data.get("obstacles", []), tol)
     planner = v.planner(data.get("planner", {}))
-    queries = v.queries(data.get("queries", []))
+    queries = v.queries(data.get("queries", []), se2)
 
     sc = Scenario(
         name=name, bounds=bounds, robot=robot, obstacles=obstacles, start=start, goal=goal,
         theta=theta, planner=planner, queries=queries, expect=expect, path=path,
-        robot_kind=kind, disk_tolerance=tol,
+        robot_kind=kind, disk_tolerance=tol, space=space, slabs=slabs,
     )
     probe = CollisionProbe(sc)
     labelled = [(start, "start"), (goal, "goal")]
@@ -223,6 +351,17 @@ def scenario_from_dict(data: dict, path: str = "<scenario>") -> Scenario:
     for pt, fld in labelled:
         v.placement(sc, probe, pt, fld)
     return sc
+
+
+# The state spaces a scenario can ask for, and the largest number of angle slabs.
+SPACES = ("translation", "se2")
+MAX_SLABS = 4096
+
+
+def _short(x, limit: int = 60) -> str:
+    """repr(x), cut to ``limit`` characters (messages stay one short line)."""
+    r = repr(x)
+    return r if len(r) <= limit else r[: limit - 3] + "..."
 
 
 class _Validator:
@@ -262,22 +401,22 @@ class _Validator:
         if x is None:
             raise self.err(field, "missing (a number is required)")
         if isinstance(x, bool) or not isinstance(x, (int, float)):
-            raise self.err(field, f"must be a number, got {type(x).__name__} {x!r}")
+            raise self.err(field, f"must be a number, got {type(x).__name__} {show(x)}")
         try:
             xf = float(x)
         except OverflowError:
-            raise self.err(field, f"{x} is too large for a double") from None
+            raise self.err(field, f"{show(x)} is too large for a double") from None
         if not math.isfinite(xf):
             raise self.err(field, f"must be finite, got {x}")
         if abs(xf) > MAX_MAGNITUDE:
-            raise self.err(field, f"{x} is beyond the supported magnitude 2^400 (about {MAX_MAGNITUDE:.2g})")
+            raise self.err(field, f"{show(x)} is beyond the supported magnitude 2^400 (about {MAX_MAGNITUDE:.2g})")
         if positive and not xf > 0.0:
             raise self.err(field, f"must be positive, got {x}")
         return xf
 
     def point(self, p, field: str) -> tuple[float, float]:
         if not isinstance(p, list) or len(p) != 2:
-            raise self.err(field, f"must be a point [x, y], got {p!r}")
+            raise self.err(field, f"must be a point [x, y], got {show(p)}")
         return self.number(p[0], f"{field}[0]"), self.number(p[1], f"{field}[1]")
 
     def pose(self, t: dict, field: str) -> tuple[tuple[float, float], float | None]:
@@ -361,10 +500,10 @@ class _Validator:
         else:
             raise self.err("robot", "needs polygon, [[robot.parts]] or radius")
         if theta:
-            c, s = math.cos(theta), math.sin(theta)
-            rot = np.array([[c, s], [-s, c]])  # row vectors: p @ rot rotates by +theta
+            from .slab import rotate  # the one rotation used for "the robot at theta"
+
             for sh in shapes:
-                sh.polygon = sh.polygon @ rot
+                sh.polygon = rotate(sh.polygon, theta)
                 if sh.disk is not None:
                     sh.disk = (0.0, 0.0, sh.disk[2])
         return shapes, kind
@@ -386,12 +525,14 @@ class _Validator:
         if "time" in t:
             out["time"] = self.number(t["time"], "planner.time", positive=True)
         if "seed" in t:
-            if isinstance(t["seed"], bool) or not isinstance(t["seed"], int) or t["seed"] < 0:
-                raise self.err("planner.seed", "must be a non-negative integer")
+            if isinstance(t["seed"], bool) or not isinstance(t["seed"], int) or not 0 <= t["seed"] <= MAX_SEED:
+                raise self.err("planner.seed", f"must be an integer in [0, 2^32 - 1), got {show(t['seed'])}")
             out["seed"] = t["seed"]
         return out
 
-    def queries(self, lst) -> list[Query]:
+    def queries(self, lst, se2: bool = False) -> list[Query]:
+        """``start``/``goal`` as ``[x, y]`` or ``{x, y}``; in SE(2) ``[x, y, theta]`` or
+        ``{x, y, theta}`` (theta defaults to 0)."""
         if not isinstance(lst, list):
             raise self.err("queries", "must be an array of tables [[queries]]")
         out = []
@@ -402,26 +543,40 @@ class _Validator:
             self.no_extra(q, f, {"start", "goal"})
             pts = []
             for key in ("start", "goal"):
-                p = q.get(key)
+                p, fk = q.get(key), f"{f}.{key}"
                 if isinstance(p, dict):
-                    self.no_extra(p, f"{f}.{key}", {"x", "y"})
-                    pts.append((self.number(p.get("x"), f"{f}.{key}.x"), self.number(p.get("y"), f"{f}.{key}.y")))
+                    xy, th = self.pose(p, fk)
+                    if th is not None and not se2:
+                        raise self.err(f"{fk}.theta", 'the robot only translates here: add space = "se2" to give '
+                                                      "queries an angle")
+                    pts.append((*xy, wrap_angle(th or 0.0)) if se2 else xy)
                 elif p is None:
-                    raise self.err(f"{f}.{key}", "missing")
+                    raise self.err(fk, "missing")
+                elif se2 and isinstance(p, list) and len(p) == 3:
+                    pts.append((*self.point(p[:2], fk), wrap_angle(self.number(p[2], f"{fk}[2]"))))
+                elif not se2 and isinstance(p, list) and len(p) == 3:
+                    raise self.err(fk, 'has an angle, but the robot only translates here: add space = "se2" '
+                                       "to let it rotate")
                 else:
-                    pts.append(self.point(p, f"{f}.{key}"))
+                    if se2 and not (isinstance(p, list) and len(p) == 2):
+                        raise self.err(fk, f"must be a pose [x, y, theta] (or [x, y]), got {_short(p)}")
+                    xy = self.point(p, fk)
+                    pts.append((*xy, 0.0) if se2 else xy)
             out.append(Query(pts[0], pts[1]))
         return out
 
-    def placement(self, sc: Scenario, probe: "CollisionProbe", pt: tuple[float, float], field: str) -> None:
-        """The reference point must be in bounds and the robot there must touch no obstacle."""
+    def placement(self, sc: Scenario, probe: "CollisionProbe", pt: tuple, field: str) -> None:
+        """The reference point must be in bounds and the robot there (turned by the
+        pose's theta in SE(2)) must touch no obstacle."""
         xmin, xmax, ymin, ymax = sc.bounds
-        x, y = pt
+        x, y = pt[0], pt[1]
+        theta = pt[2] if len(pt) > 2 else 0.0
+        where = f"({x}, {y})" if len(pt) == 2 else f"({x}, {y}, theta {theta})"
         if not (xmin <= x <= xmax and ymin <= y <= ymax):
-            raise self.err(field, f"({x}, {y}) is outside the bounds [{xmin}, {xmax}] x [{ymin}, {ymax}]")
-        hit = probe.first_hit(x, y)
+            raise self.err(field, f"{where} is outside the bounds [{xmin}, {xmax}] x [{ymin}, {ymax}]")
+        hit = probe.first_hit(x, y, theta)
         if hit is not None:
-            raise self.err(field, f"({x}, {y}) puts the robot in collision with obstacles[{hit}]")
+            raise self.err(field, f"{where} puts the robot in collision with obstacles[{hit}]")
 
 
 class CollisionProbe:
@@ -439,12 +594,12 @@ class CollisionProbe:
         self._geoms = [ob.to_shapely() for ob in sc.obstacles]
         self._tree = shapely.STRtree(self._geoms) if self._geoms else None
 
-    def first_hit(self, x: float, y: float) -> int | None:
+    def first_hit(self, x: float, y: float, theta: float = 0.0) -> int | None:
         shapely = self._shapely
         if self._tree is None:
             return None
         if self._sc.robot:
-            body = shapely.union_all([shapely.Polygon(p) for p in self._sc.robot_at(x, y)])
+            body = shapely.union_all([shapely.Polygon(p) for p in self._sc.robot_at(x, y, theta)])
         else:
             body = shapely.Point(x, y)
         hits = self._tree.query(body, predicate="intersects")

@@ -31,6 +31,7 @@ import heapq
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -55,9 +56,13 @@ def free_space(pieces: list, bounds) -> "object":
     """
     import shapely
 
+    from .pathcheck import split_pieces
+
     xmin, xmax, ymin, ymax = map(float, bounds)
     box = shapely.box(xmin, ymin, xmax, ymax)
-    polys = [shapely.Polygon(p) for p in pieces if len(p) >= 3]
+    # Zero-area pieces (points, segments) have no area to subtract: they are handled
+    # by the search (cspace.pathcheck.Degenerate), not here.
+    polys = [shapely.Polygon(p) for p in split_pieces(pieces)[0]]
     if not polys:
         return box
     return shapely.orient_polygons(box.difference(shapely.union_all(polys))) \
@@ -72,29 +77,44 @@ def _orient(geom):
     return shapely.MultiPolygon(parts) if len(parts) != 1 else parts[0]
 
 
-def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = None) -> ShortestPath:
+def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = None,
+                  on_progress: Callable[[int, int, float], None] | None = None) -> ShortestPath:
     """The shortest path from start to goal through the free C-space.
 
     ``time_limit`` (seconds) bounds the search: past it the result is unsolved with
     ``stats["reason"] == "time limit"`` (never a silent wrong answer, never a hang).
+    ``on_progress(settled, nodes, bound)``, when given, is called every
+    :data:`PROGRESS_EVERY` settled nodes and once at the end: nodes settled so far,
+    nodes of the graph, and a lower bound on the shortest length (the f value of the
+    last settled node, which never decreases with a consistent heuristic).
 
     >>> sq = np.array([[1., 0], [2, 0], [2, 2], [1, 2]])
     >>> sp = shortest_path([sq], (0, 3, 0, 3), (0, 1), (3, 1))
     >>> sp.solved, round(sp.length, 12), sp.path.tolist()
     (True, 3.828427124746, [[0.0, 1.0], [1.0, 2.0], [2.0, 2.0], [3.0, 1.0]])
+    >>> calls = []
+    >>> _ = shortest_path([sq], (0, 3, 0, 3), (0, 1), (3, 1), on_progress=lambda *a: calls.append(a))
+    >>> calls[-1][:2], round(calls[-1][2], 12)  # all 4 nodes settled; the bound reached the length
+    ((4, 4), 3.828427124746)
     """
     import shapely
 
+    from .pathcheck import Degenerate, path_violations, split_pieces
+    from .polygon import as_array
+
     t0 = time.perf_counter()
-    s = (float(start[0]), float(start[1]))
-    g = (float(goal[0]), float(goal[1]))
+    pieces = [as_array(p, copy=False, nonempty=True) for p in pieces]  # the one input gate: finite (N, 2) reals
+    s, g = _point(start, "start"), _point(goal, "goal")
+    bounds = tuple(_point(bounds[:2], "bounds")) + tuple(_point(bounds[2:], "bounds"))
     F = free_space(pieces, bounds)
     parts = [p for p in shapely.get_parts(F) if p.geom_type == "Polygon" and not p.is_empty]
     ps, pg = shapely.Point(s), shapely.Point(g)
     comp_s = next((k for k, p in enumerate(parts) if p.covers(ps)), None)
     comp_g = next((k for k, p in enumerate(parts) if p.covers(pg)), None)
     stats = {"counts": {"free_components": len(parts)}}
-    if comp_s is None or comp_g is None:
+    degenerate = split_pieces(pieces)[1]
+    deg = Degenerate(degenerate, parts[comp_s] if comp_s is not None else None) if degenerate else None
+    if comp_s is None or comp_g is None or (deg is not None and (deg.contains(s) or deg.contains(g))):
         stats["reason"] = "start or goal is not in the free C-space"
         stats["time"] = time.perf_counter() - t0
         return ShortestPath(False, np.zeros((0, 2)), math.inf, False, stats)
@@ -107,15 +127,35 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
     if s == g:
         return ShortestPath(True, np.array([s]), 0.0, False, {**stats, "time": time.perf_counter() - t0})
     nodes, tangent_dirs = _reflex_vertices(region)
+    if deg is not None:  # the free tips of zero-area pieces: the path may bend around them
+        stats["counts"]["degenerate_pieces"] = len(degenerate)
+        for tip in deg.wraps:
+            nodes.append(tip)
+            tangent_dirs.append((np.array(tip), np.array(tip)))  # any direction is tangent
     pts = np.array([s, g] + nodes, dtype=np.float64).reshape(-1, 2)
     deadline = None if time_limit is None else t0 + float(time_limit)
-    path, length, counts = _lazy_astar(pts, tangent_dirs, region, deadline)
+    path, length, counts = _lazy_astar(pts, tangent_dirs, region, deadline, on_progress, deg)
     stats["counts"].update(counts, nodes=len(pts))
     stats["time"] = time.perf_counter() - t0
-    if path is None:  # cannot happen for a connected region; reported, never hidden
+    if path is None:  # a connected region has a path, unless zero-area pieces cut it
         stats["reason"] = stats["counts"].pop("stopped", "search exhausted")
         return ShortestPath(False, np.zeros((0, 2)), math.inf, False, stats)
+    # The answer must agree with the pieces' own exact predicates, segment by segment.
+    bad = path_violations(pts[path], pieces, bounds)
+    if bad:
+        stats["reason"] = f"the path failed the exact check against the pieces (edge {bad[0][0]}, piece {bad[0][1]})"
+        return ShortestPath(False, np.zeros((0, 2)), math.inf, False, stats)
     return ShortestPath(True, pts[path], length, False, stats)
+
+
+def _point(p, what: str) -> tuple[float, float]:
+    """(x, y) as two finite floats, else ValueError (NaN and inf never reach the search)."""
+    from .polygon import as_point
+
+    try:
+        return as_point(p)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"shortest_path: {what}: {exc}") from None
 
 
 def _reflex_vertices(region) -> tuple[list, list]:
@@ -143,7 +183,11 @@ def _reflex_vertices(region) -> tuple[list, list]:
     return nodes, nbrs
 
 
-def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None) -> tuple:
+PROGRESS_EVERY = 64  # settled nodes between two progress reports
+
+
+def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None,
+                on_progress: Callable[[int, int, float], None] | None = None, deg=None) -> tuple:
     """A* from node 0 to node 1 over bitangent candidate edges, each checked when popped."""
     import shapely
 
@@ -160,6 +204,8 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
     na = np.array([x[0] for x in nbrs]).reshape(-1, 2)
     nb = np.array([x[1] for x in nbrs]).reshape(-1, 2)
     stopped = None
+    settled = 0
+    bound = float(h[0])
     while heap:
         if deadline is not None and time.perf_counter() > deadline:
             stopped = "time limit"
@@ -170,11 +216,15 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
         if par >= 0:
             tested += 1
             seg = shapely.LineString([pts[par], pts[v]])
-            if not region.covers(seg):
+            if not region.covers(seg) or (deg is not None and deg.blocks(pts[par], pts[v])):
                 continue
         closed[v] = True
         g_best[v] = gv
         parent[v] = par
+        settled += 1
+        bound = f
+        if on_progress is not None and settled % PROGRESS_EVERY == 0:
+            on_progress(settled, n, bound)
         if v == 1:
             break
         cand = np.flatnonzero(~closed)
@@ -188,6 +238,8 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
         for fw, gw_, w in zip((gw + h[cand[keep]]).tolist(), gw.tolist(), cand[keep].tolist()):
             heapq.heappush(heap, (fw, gw_, w, v))
         pushed += int(keep.sum())
+    if on_progress is not None:
+        on_progress(settled, n, bound)
     counts = {"edges_tested": tested, "edges_pushed": pushed}
     if stopped:
         counts["stopped"] = stopped

@@ -2,11 +2,14 @@
 
 This module owns the benchmark sweep: scenarios x planners x time budgets x seeded runs,
 each run isolated in its own process (a planner that segfaults or hangs costs one row,
-recorded as ``crashed`` or ``timeout``, never the sweep), run locally by ``--workers``
-threads that each wait on one child process, or on a Dask cluster (``--scheduler``).
-It also owns the outputs: ``results.csv``, ``results.json``, one OMPL benchmark log per
-(scenario, budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns
-them into the Planner Arena database) and the ``error_vs_time.png`` figure.
+recorded as ``crashed`` or ``timeout``, never the sweep): locally a forked child of this
+process, which built each scenario's C-space once (:mod:`planners.bench_pool`, at most
+``--workers`` at a time), a fresh process where fork is missing, or on a Dask cluster
+(``--scheduler``). Each run calls :func:`planners.plan.plan`, as ``cspace plan`` does.
+Its outputs: ``results.csv``, ``results.json`` and one OMPL benchmark log per (scenario,
+budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns them into the
+Planner Arena database) are written by :mod:`planners.bench_outputs`; the
+``error_vs_time.png`` figure is drawn here.
 
 The reference is the exact shortest path (:mod:`cspace.shortest`), computed once per
 scenario in the parent. It is an infimum (it touches C-obstacle boundaries), so every
@@ -19,13 +22,8 @@ their first solution are).
 """
 from __future__ import annotations
 
-import csv
-import io
-import json
 import math
 import os
-import socket
-import subprocess
 import sys
 import threading
 import time
@@ -38,15 +36,11 @@ DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
 # C-space build, simplification and verification all fit many times over).
 HARD_FACTOR = 2.0
 HARD_MARGIN = 30.0
-# Anytime planners are solved in slices (MIN_SLICE s, doubling up to budget / SLICES) to
-# time their first solution and record the best raw cost along the run.
-SLICES = 20
-MIN_SLICE = 0.002
-SLICED = {"rrtstar", "informedrrtstar", "sorrtstar", "bitstar", "prm", "prmstar"}  # not AORRTC: it crashes
+MAX_BUDGET = 1e6  # seconds per run (11 days); OMPL's clock overflows near 8e9 s
 # Fields of a row, in CSV order. Times in seconds; lengths in scenario units.
 FIELDS = (
     "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
-    "length", "length_unsimplified", "optimum", "error", "error_unsimplified",
+    "length", "length_unsimplified", "optimum", "reference", "error", "error_unsimplified",
     "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks",
     "wall_s", "message",
 )
@@ -75,6 +69,9 @@ def register(sub) -> None:
     p.add_argument("--out", default="bench_out", help="output folder (created if missing)")
     p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on")
     p.add_argument("--no-plot", action="store_true", help="skip error_vs_time.png")
+    from .cli_plan import add_space_options
+
+    add_space_options(p)
     p.add_argument("--quiet", "-q", action="store_true", help="no progress line")
     # Test hook: the child of this (planner, seed) calls os.abort(), as a segfaulting planner would.
     p.add_argument("--abort-on", help=argparse.SUPPRESS)
@@ -121,6 +118,8 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
             raise InputError(source, "--times", f"not a number: {s!r}") from None
         if not (math.isfinite(t) and t > 0):
             raise InputError(source, "--times", f"must be positive seconds, got {s!r}")
+        if t > MAX_BUDGET:
+            raise InputError(source, "--times", f"at most {MAX_BUDGET:g} s per run, got {s!r}")
         if t in out:
             raise InputError(source, "--times", f"budget {s} given twice")
         out.append(t)
@@ -128,8 +127,13 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
 
 
 def run(args) -> int:
+    from .ompl_glue import OMPL_HINT, ompl_available
+
     planners = parse_planners(args.planners)
     times = parse_times(args.times)
+    if not ompl_available():
+        raise InputError("bench", "--planners", f"the bench runs OMPL's planners, and OMPL is not installed "
+                                                f"({OMPL_HINT})")
     if args.runs < 1:
         raise InputError("bench", "--runs", f"must be at least 1, got {args.runs}")
     if args.workers < 1:
@@ -141,18 +145,24 @@ def run(args) -> int:
         name, _, seed = args.abort_on.partition(":")
         abort_on = (parse_planners(name)[0], int(seed or 0))
     out = args.out
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise InputError(out, "--out", "exists and is not a folder")
-    scenarios = reference(args.scenario, quiet=args.quiet)
+    from .output import check_folder
+
+    check_folder(out, "--out")
+    held: dict = {}
+    if args.slabs is not None and not 4 <= args.slabs <= 4096:
+        raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
+    scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
     os.makedirs(out, exist_ok=True)
+    _clear_outputs(out)  # never mix two sweeps in one folder
     tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on)
     t0 = time.perf_counter()
-    rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet)
+    rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
+                              held=held)
     meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
             "iterations": args.iterations, "workers": args.workers, "scheduler": args.scheduler,
             "wall_s": time.perf_counter() - t0, "complete": not interrupted,
             "hard_limit": f"budget * {HARD_FACTOR:g} + {HARD_MARGIN:g} s"}
-    write_outputs(rows, out, meta, plot=not args.no_plot)
+    interrupted = _write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
     if not args.quiet:
         sys.stderr.write(summary(rows) + "\n")
         sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
@@ -160,26 +170,62 @@ def run(args) -> int:
     return 130 if interrupted else 0
 
 
+from .bench_outputs import (  # noqa: E402,F401  (the outputs live there; re-exported)
+    OUTPUTS, _clear_outputs, _write_deferring_sigint, ompl_logs, to_csv, write_outputs,
+)
+
 # ---------------------------------------------------------------- the reference
 
-def reference(files: list[str], quiet: bool = True) -> list[dict]:
-    """Load each scenario and compute its exact shortest path length once.
+def reference(files: list[str], quiet: bool = True, held: dict | None = None, space: str | None = None,
+              slabs: int | None = None) -> list[dict]:
+    """Load each scenario and compute its reference length once.
 
-    Returns ``[{"file", "scenario", "optimum"}]`` (``optimum`` None if no path exists).
-    A missing or malformed file is a ScenarioError (exit 2).
+    Returns ``[{"file", "scenario", "optimum", "reference", "space", "slabs"}]``.
+    Translation: ``optimum`` is the exact shortest path's length (``reference`` is
+    ``"optimum"``; None if no path exists). SE(2) has no exact planner: ``optimum`` is
+    the inscribed-disk lower bound on the reference point's path length
+    (:mod:`planners.se2_bounds`; ``reference`` is ``"lower_bound"``), so a row's
+    ``error = length / lower bound - 1`` is an upper bound on its true error.
+    ``scenario`` is the scenario's name, made unique when two files share a name (the
+    file's name is added), so that the summary, the figure and the logs keep them
+    apart. With ``held``, ``held[file] = (scenario, cspace)`` keeps each built C-space
+    for the runs. A missing or malformed file is a ScenarioError (exit 2).
     """
     from cspace.scenario import load_scenario
 
-    from .plan import plan
+    from .plan import _build_cspace, plan
 
     out = []
     for f in files:
-        sc = load_scenario(f)
-        res = plan(sc, planner="exact")
-        out.append({"file": os.path.abspath(f), "scenario": sc.name,
-                    "optimum": float(res.length) if res.solved else None})
+        full = os.path.abspath(f)
+        if any(o["file"] == full for o in out):
+            raise InputError(f, "scenario", "given twice")
+        sc = load_scenario(f, space=space)
+        if sc.space == "se2":
+            from .se2_bounds import disk_bound
+
+            cs = _build_cspace(sc, slabs)
+            for k in range(cs.slabs):  # built once here, not lazily in every forked run
+                cs.slab(k)
+            db = disk_bound(sc, sc.all_queries()[0])
+            bound = db.lower_bound if math.isfinite(db.lower_bound) else None
+            out.append({"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
+                        "space": "se2", "slabs": cs.slabs})
+            note = f"lower bound {bound:.6g} ({db.message})" if bound else db.message
+        else:
+            res = plan(sc, planner="exact")
+            cs = res.cspace
+            out.append({"file": full, "scenario": sc.name, "optimum": float(res.length) if res.solved else None,
+                        "reference": "optimum", "space": "translation", "slabs": None})
+            note = f"exact shortest path {res.length:.6g} ({res.message})"
+        if held is not None:
+            held[full] = (sc, cs)
         if not quiet:
-            sys.stderr.write(f"{sc.name}: exact shortest path {res.length:.6g} ({res.message})\n")
+            sys.stderr.write(f"{sc.name}: {note}\n")
+    names = [o["scenario"] for o in out]
+    for i, o in enumerate(out):
+        if names.count(o["scenario"]) > 1:
+            o["scenario"] = f"{o['scenario']} ({os.path.relpath(files[i])}, #{i + 1})"
     return out
 
 
@@ -191,78 +237,47 @@ def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None)
             for t in times:
                 for seed in range(runs):
                     tasks.append({"order": [si, pi, t, seed], "file": sc["file"], "scenario": sc["scenario"],
-                                  "optimum": sc["optimum"], "planner": p, "time_budget": t, "seed": seed,
+                                  "optimum": sc["optimum"], "reference": sc.get("reference", "optimum"),
+                                  "space": sc.get("space"), "slabs": sc.get("slabs"),
+                                  "planner": p, "time_budget": t, "seed": seed,
                                   "iterations": iterations, "abort": abort_on == (p, seed)})
     return tasks
 
 
 # ---------------------------------------------------------------- one run (in the child)
 
-def run_one(task: dict) -> dict:
+def run_one(task: dict, scenario=None, cspace=None) -> dict:
     """Plan one seeded run in this process and return its row (status ``ok``).
 
-    The path is simplified and verified exactly as ``cspace plan`` does; a run is
-    solved only if the final path passes the exact segment test.
+    The run goes through :func:`planners.plan.plan`, the routine of ``cspace plan``
+    (anytime planners solved in slices to time the first solution): the path is
+    simplified and verified exactly, and a run is solved only if it passes.
+    ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space.
     """
-    from cspace.cspace import CSpace
     from cspace.scenario import load_scenario
 
-    from .ompl_glue import frame_exponent, make_setup, ompl, path_states, set_query, termination
-    from .plan import _snap, _verify, path_length
+    from .plan import plan
 
     if task.get("abort"):
         os.abort()
-    ob = ompl()[0]
-    sc = load_scenario(task["file"])
-    cs = CSpace.from_scenario(sc)
-    q = sc.all_queries()[0]
+    sc = scenario if scenario is not None else load_scenario(task["file"], space=task.get("space"))
     planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
-    k = frame_exponent(cs.bounds)
-    ss, space, _checker, _validator = make_setup(cs, planner, int(task["seed"]), k)
-    set_query(ss, space, q.start, q.goal, k)
-    p0, m0 = cs.point_count(), cs.checks["segments"]
-    first, progress = None, []
-    t0 = time.perf_counter()
-    if planner.lower() in SLICED and not iters:
-        # Continue the same search slice by slice: same total budget, plus the time
-        # of the first solution (to within one slice) and the best cost along the run.
-        # Slices double from MIN_SLICE up to budget / SLICES, so an early first
-        # solution is timed finely and a long run still takes few slices.
-        step, k = max(budget / SLICES, MIN_SLICE), 0
-        while (left := budget - (time.perf_counter() - t0)) > 0:
-            ss.solve(ob.timedPlannerTerminationCondition(min(step, MIN_SLICE * 2 ** k, left)))
-            k += 1
-            if ss.haveExactSolutionPath():
-                t = time.perf_counter() - t0
-                first = t if first is None else first
-                progress.append([t, ss.getSolutionPath().length()])
-    else:
-        ptc, _keep = termination(budget, iters)
-        ss.solve(ptc)
-        if ss.haveExactSolutionPath():
-            first = time.perf_counter() - t0
-            progress.append([first, ss.getSolutionPath().length()])
-    solve_s = time.perf_counter() - t0
-    checks = cs.point_count() - p0, cs.checks["segments"] - m0
-    found = ss.haveExactSolutionPath()
-    raw = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
-    t1 = time.perf_counter()
-    if found:
-        ss.simplifySolution()
-    simplify_s = time.perf_counter() - t1 if found else 0.0
-    path = _snap(path_states(ss.getSolutionPath(), k), q) if found else None
-    ok, message = _verify(cs, path, q) if found else (False, "no exact solution within the budget")
+    res = plan(sc, planner=planner, time=budget, seed=int(task["seed"]), iterations=iters,
+               cspace=cspace, slices=True, slabs=task.get("slabs") if cspace is None else None)
+    ok = bool(res.solved)
     opt = task["optimum"]
-    length = path_length(path) if ok else None
-    raw_len = path_length(raw) if ok else None
+    length = float(res.length) if ok else None
+    raw_len = res.length_unsimplified if ok else None
     return {
         "scenario": task["scenario"], "file": task["file"], "planner": planner, "time_budget": budget,
-        "seed": int(task["seed"]), "status": "ok", "solved": bool(ok),
+        "seed": int(task["seed"]), "status": "ok", "solved": ok,
         "length": length, "length_unsimplified": raw_len, "optimum": opt,
+        "reference": task.get("reference", "optimum"),
         "error": _error(length, opt), "error_unsimplified": _error(raw_len, opt),
-        "first_solution_s": first if ok else None, "solve_s": solve_s, "simplify_s": simplify_s,
-        "state_checks": int(checks[0]), "motion_checks": int(checks[1]), "wall_s": None,
-        "message": message, "progress": progress,
+        "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings["solve"],
+        "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
+        "motion_checks": int(res.checks["motions"]), "wall_s": None,
+        "message": res.message, "progress": res.progress,
     }
 
 
@@ -275,21 +290,6 @@ def _error(length, optimum):
     if length is None or not optimum:
         return None
     return length / optimum - 1.0
-
-
-def _child_main() -> None:  # pragma: no cover - runs in the child process
-    """Entry of a child process: task JSON on stdin, one marked row line on stdout."""
-    import signal
-
-    task = json.loads(sys.stdin.read())
-    signal.alarm(int(task["hard_limit"]) + 5)  # backstop if the parent died without killing us
-    try:
-        row = run_one(task)
-    except Exception as exc:  # a Python error in the run: recorded, the sweep goes on
-        row = {"status": "crashed", "message": f"{type(exc).__name__}: {exc}"}
-    sys.stdout.write(_MARK + json.dumps(row) + "\n")
-    sys.stdout.flush()
-    os._exit(0)  # skip the bindings' "nanobind: leaked" report at exit
 
 
 # ---------------------------------------------------------------- one run (isolated)
@@ -308,44 +308,10 @@ def hard_limit(budget: float) -> float:
 
 
 def isolated_run(task: dict, limit: float | None = None) -> dict | None:
-    """Run one task in a fresh child process; the row records ``ok``, ``crashed`` or ``timeout``.
+    """Run one task in a fresh process (see :func:`planners.bench_pool.isolated_run`)."""
+    from .bench_pool import isolated_run as run
 
-    A child that dies by a signal, exits without a row or raises is ``crashed``; one
-    still running after ``limit`` seconds (default :func:`hard_limit`) is killed and is
-    ``timeout``. Returns None if the sweep was interrupted meanwhile.
-    """
-    limit = hard_limit(task["time_budget"]) if limit is None else limit
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
-    t0 = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-c", "from planners.bench import _child_main; _child_main()"],
-                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            env=env, start_new_session=True, text=True)
-    _live.add(proc)
-    try:
-        out, err = proc.communicate(json.dumps({**task, "hard_limit": limit}), timeout=limit)
-        status = None
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        out, err = proc.communicate()
-        status = "timeout"
-    finally:
-        _live.discard(proc)
-    if _stop.is_set():
-        return None
-    wall = time.perf_counter() - t0
-    row = None
-    for line in (out or "").splitlines():
-        if line.startswith(_MARK):
-            row = json.loads(line[len(_MARK):])
-    if status == "timeout":
-        row = {"status": "timeout", "message": f"killed after {limit:g} s"}
-    elif row is None:
-        code = proc.returncode
-        how = f"signal {-code}" if code < 0 else f"exit code {code}"
-        tail = (err or "").strip().splitlines()
-        row = {"status": "crashed", "message": f"child died ({how})" + (f": {tail[-1][:200]}" if tail else "")}
-    return _complete(task, row, wall)
+    return run(task, limit)
 
 
 def _complete(task: dict, row: dict, wall: float) -> dict:
@@ -353,7 +319,7 @@ def _complete(task: dict, row: dict, wall: float) -> dict:
     base = {f: None for f in FIELDS}
     base.update({"scenario": task["scenario"], "file": task["file"], "planner": task["planner"],
                  "time_budget": task["time_budget"], "seed": task["seed"], "optimum": task["optimum"],
-                 "solved": False, "progress": []})
+                 "reference": task.get("reference", "optimum"), "solved": False, "progress": []})
     base.update(row)
     base["wall_s"] = wall
     base["order"] = task["order"]
@@ -363,18 +329,34 @@ def _complete(task: dict, row: dict, wall: float) -> dict:
 # ---------------------------------------------------------------- the sweep
 
 def sweep(tasks: list[dict], workers: int = 1, scheduler: str | None = None,
-          progress: bool = False) -> tuple[list[dict], bool]:
+          progress: bool = False, held: dict | None = None) -> tuple[list[dict], bool]:
     """Run every task; returns ``(rows sorted in task order, interrupted)``.
 
-    Ctrl-C stops the sweep: running children are killed, finished rows are kept.
+    With ``held`` (file -> (scenario, cspace), from :func:`reference`) and ``os.fork``,
+    runs are forked children of this process (:mod:`planners.bench_pool`); otherwise
+    (or on a Dask cluster) each run is a fresh process. Ctrl-C stops the sweep:
+    running children are killed, finished rows are kept.
     """
+    from .bench_pool import CAN_FORK, run_forked
+
     _stop.clear()
     rows: list[dict] = []
     bar = _Progress(len(tasks), progress)
     interrupted = False
+
+    def on_row(task, row, wall):
+        rows.append(_complete(task, row, wall))
+        bar.step(rows[-1])
+
     try:
         if scheduler:
             _sweep_dask(tasks, scheduler, rows, bar)
+        elif held is not None and CAN_FORK and all(t["file"] in held for t in tasks):
+            from . import plan as _plan  # noqa: F401  (imported once, before forking)
+            from .ompl_glue import ompl
+
+            ompl()
+            run_forked(tasks, held, workers, lambda t: hard_limit(t["time_budget"]), on_row)
         else:
             _sweep_local(tasks, workers, rows, bar)
     except KeyboardInterrupt:
@@ -459,136 +441,6 @@ class _Progress:
             sys.stderr.write("\n")
 
 
-# ---------------------------------------------------------------- outputs
-
-def write_outputs(rows: list[dict], out: str, meta: dict, plot: bool = True) -> None:
-    """Write results.csv, results.json, the OMPL logs and (optionally) the figure, each atomically."""
-    from .output import write_json, write_text
-
-    write_text(os.path.join(out, "results.csv"), to_csv(rows))
-    write_json(os.path.join(out, "results.json"), {"meta": _clean(meta), "fields": list(FIELDS),
-                                                   "rows": [_clean(r) for r in rows]})
-    logs = os.path.join(out, "ompl")
-    os.makedirs(logs, exist_ok=True)
-    for name, text in ompl_logs(rows, meta).items():
-        write_text(os.path.join(logs, name), text)
-    if plot and rows:
-        plot_error_vs_time(rows, os.path.join(out, "error_vs_time.png"))
-
-
-def _clean(x):
-    """JSON-safe copy: non-finite floats become None."""
-    if isinstance(x, float):
-        return x if math.isfinite(x) else None
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    return x
-
-
-def to_csv(rows: list[dict]) -> str:
-    """The rows as CSV text with the :data:`FIELDS` header (missing values empty).
-
-    >>> to_csv([]).strip() == ",".join(FIELDS)
-    True
-    """
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(FIELDS)
-    for r in rows:
-        w.writerow(["" if r.get(f) is None else (repr(r[f]) if isinstance(r[f], float) else r[f]) for f in FIELDS])
-    return buf.getvalue()
-
-
-# OMPL's benchmark log (the format ompl_benchmark_statistics.py parses): one
-# experiment per file, so one file per (scenario, time budget).
-_ENUM = ("status|Unknown status|Invalid start|Invalid goal|Unrecognized goal type|Timeout|"
-         "Approximate solution|Exact solution|Crash|Abort|Infeasible")
-_RUN_PROPS = (
-    ("time", "REAL", "solve_s"), ("solved", "BOOLEAN", "solved"), ("status", "ENUM", None),
-    ("correct solution", "BOOLEAN", "solved"), ("solution length", "REAL", "length_unsimplified"),
-    ("simplified solution length", "REAL", "length"), ("simplification time", "REAL", "simplify_s"),
-    ("optimum", "REAL", "optimum"), ("error", "REAL", "error"), ("first solution time", "REAL", "first_solution_s"),
-    ("state checks", "INTEGER", "state_checks"), ("motion checks", "INTEGER", "motion_checks"),
-    ("seed", "INTEGER", "seed"), ("wall time", "REAL", "wall_s"),
-)
-
-
-def _status_code(row: dict) -> int:
-    """Index into the status enum: exact solution, timeout, crash or abort (killed)."""
-    if row["status"] == "crashed":
-        return 7
-    if row["status"] == "timeout":
-        return 8
-    return 6 if row["solved"] else 4
-
-
-def _val(v) -> str:
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "nan"
-    if isinstance(v, bool):
-        return str(int(v))
-    return repr(v) if isinstance(v, float) else str(v)
-
-
-def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
-    """OMPL benchmark logs ``{file name: text}``, one per (scenario, time budget).
-
-    Planners appear as ``geometric_NAME``; the runs table gets the columns of
-    ``_RUN_PROPS``; anytime runs add a progress table (time, best raw cost).
-    """
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        ver = version("ompl")
-    except PackageNotFoundError:  # pragma: no cover
-        ver = "0.0.0"
-    groups: dict = {}
-    for r in rows:
-        groups.setdefault((r["scenario"], r["time_budget"]), []).append(r)
-    out = {}
-    date = time.strftime("%Y-%m-%d %H:%M:%S")
-    for (scen, budget), rs in groups.items():
-        planners: dict = {}
-        for r in rs:
-            planners.setdefault(r["planner"], []).append(r)
-        opt = rs[0]["optimum"]
-        lines = [f"OMPL version {ver}", f"Experiment {_token(scen)}_t{budget:g}",
-                 "2 experiment properties", f"optimum REAL = {_val(opt)}", f"budget REAL = {budget!r}",
-                 f"Running on {socket.gethostname()}", f"Starting at {date}",
-                 "<<<|", f"cspace bench: scenario {scen} ({rs[0]['file']}), budget {budget:g} s, "
-                         f"error against the exact shortest path", "|>>>",
-                 "<<<|", "|>>>", "0 is the random seed", f"{budget!r} seconds per run", "0 MB per run",
-                 f"{max(len(v) for v in planners.values())} runs per planner",
-                 f"{sum(r['wall_s'] or 0.0 for r in rs)!r} seconds spent to collect the data",
-                 "1 enum types", _ENUM, f"{len(planners)} planners"]
-        for p, prs in planners.items():
-            lines += [f"geometric_{p}", "0 common properties", f"{len(_RUN_PROPS)} properties for each run"]
-            lines += [f"{name} {kind}" for name, kind, _ in _RUN_PROPS]
-            lines.append(f"{len(prs)} runs")
-            for r in prs:
-                vals = [str(_status_code(r)) if key is None and name == "status" else _val(r.get(key))
-                        for name, _, key in _RUN_PROPS]
-                lines.append("; ".join(vals) + "; ")
-            if any(r.get("progress") for r in prs):
-                lines += ["2 progress properties", "time REAL", "best cost REAL", f"{len(prs)} runs"]
-                for r in prs:
-                    lines.append("".join(f"{t!r},{c!r},;" for t, c in (r.get("progress") or [])))
-            lines.append(".")
-        out[f"{_token(scen)}_t{budget:g}.log"] = "\n".join(lines) + "\n"
-    return out
-
-
-def _token(name: str) -> str:
-    """A name safe as one whitespace-free token and file name.
-
-    >>> _token("maze 8x8/a")
-    'maze_8x8_a'
-    """
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in str(name)) or "scenario"
-
-
 # ---------------------------------------------------------------- statistics and the figure
 
 def curves(rows: list[dict]) -> dict:
@@ -624,11 +476,15 @@ def curves(rows: list[dict]) -> dict:
 def summary(rows: list[dict]) -> str:
     """A table: median error and success rate at the largest budget, per scenario and planner."""
     cs = curves(rows)
+    bounded = {r["scenario"] for r in rows if r.get("reference") == "lower_bound"}
     lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'success':>8}"]
     for (scen, p), c in cs.items():
         m = c["median"][-1]
-        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {'-' if m is None else f'{m:.4f}':>13} "
-                     f"{c['success'][-1]:>8.0%}")
+        text = "-" if m is None else (f"<= {m:.4f}" if scen in bounded else f"{m:.4f}")
+        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} {c['success'][-1]:>8.0%}")
+    if bounded:
+        lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
+                     "bound on the error")
     return "\n".join(lines)
 
 

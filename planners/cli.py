@@ -12,8 +12,9 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 
-from cspace.scenario import ScenarioError
+from cspace.scenario import ScenarioError, clip
 
 COMMANDS = {
     "plan": "planners.cli_plan",
@@ -25,8 +26,8 @@ COMMANDS = {
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2, like every other input fault
-        sys.stderr.write(f"error: {self.prog}: {message}\n")
+    def error(self, message):  # one short line, exit 2, like every other input fault
+        sys.stderr.write(f"error: {self.prog}: {clip(message, 240)}\n")
         sys.exit(2)
 
 
@@ -93,7 +94,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser(first if first in COMMANDS else None)
     args = parser.parse_args(argv)
     try:
-        code = args.run(args)
+        with warnings.catch_warnings():
+            if not getattr(args, "verbose", False):  # numpy/matplotlib chatter is not for the terminal
+                warnings.simplefilter("ignore")
+            code = args.run(args)
     except ScenarioError as exc:
         sys.stderr.write(f"error: {exc}\n")
         code = 2
@@ -106,7 +110,8 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # a bug, not bad input: still one line unless --verbose
         if getattr(args, "verbose", False):
             raise
-        sys.stderr.write(f"internal error: {type(exc).__name__}: {exc} (run with --verbose for the traceback)\n")
+        sys.stderr.write(f"internal error: {type(exc).__name__}: {clip(str(exc), 240)} "
+                         "(run with --verbose for the traceback)\n")
         code = 3
     return code
 

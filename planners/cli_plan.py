@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import sys
 
-from .output import PLOT_FORMATS, check_output, write_json
+from .ompl_glue import OMPL_HINT, ompl_available
+from .output import PLOT_FORMATS, check_distinct, check_output, write_json
 
 
 def register(sub) -> None:
     p = sub.add_parser("plan", help="plan a collision-free path for a scenario",
-                       description="Plan a path for a translating robot; exit 0 solved, 1 not solved, 2 bad input.")
+                       description="Plan a path for a translating (or, with --space se2, rotating) robot; "
+                                   "exit 0 solved, 1 not solved, 2 bad input.")
     p.add_argument("scenario", help="scenario TOML file")
     p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, else RRTConnect")
     p.add_argument("--time", type=number, help="time limit in seconds; default: the scenario's, else 1")
@@ -16,10 +18,21 @@ def register(sub) -> None:
     p.add_argument("--iterations", type=integer, help="also stop after this many planner iterations (deterministic budget)")
     p.add_argument("--all-queries", action="store_true", help="plan every [[queries]] entry on one C-space")
     p.add_argument("--no-simplify", action="store_true", help="keep the planner's raw path")
+    add_space_options(p)
     p.add_argument("--plot", help="save a picture of the path (.png, .svg or .pdf)")
+    p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
     p.add_argument("--json", help="write the result as JSON")
     p.add_argument("--verbose", "-v", action="store_true", help="print the C-space report and OMPL's messages")
     p.set_defaults(run=run)
+
+
+def add_space_options(p) -> None:
+    """``--space`` and ``--slabs`` (plan, show and bench share them)."""
+    p.add_argument("--space", choices=("translation", "se2"),
+                   help="state space: translation (the robot keeps its angle) or se2 (it also rotates); "
+                        "default: the scenario's, else translation")
+    p.add_argument("--slabs", type=integer, help="SE(2): angle slabs of the sliced C-space (default: derived "
+                                                 "from the robot and the scene)")
 
 
 def number(s: str) -> float:
@@ -31,6 +44,8 @@ def integer(s: str) -> int:
 
 
 def run(args) -> int:
+    from cspace.scenario import check_input
+
     from .errors import InputError
 
     src = args.scenario
@@ -40,46 +55,87 @@ def run(args) -> int:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
-    fmt = check_output(args.plot, "--plot", PLOT_FORMATS) if args.plot else None
-    if args.json:
-        check_output(args.json, "--json")
+    if args.slabs is not None and not 4 <= args.slabs <= 4096:
+        raise InputError(src, "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
+    from .ompl_glue import MAX_TIME, SEED_LIMIT, planner_name
+
+    if args.time is not None and args.time > MAX_TIME:
+        raise InputError(src, "--time", f"at most {MAX_TIME:g} s (OMPL's clock overflows near 8e9 s), got {args.time:g}")
+    if args.seed is not None and args.seed >= SEED_LIMIT:
+        raise InputError(src, "--seed", f"must be below 2^32 - 1 (OMPL's seeds are 32-bit), got {args.seed}")
+    if args.planner is not None:
+        args.planner = planner_name(args.planner, src, "--planner")
+        if args.planner != "exact" and not ompl_available():
+            raise InputError(src, "--planner", f"{args.planner} needs OMPL, which is not installed "
+                             f"({OMPL_HINT}); --planner exact works without it")
+    elif not ompl_available():
+        sys.stderr.write("note: OMPL is not installed: planning with the exact planner instead "
+                         f"({OMPL_HINT})\n")
+        args.planner = "exact"
+    check_input(src)
+    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[src]) if args.plot is not None else None
+    if args.animate is not None:
+        check_output(args.animate, "--animate", {".gif": "gif"}, inputs=[src])
+    if args.json is not None:
+        check_output(args.json, "--json", inputs=[src])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate")])
     from .plan import plan
 
-    if args.verbose:
+    if args.verbose and args.planner != "exact":
         from .ompl_glue import ompl
 
         ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
     res = plan(src, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
-               simplify=not args.no_simplify, all_queries=args.all_queries)
+               simplify=not args.no_simplify, all_queries=args.all_queries,
+               space=args.space, slabs=args.slabs)
     print(summary(res, verbose=args.verbose))
-    if args.json:
-        write_json(args.json, res.as_dict())
-    if args.plot:
+    if args.json is not None:
+        write_json(args.json, res.as_dict(), "--json")
+    if args.plot is not None:
         from .plot import plot_result
 
         plot_result(res, args.plot, fmt=fmt)
+    if args.animate and res.solved:
+        from .animate import animate_path
+
+        animate_path(res, args.animate)
+    elif args.animate:
+        sys.stderr.write(f"note: --animate {args.animate}: nothing to animate (not solved)\n")
     results = res.queries or [res]
     return 0 if all(r.solved for r in results) else 1
 
 
 def summary(res, verbose: bool = False) -> str:
-    """A short human summary of a plan."""
+    """A short human summary of a plan.
+
+    With several queries: one line per query (with its own stage times), then the
+    count, then the whole run's total on a line of its own.
+    """
     lines = []
     results = res.queries or [res]
     for i, r in enumerate(results):
         tag = f"{r.scenario}" + (f" query {i}" if res.queries else "")
+        by = "exact" if r.planner == "exact" else f"{r.planner} (seed {r.seed})"
         if r.solved:
-            lines.append(f"{tag}: solved by {r.planner} (seed {r.seed}): length {r.length:.6g}, "
+            lines.append(f"{tag}: solved by {by}: length {r.length:.6g}, "
                          f"{len(r.path)} waypoints, solve {r.timings.get('solve', 0.0) * 1e3:.1f} ms")
+        elif r.planner == "exact" and "proven unsolvable" in r.message:
+            lines.append(f"{tag}: proven unsolvable (start and goal are in different free components)")
+        elif r.planner == "exact":
+            lines.append(f"{tag}: NOT solved by exact: {r.message}")
         else:
-            lines.append(f"{tag}: NOT solved by {r.planner} (seed {r.seed}) within the limit: {r.message}")
+            lines.append(f"{tag}: NOT solved by {by} within the limit: {r.message}")
     if res.queries:
+        for i, r in enumerate(res.queries):
+            lines.append(f"query {i} time: " + _times(r.timings, skip=("load", "cspace", "total")))
         n = sum(r.solved for r in res.queries)
         lengths = [r.length for r in res.queries if r.solved]
-        mean = sum(lengths) / len(lengths) if lengths else float("nan")
-        lines.append(f"{n}/{len(res.queries)} queries solved, mean length {mean:.6g}")
-    t = res.timings
-    lines.append("time: " + ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in t.items()))
+        mean = f", mean length {sum(lengths) / len(lengths):.6g}" if lengths else ""
+        lines.append(f"{n}/{len(res.queries)} queries solved{mean}")
+        t = res.timings
+        lines.append("total time: " + _times({k: t[k] for k in ("load", "cspace", "total") if k in t}))
+    else:
+        lines.append("time: " + _times(res.timings))
     lines.append("stages: " + " -> ".join(res.stages))
     if verbose and res.cspace_report:
         rep = res.cspace_report
@@ -92,3 +148,12 @@ def summary(res, verbose: bool = False) -> str:
             lines.append(f"  {s['stage']:<20} {state:<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
         lines.append(f"checks: {res.checks}")
     return "\n".join(lines)
+
+
+def _times(t: dict, skip=()) -> str:
+    """``name 1.2 ms, ...`` for a timings dict.
+
+    >>> _times({"solve": 0.0012, "total": 0.5}, skip=("total",))
+    'solve 1.2 ms'
+    """
+    return ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in t.items() if k not in skip)

@@ -19,17 +19,26 @@ import numpy as np
 from .plan import PlanResult
 
 
-def exact_plan(sc, cspace, query, time_limit: float | None = None) -> PlanResult:
-    """Shortest path for one query on a built C-space (search bounded by ``time_limit``)."""
+def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: bool | None = None) -> PlanResult:
+    """Shortest path for one query on a built C-space (search bounded by ``time_limit``).
+
+    A search that lasts longer than :data:`planners.progress.DELAY` shows a bar on a terminal
+    (nodes settled, and a lower bound on the length that rises towards the answer);
+    ``progress=False`` silences it, ``None`` draws it only when stderr is a terminal.
+    """
     from cspace.shortest import shortest_path as geometric_shortest
 
+    from . import progress as pg
+
     t = time.perf_counter()
-    sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit)
+    with pg.progress(None, "exact search", enabled=progress, unit="node", delay=pg.DELAY, tick=1.0) as bar:
+        sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit,
+                                on_progress=pg.search_reporter(bar) if bar.shown else None)
     dt = time.perf_counter() - t
     if sp.solved:
         message = "exact shortest path (touches C-obstacle boundaries where it bends)"
     elif sp.proven_unsolvable:
-        message = "proven unsolvable: start and goal lie in different free components"
+        message = "proven unsolvable (start and goal are in different free components)"
     else:
         message = f"no path found ({sp.stats.get('reason', 'search exhausted')})"
     return PlanResult(
@@ -52,3 +61,24 @@ def shortest_path(scenario, query_index: int = 0) -> PlanResult:
 
     return plan(scenario, planner="exact", all_queries=query_index > 0) if query_index == 0 else \
         plan(scenario, planner="exact", all_queries=True).queries[query_index]
+
+
+def exact_se2(sc, query, source: str, time_limit: float | None = None) -> PlanResult:
+    """``exact`` for a rotating robot: there is no exact SE(2) planner, but the inscribed-disk
+    rule (:mod:`planners.se2_bounds`) may prove the query unsolvable; then the result says
+    so (not solved, exit 1). Otherwise a ScenarioError on ``planner`` (exit 2) says what to
+    use instead."""
+    from cspace.scenario import ScenarioError
+
+    from .se2_bounds import disk_bound
+
+    db = disk_bound(sc, query, time_limit=time_limit if time_limit is not None else 10.0)
+    if not db.proven_unsolvable:
+        raise ScenarioError(source, "planner", "there is no exact planner for a rotating robot (space = \"se2\"); "
+                            "the inscribed-disk rule did not prove the scene unsolvable either: use a sampling "
+                            "planner such as RRTConnect")
+    return PlanResult(
+        scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, planner="exact",
+        seed=0, timings={"solve": db.seconds}, checks={}, stages=["disk_bound"], start=tuple(query.start),
+        goal=tuple(query.goal), message=db.message,
+    )

@@ -1,30 +1,55 @@
-"""OMPL glue: the state space, the validity checker and motion validator over a C-space.
+"""OMPL glue: importing OMPL, the planner names, the setup, the query and the budget.
 
-This module owns everything that touches OMPL's objects. OMPL never sees geometry:
-the validity checker asks :meth:`cspace.CSpace.is_free_xy`, the motion validator asks
-the exact :meth:`cspace.CSpace.segment_free` (no sampling along the segment, so a thin
-obstacle cannot be tunnelled through), and the clearance goes through GJK.
+OMPL never sees geometry: the state-space adapter (:mod:`planners.spaces`) gives the
+state space, the validity checker (the C-space's exact point test) and the motion
+validator (the exact segment test: no sampling along the segment, so a thin obstacle
+cannot be tunnelled through).
 """
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import sys
 
 from cspace.scenario import ScenarioError
 
+from .spaces import frame_exponent  # noqa: F401  (re-exported: scripts use it from here)
+
 _ompl = None
 
 
+OMPL_HINT = ("OMPL 2 has wheels for Linux and macOS 15 on Python 3.10-3.13: "
+             "pip install 'ompl>=2.0.1,<3'")
+
+
+class OMPLNotInstalled(ModuleNotFoundError):
+    """A sampling planner was asked for, but the ``ompl`` package cannot be imported."""
+
+
+def ompl_available() -> bool:
+    """Whether OMPL can be imported here (the exact planner works either way)."""
+    try:
+        ompl()
+    except OMPLNotInstalled:
+        return False
+    return True
+
+
 def ompl():
-    """Import OMPL once, silence its logging, and return ``(base, geometric, util)``."""
+    """Import OMPL once, silence its logging, and return ``(base, geometric, util)``.
+
+    Without OMPL: :class:`OMPLNotInstalled`, saying how to get it.
+    """
     global _ompl
     if _ompl is None:
-        with _quiet_fd(2):
-            from ompl import base as ob
-            from ompl import geometric as og
-            from ompl import util as ou
+        try:
+            with _quiet_fd(2):
+                from ompl import base as ob
+                from ompl import geometric as og
+                from ompl import util as ou
+        except ImportError as exc:
+            raise OMPLNotInstalled(f"the sampling planners need OMPL, which is not installed ({OMPL_HINT})",
+                                   name="ompl") from exc
         ou.setLogLevel(ou.LOG_NONE)
         _ompl = (ob, og, ou)
     return _ompl
@@ -75,70 +100,58 @@ def planner_name(name: str | None, source: str = "<options>", field: str = "plan
     return canon
 
 
-def frame_exponent(bounds) -> int:
-    """The power of two k OMPL's states are scaled by: 0 for scenes of ordinary size.
+def make_setup(space, planner: str, seed: int, k: int = 0, query: int = 0):
+    """A configured ``SimpleSetup`` over a state-space adapter (:mod:`planners.spaces`)
+    with the named planner, seeded with query ``query``'s stream (:func:`ompl_seed`).
 
-    OMPL has absolute thresholds (a longest valid segment must exceed machine epsilon,
-    the goal is reached within ``GOAL_THRESHOLD``), so a scene 1e-17 across cannot be
-    planned as it is. Scenes whose extent leaves [2^-20, 2^100] are planned in a frame
-    scaled by 2^k to an extent near 1: exact, so the C-space's answers, and so the
-    path (scaled back), are the same. The hot path pays nothing when k is 0.
-
-    >>> frame_exponent((0.0, 10.0, 0.0, 10.0)), frame_exponent((0.0, 1e-17, 0.0, 1e-17))
-    (0, 56)
+    ``space`` may also be a bare C-space (then a :class:`~planners.spaces.TranslationSpace`
+    with frame exponent ``k`` is made). Returns ``(setup, ompl_space, checker, validator)``;
+    keep the last two alive as long as the setup is used (OMPL holds them by reference).
     """
-    xmin, xmax, ymin, ymax = map(float, bounds)
-    extent = max(xmax - xmin, ymax - ymin)
-    if not (0.0 < extent < math.inf) or 2.0**-20 <= extent <= 2.0**100:
-        return 0
-    return -math.frexp(extent)[1]
+    from .spaces import TranslationSpace
 
-
-def make_setup(cspace, planner: str, seed: int, k: int = 0):
-    """A configured ``SimpleSetup`` over ``cspace`` with the named planner, seeded,
-    its states scaled by 2^k (:func:`frame_exponent`).
-
-    Returns ``(setup, space, checker, validator)``; keep the last two alive as long
-    as the setup is used (OMPL holds them by reference).
-    """
+    adapter = space if hasattr(space, "state_space") else TranslationSpace(space, k)
     ob, og, ou = ompl()
-    # OMPL ignores seed 0, so user seeds map to seed + 1. Re-seeding before any
-    # RNG is created makes every plan with the same seed draw the same samples.
+    # OMPL ignores seed 0, so user seeds map to seed + 1 (see :func:`ompl_seed`).
+    # Re-seeding before any RNG is created makes every plan with the same seed draw
+    # the same samples.
     with _quiet_fd(2):
-        ou.RNG.setSeed(int(seed) + 1)
-    space = ob.RealVectorStateSpace(2)
-    xmin, xmax, ymin, ymax = (math.ldexp(float(v), k) for v in cspace.bounds)
-    bounds = ob.RealVectorBounds(2)
-    bounds.setLow(0, xmin)
-    bounds.setHigh(0, xmax)
-    bounds.setLow(1, ymin)
-    bounds.setHigh(1, ymax)
-    space.setBounds(bounds)
-    ss = og.SimpleSetup(space)
+        ou.RNG.setSeed(ompl_seed(seed, query))
+    ospace = adapter.state_space()
+    ss = og.SimpleSetup(ospace)
     si = ss.getSpaceInformation()
-    checker = validity_function(cspace, k)
+    checker = adapter.validity()
     ss.setStateValidityChecker(checker)
-    validator = _validator_class()(si, cspace, k)
+    validator = adapter.motion_validator(si)
     si.setMotionValidator(validator)
     ss.setPlanner(getattr(og, planner)(si))
-    return ss, space, checker, validator
+    return ss, ospace, checker, validator
 
 
-_classes: dict = {}
+SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit and must not be 0
+
+
+def ompl_seed(seed: int, query: int = 0) -> int:
+    """OMPL's seed for a user seed and a query index: its own stream per query.
+
+    Query 0 gets ``seed + 1`` (OMPL ignores 0), so a single plan and the first query of
+    a multi-query plan draw the same samples; later queries get well-mixed seeds.
+
+    >>> ompl_seed(0), ompl_seed(7), ompl_seed(0, 1) != ompl_seed(1, 0)
+    (1, 8, True)
+    """
+    if query == 0:
+        return int(seed) % SEED_LIMIT + 1
+    mixed = (int(seed) * 0x9E3779B1 + int(query) * 0x85EBCA77 + 0x165667B1) % (2**32)
+    return mixed % SEED_LIMIT + 1
 
 
 def validity_function(cspace, k: int = 0):
-    """The state validity checker: a plain function, the cheapest callback OMPL can call.
+    """The state validity checker of a translation C-space (see
+    :meth:`planners.spaces.TranslationSpace.validity`)."""
+    from .spaces import TranslationSpace
 
-    (A ``StateValidityChecker`` subclass costs about 0.15 us more per state from Python;
-    :func:`clearance_checker` provides one, with ``clearance``, for the planners that
-    ask for it.) States scaled by 2^k are scaled back first.
-    """
-    if k:
-        test = cspace.point_test(cspace._points.__next__)
-        return lambda s: test(math.ldexp(s[0], -k), math.ldexp(s[1], -k))
-    # The test reads ``state[0], state[1]`` itself: one Python frame per state, not two.
-    return cspace.point_test(cspace._points.__next__, state=True)
+    return TranslationSpace(cspace, k).validity()
 
 
 def clearance_checker(si, cspace):
@@ -164,55 +177,52 @@ def clearance_checker(si, cspace):
     return _classes["checker"](si, cspace)
 
 
-def _validator_class():
-    if "validator" not in _classes:
-        ob = ompl()[0]
-
-        class ExactMotionValidator(ob.MotionValidator):
-            """A motion is valid iff the closed segment lies in the free C-space (exact)."""
-
-            def __init__(self, si, cspace, k: int = 0):
-                super().__init__(si)
-                self.segment_free = cspace.segment_free
-                self.k = k
-
-            def checkMotion(self, s1, s2, *rest):
-                if self.k:  # states scaled by 2^k (exactly): back to the C-space's frame
-                    k = -self.k
-                    ok = self.segment_free((math.ldexp(s1[0], k), math.ldexp(s1[1], k)),
-                                           (math.ldexp(s2[0], k), math.ldexp(s2[1], k)))
-                else:
-                    ok = self.segment_free((s1[0], s1[1]), (s2[0], s2[1]))
-                if rest and not ok:  # the (s1, s2, lastValid) form: report no progress
-                    with contextlib.suppress(Exception):
-                        rest[0].second = 0.0
-                return ok
-
-        _classes["validator"] = ExactMotionValidator
-    return _classes["validator"]
-
-
+_classes: dict = {}
 GOAL_THRESHOLD = 1e-9
 
 
-def set_query(ss, space, start, goal, k: int = 0) -> None:
-    """Set the start and goal states, scaled by 2^k, the goal reached within
+def set_query(ss, adapter, start, goal) -> None:
+    """Set the start and goal poses through the adapter, the goal reached within
     ``GOAL_THRESHOLD`` (the rest of the way is appended and verified exactly)."""
+    space = ss.getStateSpace()
     s = space.allocState()
-    s[0], s[1] = math.ldexp(float(start[0]), k), math.ldexp(float(start[1]), k)
+    adapter.set_state(s, start)
     g = space.allocState()
-    g[0], g[1] = math.ldexp(float(goal[0]), k), math.ldexp(float(goal[1]), k)
+    adapter.set_state(g, goal)
     ss.setStartAndGoalStates(s, g, GOAL_THRESHOLD)
 
 
-def termination(time_limit: float, iterations: int | None = None):
-    """Stop at the time limit, or after ``iterations`` planner iterations if given.
+MAX_TIME = 1e8  # seconds; OMPL's clock (int64 nanoseconds from now) overflows near 8e9 s
 
-    OMPL evaluates the condition once per planner iteration, so an iteration budget
-    is deterministic where a time budget is not (for anytime planners).
+
+def clamp_time(t: float) -> float:
+    """A time limit OMPL's clock can hold (at most ``MAX_TIME``, at least 0).
+
+    >>> clamp_time(1e10), clamp_time(-1.0), clamp_time(0.5)
+    (100000000.0, 0.0, 0.5)
+    """
+    return min(max(float(t), 0.0), MAX_TIME)
+
+
+def configure(planner, name: str, iterations: int | None) -> None:
+    """Planner settings that carry an iteration budget: FMT and BFMT sample that many states.
+
+    (See :mod:`planners.routine` for what ``iterations`` means per planner.)
+    """
+    if iterations and name.lower() in ("fmt", "bfmt"):
+        planner.setNumSamples(int(iterations))
+
+
+def termination(time_limit: float, iterations: int | None = None):
+    """Stop at the time limit, or after ``iterations`` evaluations of the condition if given.
+
+    Most planners evaluate the condition once per iteration of their main loop, so an
+    iteration budget is deterministic where a time budget is not. The counting
+    condition is a Python function: never hand it to a planner that evaluates it on
+    a thread of its own (PRM's solution thread: deadlock on the interpreter lock).
     """
     ob = ompl()[0]
-    timed = ob.timedPlannerTerminationCondition(float(time_limit))
+    timed = ob.timedPlannerTerminationCondition(clamp_time(time_limit))
     if not iterations:
         return timed, None
     count = [0]
@@ -226,7 +236,7 @@ def termination(time_limit: float, iterations: int | None = None):
 
 
 def path_states(path, k: int = 0) -> list[tuple[float, float]]:
-    """States of an OMPL PathGeometric as (x, y) tuples, scaled back by 2^-k."""
-    if k:
-        return [(math.ldexp(s[0], -k), math.ldexp(s[1], -k)) for s in path.getStates()]
-    return [(s[0], s[1]) for s in path.getStates()]
+    """States of a 2-D OMPL PathGeometric as (x, y) tuples, scaled back by 2^-k."""
+    import math
+
+    return [(math.ldexp(s[0], -k), math.ldexp(s[1], -k)) for s in path.getStates()]

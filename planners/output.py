@@ -1,78 +1,272 @@
-"""Writing outputs safely: to a temporary file beside the target, then an atomic rename.
+"""Writing outputs safely: checked before any work, then written so nothing is lost.
 
-This module owns output paths: their early validation (so a bad ``--json`` or
-``--plot`` path fails before any work, with a one-line error) and atomic writes
-(so an interrupted run never leaves a half-written file, and an existing file is
-replaced only by a complete one).
+This module owns output paths:
+
+- **Early validation** (:func:`check_output`), before any work, one-line errors:
+  an empty path, a folder, a path under a file, a missing or unwritable folder
+  (probed by creating and removing a temporary file there, which also catches
+  ``/proc`` and read-only mounts), a block device or socket, and an output that is
+  one of the inputs (same file, also through a symbolic or hard link: compared by
+  device and inode) are all refused.
+- **What a path is decides how it is written** (:func:`atomic_path`):
+  a regular file (or a new name) is written atomically: to an unnamed temporary
+  file in the target's folder (Linux ``O_TMPFILE``), which is given a name only
+  once complete and renamed over the target at once, so a crash, even ``kill -9``,
+  leaves either the old file or the new one and no half-written file. A symbolic
+  link is followed: its target is replaced, the link survives. A character device
+  (``/dev/null``, a terminal) or a FIFO (``>(jq .)``) is written directly, never
+  replaced by a file; a FIFO without a reader is refused rather than waited on.
+- **Temporaries** are named ``.cspace-tmp-PID-RANDOM``: where ``O_TMPFILE`` is
+  not available, or in the instant between naming and renaming, a killed process
+  can leave one; the next run that writes into that folder removes those whose
+  process is gone.
+- **Write failures** (a full disk, ``/dev/full``) are one-line :class:`InputError`
+  s naming the path, never a traceback and never a silent success.
 """
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
-import tempfile
+import re
+import secrets
+import stat
 
 from .errors import InputError
 
 PLOT_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+TMP_PREFIX = ".cspace-tmp-"
+_TMP_NAME = re.compile(re.escape(TMP_PREFIX) + r"(\d+)-[0-9a-f]+(\.[A-Za-z0-9]*)?$")
 
 
-def check_output(path: str, option: str, suffixes: dict | None = None) -> str:
+def check_output(path: str, option: str, suffixes: dict | None = None, inputs=()) -> str:
     """Validate an output path before any work; returns the format for plots.
+
+    ``inputs`` are files the run reads: an output that is one of them is refused.
 
     >>> check_output("out.json", "--json")
     ''
     """
-    folder = os.path.dirname(os.path.abspath(path)) or "."
-    if os.path.isdir(path):
-        raise InputError(path, option, "is a directory, expected a file name")
-    if not os.path.isdir(folder):
+    if not path:
+        raise InputError(repr(path), option, "an empty path names no file")
+    fmt = ""
+    if suffixes is not None:
+        ext = os.path.splitext(path)[1].lower()
+        if ext not in suffixes:
+            raise InputError(path, option, f"unsupported extension {ext or '(none)'!r} (use {', '.join(suffixes)})")
+        fmt = suffixes[ext]
+    st = _stat(path, option)
+    if st is not None:
+        if stat.S_ISDIR(st.st_mode):
+            raise InputError(path, option, "is a directory, expected a file name")
+        for src in inputs:
+            if _same(st, src):
+                raise InputError(path, option, f"is the input {src}; writing it would destroy it")
+        if stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode):
+            return fmt  # written directly (see atomic_path)
+        if not stat.S_ISREG(st.st_mode):
+            raise InputError(path, option, "is not a regular file, a character device or a FIFO")
+    folder = os.path.dirname(os.path.realpath(path))
+    if not os.path.isdir(folder):  # (realpath and isdir take a NUL byte; _stat refused it above)
         raise InputError(path, option, f"folder {folder} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise InputError(path, option, f"folder {folder} is not writable")
-    if suffixes is None:
-        return ""
-    ext = os.path.splitext(path)[1].lower()
-    if ext not in suffixes:
-        raise InputError(path, option, f"unsupported extension {ext or '(none)'!r} (use {', '.join(suffixes)})")
-    return suffixes[ext]
+    clean_stale(folder)
+    try:  # the one reliable test (root passes access(); /proc and read-only mounts refuse files)
+        with _temporary(folder, os.path.splitext(path)[1]) as (fd, _tmp):
+            pass
+    except OSError as exc:
+        raise InputError(path, option, f"cannot create a file in {folder} ({exc.strerror or exc})") from None
+    return fmt
 
 
-def _read_umask() -> int:
+def check_folder(path: str, option: str) -> None:
+    """Validate an output folder before any work: created if missing, and writable.
+
+    >>> import tempfile; check_folder(tempfile.mkdtemp(), "--out")
+    """
+    if not path:
+        raise InputError(repr(path), option, "an empty path names no folder")
+    try:
+        os.makedirs(path, exist_ok=True)
+    except FileExistsError:
+        raise InputError(path, option, "exists and is not a folder") from None
+    except NotADirectoryError:
+        raise InputError(path, option, "a parent of this path is a file, not a folder") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte
+        raise InputError(path, option, f"cannot create this folder ({getattr(exc, 'strerror', None) or exc})") from None
+    clean_stale(path)
+    try:
+        with _temporary(path, ""):
+            pass
+    except OSError as exc:
+        raise InputError(path, option, f"cannot create a file in it ({exc.strerror or exc})") from None
+
+
+def check_distinct(outputs: list) -> None:
+    """Refuse two options naming one output file (``[(path, option), ...]``, None skipped).
+
+    >>> check_distinct([("a.json", "--json"), ("a.png", "--plot"), (None, "--csv")])
+    """
+    seen = {}
+    for path, option in outputs:
+        if not path:
+            continue
+        key = os.path.realpath(path)
+        if key in seen:
+            raise InputError(path, option, f"is also the {seen[key]} output")
+        seen[key] = option
+
+
+def _stat(path: str, option: str):
+    """``os.stat`` (following links), None when nothing is there; other faults are one line."""
+    try:
+        return os.stat(path)
+    except FileNotFoundError:  # a new name, or a dangling link (its target is created)
+        return None
+    except NotADirectoryError:
+        raise InputError(path, option, "a parent of this path is a file, not a folder") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        raise InputError(path, option, f"cannot use this path ({getattr(exc, 'strerror', None) or exc})") from None
+
+
+def _same(st: os.stat_result, src) -> bool:
+    try:
+        s = os.stat(src)
+    except (OSError, ValueError, TypeError):
+        return False
+    return (s.st_dev, s.st_ino) == (st.st_dev, st.st_ino)
+
+
+def clean_stale(folder: str) -> int:
+    """Remove this tool's temporaries in ``folder`` whose process is gone; returns how many.
+
+    >>> import tempfile
+    >>> clean_stale(tempfile.mkdtemp())
+    0
+    """
+    removed = 0
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return 0
+    for name in names:
+        m = _TMP_NAME.match(name)
+        if m is None or _alive(int(m.group(1))):
+            continue
+        try:
+            os.unlink(os.path.join(folder, name))
+            removed += 1
+        except OSError:
+            pass
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return pid < 2**31  # exists, another user's (an absurd pid is nobody's)
+    return True
+
+
+def _umask() -> int:
     mask = os.umask(0)  # the only way to read it; done once, at import (not thread-safe later)
     os.umask(mask)
     return mask
 
 
-_UMASK = _read_umask()
+_UMASK = _umask()
 
 
 @contextlib.contextmanager
-def atomic_path(path: str):
-    """Yield a temporary path beside ``path``; on success rename it over ``path``."""
-    folder = os.path.dirname(os.path.abspath(path))
-    ext = os.path.splitext(path)[1]
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=ext, dir=folder)
-    os.close(fd)
+def _temporary(folder: str, ext: str):
+    """An open temporary file in ``folder``: ``(fd, name)``, name None while unnamed (O_TMPFILE)."""
+    fd = None
+    if hasattr(os, "O_TMPFILE") and os.path.isdir("/proc/self/fd"):
+        try:
+            fd = os.open(folder, os.O_TMPFILE | os.O_RDWR | os.O_CLOEXEC, 0o666)
+        except OSError as exc:
+            if exc.errno not in (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT):
+                raise
+    name = None
+    if fd is None:  # no O_TMPFILE here: a named temporary, removed below or by clean_stale
+        name = os.path.join(folder, f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(6)}{ext}")
+        fd = os.open(name, os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666 & ~_UMASK)
     try:
-        yield tmp
-        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; give the usual mode of a new file
-        os.replace(tmp, path)
+        yield fd, name
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        os.close(fd)
+        if name is not None and os.path.lexists(name):
+            os.unlink(name)
 
 
-def write_json(path: str, data) -> None:
-    """Write ``data`` as JSON atomically."""
-    with atomic_path(path) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            json.dump(data, fh, indent=1, allow_nan=False)
-            fh.write("\n")
+@contextlib.contextmanager
+def atomic_path(path: str, option: str = "output"):
+    """Yield a path to write ``path``'s new content to; see the module notes.
+
+    Regular files (and new names) are replaced atomically, links followed, devices and
+    FIFOs written directly. Any OS failure is an :class:`InputError` naming ``path``.
+    """
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        st = None
+    try:
+        if st is not None and (stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode)):
+            with _direct(path) as target:
+                yield target
+            return
+        real = os.path.realpath(path)  # a link is followed: its target is what gets replaced
+        folder = os.path.dirname(real)
+        clean_stale(folder)
+        with _temporary(folder, os.path.splitext(real)[1]) as (fd, name):
+            if st is not None and stat.S_ISREG(st.st_mode):
+                os.fchmod(fd, stat.S_IMODE(st.st_mode))  # a replaced file keeps its permissions
+            yield name or f"/proc/self/fd/{fd}"
+            if name is None:  # give the complete file a name, then move it over the target at once
+                name = os.path.join(folder, f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(6)}")
+                dfd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+                try:  # a dir fd makes this linkat(..., AT_SYMLINK_FOLLOW), which names an O_TMPFILE file
+                    os.link(f"/proc/self/fd/{fd}", os.path.basename(name), dst_dir_fd=dfd)
+                finally:
+                    os.close(dfd)
+            try:
+                os.replace(name, real)
+            except BaseException:
+                if os.path.lexists(name):
+                    os.unlink(name)
+                raise
+    except (OSError, ValueError) as exc:
+        raise InputError(path, option, f"cannot write ({getattr(exc, 'strerror', None) or exc})") from None
 
 
-def write_text(path: str, text: str) -> None:
-    """Write ``text`` atomically."""
-    with atomic_path(path) as tmp:
+@contextlib.contextmanager
+def _direct(path: str):
+    """A device or FIFO: opened without blocking (a FIFO with no reader is refused)."""
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK | os.O_CLOEXEC | os.O_NOCTTY)
+    except OSError as exc:
+        if exc.errno == errno.ENXIO:
+            raise OSError(errno.ENXIO, "a FIFO with no reader") from None
+        raise
+    try:
+        os.set_blocking(fd, True)
+        yield f"/proc/self/fd/{fd}" if os.path.isdir("/proc/self/fd") else path
+    finally:
+        os.close(fd)
+
+
+def write_json(path: str, data, option: str = "output") -> None:
+    """Write ``data`` as JSON (see :func:`atomic_path`)."""
+    write_text(path, json.dumps(data, indent=1, allow_nan=False) + "\n", option)
+
+
+def write_text(path: str, text: str, option: str = "output") -> None:
+    """Write ``text`` (see :func:`atomic_path`); a short write or a full disk is an error."""
+    with atomic_path(path, option) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)

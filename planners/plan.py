@@ -1,9 +1,12 @@
 """Planning a path: scenario -> C-space -> OMPL -> simplified, exactly verified path.
 
-This module owns :func:`plan` and :class:`PlanResult`. A path is reported solved
-only if OMPL found an exact solution *and* every segment of the final (simplified)
-path passes the exact segment test of the C-space again, from the start exactly to
-the goal exactly.
+This module owns :func:`plan` and :class:`PlanResult`: it resolves the options, builds
+the C-space, checks the queries, and hands a state-space adapter
+(:mod:`planners.spaces`) to :func:`planners.routine.run_planner`, the one routine
+that drives OMPL. ``cspace plan``, ``planners.plan()`` and every ``cspace bench``
+run go through it. A path is reported solved only if OMPL found an exact solution
+*and* the adapter's exact verification accepts the final (simplified) path, from
+the start exactly to the goal exactly.
 """
 from __future__ import annotations
 
@@ -38,6 +41,10 @@ class PlanResult:
     length_unsimplified: float | None = None
     cspace_report: dict | None = None
     queries: list | None = None
+    # Filled by run_planner: when the first exact solution was found (seconds into the
+    # solve) and [time, best raw length] pairs along the run (the bench's anytime curve).
+    first_solution: float | None = None
+    progress: list = field(default_factory=list)
     # The objects behind the result, for plots and further queries (not serialised).
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
@@ -82,65 +89,123 @@ def path_length(path: np.ndarray) -> float:
     return float(np.hypot(*np.diff(path, axis=0).T).sum())
 
 
-def _resolve(scenario, planner, time_limit, seed, iterations=None):
+MAX_TIME = 1e8  # seconds (about three years); OMPL's steady clock overflows near 8e9 s
+SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit
+
+
+DEFAULT_TIME_SE2 = 10.0  # seconds, when neither the call nor the file gives a time (translation: 1)
+
+
+def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
     """Scenario object plus the effective planner, time and seed (arguments over file defaults)."""
     from .ompl_glue import planner_name
 
     t0 = time.perf_counter()
-    sc = scenario if isinstance(scenario, Scenario) else load_scenario(os.fspath(scenario))
+    if isinstance(scenario, Scenario):
+        sc = scenario
+        if space is not None and space != sc.space:
+            raise ScenarioError("plan()", "space", f"the scenario was loaded as {sc.space!r}; load it with "
+                                                   f"load_scenario(path, space={space!r}) or pass its path")
+    else:
+        sc = load_scenario(os.fspath(scenario), space=space)
     load_s = time.perf_counter() - t0
     src = sc.path or "<scenario>"
     opts = sc.planner
-    name = planner_name(planner if planner is not None else opts.get("name"), src,
-                        "planner" if planner is not None else "planner.name")
-    t = time_limit if time_limit is not None else opts.get("time", 1.0)
+    # An argument is blamed as an argument of plan(), a file's value as the file's field.
+    def where(arg, fld):
+        return ("plan()", fld) if arg is not None else (src, f"planner.{fld}")
+
+    if planner is not None:
+        name = planner_name(planner, "plan()", "planner")
+    else:
+        name = planner_name(opts.get("name"), src, "planner.name")
+    # SE(2) builds its angle slabs lazily, inside the planner's time: a longer default.
+    t = time_limit if time_limit is not None else opts.get("time", DEFAULT_TIME_SE2 if sc.space == "se2" else 1.0)
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
-        raise ScenarioError(src, "time", f"must be a positive number of seconds, got {t!r}")
+        raise ScenarioError(*where(time_limit, "time"), f"must be a positive number of seconds, got {t!r}")
+    if t > MAX_TIME:
+        raise ScenarioError(*where(time_limit, "time"),
+                            f"at most {MAX_TIME:g} s (OMPL's clock overflows near 8e9 s), got {t!r}")
     s = seed if seed is not None else opts.get("seed", 0)
     if iterations is not None and (isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1):
-        raise ScenarioError(src, "iterations", f"must be a positive integer, got {iterations!r}")
-    if isinstance(s, bool) or not isinstance(s, int) or s < 0:
-        raise ScenarioError(src, "seed", f"must be a non-negative integer, got {s!r}")
+        raise ScenarioError("plan()", "iterations", f"must be a positive integer, got {iterations!r}")
+    if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s < SEED_LIMIT:
+        raise ScenarioError(*where(seed, "seed"), f"must be an integer in [0, 2^32 - 1), got {s!r}")
     return sc, name, float(t), int(s), load_s
 
 
 def plan(scenario, planner: str | None = None, time: float | None = None, seed: int | None = None,
          *, simplify: bool = True, iterations: int | None = None, cspace: CSpace | None = None,
-         all_queries: bool = False) -> PlanResult:
+         all_queries: bool = False, slices: bool = False, on_progress=None, space: str | None = None,
+         slabs: int | None = None) -> PlanResult:
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
     (defaults: RRTConnect, 1 s, seed 0). ``iterations`` adds a deterministic budget
     in planner iterations. With ``all_queries`` every ``[[queries]]`` entry is
-    planned on the same C-space (and, for PRM-family planners, the same roadmap);
-    the result then carries ``queries``, one result per query, and the top-level
-    fields describe the first one.
+    planned on the same C-space (and, for PRM-family planners, the same roadmap),
+    each query with its own seeded random stream; the result then carries
+    ``queries``, one result per query, and the top-level fields describe the first.
+    ``cspace`` reuses a C-space built from the same scenario. ``slices`` and
+    ``on_progress`` are the bench's hooks (see :func:`run_planner`).
+
+    ``space="se2"`` (or ``space = "se2"`` in the file) lets the robot rotate: poses and
+    the path's rows are (x, y, theta), the C-space is the sliced
+    :class:`cspace.se2.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
+    derived from the scene) and every motion is certified along OMPL's SE(2)
+    interpolation. There is no exact planner in SE(2); ``planner="exact"`` there
+    answers only when the inscribed-disk rule proves the scene unsolvable.
+
+    >>> import os
+    >>> res = plan(os.path.join(os.path.dirname(__file__), "..", "scenarios", "basic.toml"), seed=3)
+    >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
+    (True, [1.0, 1.0], [9.0, 9.0])
     """
-    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations)
+    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space)
+    se2 = sc.space == "se2"
+    if slabs is not None and not se2:
+        raise ScenarioError("plan()", "slabs", 'applies to space = "se2" only')
+    if name != "exact":
+        from .ompl_glue import ompl
+
+        ompl()  # without OMPL: fails here, before the C-space is built
     wall0 = _now()
     if cspace is None:
         t0 = _now()
-        cspace = CSpace.from_scenario(sc)
+        cspace = _build_cspace(sc, slabs)
         build_s = _now() - t0
     else:
         build_s = 0.0
     report = cspace.report()
+    adapter = _adapter(sc, cspace)
     queries = sc.all_queries() if all_queries else sc.all_queries()[:1]
     src = sc.path or "<scenario>"
+    poses = []
     for i, q in enumerate(queries):
-        for pt, fld in ((q.start, "start"), (q.goal, "goal")):
-            if not cspace.is_free(pt):
+        pair = (adapter.pose(q.start), adapter.pose(q.goal))
+        for pt, fld in zip(pair, ("start", "goal")):
+            if not adapter.is_free(pt):
                 label = fld if i == 0 else f"queries[{i - 1}].{fld}"
-                raise ScenarioError(src, label, f"({pt[0]}, {pt[1]}) is not a free state of the C-space")
-    if name == "exact":
+                raise ScenarioError(src, label, f"{pt} is not a free state of the C-space")
+        poses.append(pair)
+    if name == "exact" and se2:
+        from .exact import exact_se2
+
+        results = [exact_se2(sc, q, src, time_limit=tlim) for q in queries]
+    elif name == "exact":
         from .exact import exact_plan
 
         results = [exact_plan(sc, cspace, q, time_limit=tlim) for q in queries]
     else:
-        results = _plan_ompl(sc, cspace, queries, name, tlim, sd, simplify, iterations)
+        from .routine import run_planner
+
+        results = run_planner(adapter, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
+                              slices=slices, on_progress=on_progress, scenario=sc.name)
+        if se2:
+            _explain_se2_failures(sc, queries, results)
     for r in results:
         r.timings = {"load": load_s, "cspace": build_s, **r.timings}
-        r.stages = [s["stage"] for s in report["stages"] if s["ran"]] + r.stages
+        r.stages = _stage_names(report) + r.stages
         r.cspace_report = report
     first = results[0]
     first.timings["total"] = load_s + (_now() - wall0)
@@ -156,76 +221,48 @@ def _now() -> float:
     return time.perf_counter()
 
 
-def _plan_ompl(sc, cspace, queries, name, tlim, seed, simplify, iterations) -> list[PlanResult]:
-    from .ompl_glue import ANYTIME, frame_exponent, make_setup, path_states, set_query, termination
-
-    t0 = _now()
-    k = frame_exponent(cspace.bounds)
-    ss, space, checker, validator = make_setup(cspace, name, seed, k)
-    setup_s = _now() - t0
-    planner = ss.getPlanner()
-    multi = name.lower() in ("prm", "prmstar")
-    out = []
-    for i, q in enumerate(queries):
-        if i:
-            if multi:
-                planner.clearQuery()  # keep the roadmap, drop the old start and goal
-            else:
-                ss.clear()
-        set_query(ss, space, q.start, q.goal, k)
-        before = {"points": cspace.point_count(), "segments": cspace.checks["segments"]}
-        t1 = _now()
-        ptc, _keep = termination(tlim, iterations)
-        status = ss.solve(ptc)
-        solve_s = _now() - t1
-        exact_sol = bool(status) and ss.haveExactSolutionPath()
-        raw = _snap(path_states(ss.getSolutionPath(), k), q) if exact_sol else np.zeros((0, 2))
-        length_raw = path_length(raw) if exact_sol else None
-        t2 = _now()
-        if exact_sol and simplify:
-            ss.simplifySolution()
-        simp_s = _now() - t2 if exact_sol and simplify else 0.0
-        path = _snap(path_states(ss.getSolutionPath(), k), q) if exact_sol else np.zeros((0, 2))
-        t3 = _now()
-        verified, message = _verify(cspace, path, q) if exact_sol else (False, str(status))
-        verify_s = _now() - t3
-        after = {"points": cspace.point_count(), "segments": cspace.checks["segments"]}
-        out.append(PlanResult(
-            scenario=sc.name, solved=verified, exact=verified, path=path if verified else np.zeros((0, 2)),
-            length=path_length(path) if verified else math.inf, planner=name, seed=seed,
-            timings={"setup": setup_s if i == 0 else 0.0, "solve": solve_s, "simplify": simp_s, "verify": verify_s},
-            checks={"states": after["points"] - before["points"], "motions": after["segments"] - before["segments"]},
-            stages=["setup", "solve"] + (["simplify"] if exact_sol and simplify else []) + ["verify"],
-            start=tuple(q.start), goal=tuple(q.goal), message=message,
-            length_unsimplified=length_raw,
-        ))
-        if name.lower() in ANYTIME and iterations is None:
-            out[-1].message += " (anytime planner: ran to its time limit)"
-    return out
+def _stage_names(report: dict) -> list[str]:
+    """The C-space stages that ran (a sliced SE(2) C-space builds its slabs lazily, later)."""
+    if "stages" in report:
+        return [s["stage"] for s in report["stages"] if s["ran"]]
+    return ["decompose", f"slabs (K = {report['slabs']}, lazy)"]
 
 
-def _snap(states, q) -> np.ndarray:
-    """The planner's path, ending exactly at the goal.
+def _build_cspace(sc: Scenario, slabs: int | None = None):
+    """The C-space a scenario's state space needs: translation, or sliced SE(2)."""
+    if sc.space == "se2":
+        from cspace.se2 import SE2CSpace
 
-    OMPL reports the goal reached within ``GOAL_THRESHOLD`` (1e-9; a threshold of 0
-    makes RRT miss a goal it has sampled); the last little step to the exact goal is
-    appended and, like every segment, verified exactly afterwards.
-    """
-    path = np.array(states, dtype=np.float64).reshape(-1, 2)
-    goal = np.array(q.goal, dtype=np.float64)
-    if len(path) and not (path[-1] == goal).all():
-        path = np.vstack([path, goal])
-    return path
+        return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)
+    return CSpace.from_scenario(sc)
 
 
-def _verify(cspace: CSpace, path: np.ndarray, q) -> tuple[bool, str]:
-    """Every segment exactly free, and the path runs from the start to the goal exactly."""
-    if len(path) < 2:
-        same = len(path) == 1 and tuple(path[0]) == tuple(q.start) == tuple(q.goal)
-        return same, "" if same else "empty path"
-    if tuple(path[0]) != tuple(map(float, q.start)) or tuple(path[-1]) != tuple(map(float, q.goal)):
-        return False, "path does not run exactly from start to goal"
-    for k in range(len(path) - 1):
-        if not cspace.segment_free(path[k], path[k + 1]):
-            return False, f"segment {k} failed the exact test"
-    return True, "exact solution"
+def _adapter(sc: Scenario, cspace):
+    """The state-space adapter of :mod:`planners.spaces` for the scenario's space."""
+    if sc.space == "se2":
+        from .space_se2 import SE2Space
+
+        return SE2Space(cspace)
+    from .spaces import TranslationSpace
+
+    return TranslationSpace(cspace)
+
+
+def _explain_se2_failures(sc: Scenario, queries, results) -> None:
+    """A rotating robot's plan that failed: does the inscribed-disk rule prove it unsolvable?"""
+    from .se2_bounds import disk_bound
+
+    for q, r in zip(queries, results):
+        if not r.solved:
+            t = _now()
+            db = disk_bound(sc, q, time_limit=5.0)
+            r.timings["disk_bound"] = _now() - t
+            if db.proven_unsolvable:
+                r.message = db.message
+
+
+def run_planner(*args, **kwargs):
+    """See :func:`planners.routine.run_planner` (re-exported here)."""
+    from .routine import run_planner as run
+
+    return run(*args, **kwargs)

@@ -858,25 +858,42 @@ def run_case(case: Case) -> dict:
             "time_ms": 1000.0 * seconds, "passed": bool(passed), "guarantee": GUARANTEES[case.layer]}
 
 
-def run_all(cases: list[Case] | None = None) -> list[dict]:
-    """Rows of the report, one per case."""
-    return [run_case(c) for c in (catalogue() if cases is None else cases)]
+def run_all(cases: list[Case] | None = None, progress: bool | None = False) -> list[dict]:
+    """Rows of the report, one per case (a bar on a terminal with ``progress=None``)."""
+    from .progress import track
+
+    cases = catalogue() if cases is None else cases
+    return [run_case(c) for c in track(cases, "stability", enabled=progress, unit="case")]
 
 
-def format_table(rows: list[dict]) -> str:
-    """The report as a text table.
+WIDTH = 80  # the table fits a classic terminal: results go on their own indented line
+
+
+def format_table(rows: list[dict], width: int = WIDTH) -> str:
+    """The report as a text table, one case per two lines: name and numbers, then its result.
+
+    The layer is the case name's prefix (``pred_``, ``hull_``, ``gjk_`` ...), so it
+    takes no column; the result is wrapped to ``width`` under its case.
 
     >>> print(format_table([{"case": "c", "layer": "hull", "result": "ok", "error": 0.0,
-    ...                      "time_ms": 1.5, "passed": True}]).splitlines()[2])
-    c     hull   ok      0.00e+00      1.5  pass
+    ...                      "time_ms": 1.5, "passed": True}]))
+    case     error  time ms  pass
+    ----  --------  -------  ----
+    c     0.00e+00      1.5  pass
+        ok
     """
-    head = ("case", "layer", "result", "error", "time ms", "pass")
-    body = [(r["case"], r["layer"], r["result"], "-" if r["error"] is None else f"{r['error']:.2e}",
-             f"{r['time_ms']:.1f}", "pass" if r["passed"] else "FAIL") for r in rows]
-    w = [max(len(str(x[i])) for x in [head] + body) for i in range(6)]
-    line = lambda x: "  ".join([str(x[0]).ljust(w[0]), str(x[1]).ljust(w[1]), str(x[2]).ljust(w[2]),
-                                str(x[3]).rjust(w[3]), str(x[4]).rjust(w[4]), str(x[5])]).rstrip()
-    out = [line(head), "  ".join("-" * k for k in w)] + [line(x) for x in body]
+    import textwrap
+
+    head = ("case", "error", "time ms", "pass")
+    body = [(r["case"], "-" if r["error"] is None else f"{r['error']:.2e}", f"{r['time_ms']:.1f}",
+             "pass" if r["passed"] else "FAIL") for r in rows]
+    w = [max(len(x[i]) for x in [head] + body) for i in range(4)]
+    line = lambda x: "  ".join([x[0].ljust(w[0]), x[1].rjust(w[1]), x[2].rjust(w[2]), x[3]]).rstrip()
+    out = [line(head), "  ".join("-" * k for k in w)]
+    for x, r in zip(body, rows):
+        out.append(line(x))
+        out += textwrap.wrap(str(r["result"]), width, initial_indent="    ", subsequent_indent="      ",
+                             break_on_hyphens=False) or ["    -"]
     return "\n".join(out)
 
 
@@ -893,7 +910,12 @@ def plot(rows: list[dict], path: str) -> None:
     ax.bar(range(len(rows)), times, color=["tab:green" if r["passed"] else "tab:red" for r in rows])
     ax.set_yscale("log")
     ax.set_xticks(range(len(rows)), [r["case"] for r in rows], rotation=90, fontsize=6)
-    ax.set_ylabel("time (ms)")
+    ax.set_ylabel("time of the layer call (ms)")
+    ax.set_xlabel("case (its name begins with its layer)")
+    from matplotlib.patches import Patch
+
+    ax.legend(handles=[Patch(color="tab:green", label="guarantee holds"), Patch(color="tab:red", label="FAILED")],
+              loc="upper left", fontsize=8)
     ax.set_title(f"cspace stability: {sum(r['passed'] for r in rows)}/{len(rows)} cases pass")
     fig.tight_layout()
     with atomic_path(path) as tmp:
@@ -912,17 +934,21 @@ def register(sub) -> None:
 def run(args) -> int:
     from .output import check_output, write_json
 
-    if args.json:
+    if args.json is not None:  # "" is refused by check_output, not skipped
         check_output(args.json, "--json")
-    if args.plot:
+    if args.plot is not None:
         check_output(args.plot, "--plot", {".png": "png"})
-    rows = run_all()
+    import textwrap
+
+    rows = run_all(progress=None)
     print(format_table(rows))
     failed = [r["case"] for r in rows if not r["passed"]]
-    print(f"\n{len(rows) - len(failed)}/{len(rows)} cases pass" + (f"; FAILED: {', '.join(failed)}" if failed else ""))
-    if args.json:
+    print("\n" + textwrap.fill(f"{len(rows) - len(failed)}/{len(rows)} cases pass"
+                               + (f"; FAILED: {', '.join(failed)}" if failed else ""), WIDTH,
+                               subsequent_indent="  ", break_on_hyphens=False))
+    if args.json is not None:
         write_json(args.json, {"cases": rows, "guarantees": GUARANTEES, "passed": not failed})
-    if args.plot:
+    if args.plot is not None:
         plot(rows, args.plot)
     sys.stdout.flush()
     return 0 if not failed else 1

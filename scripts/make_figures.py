@@ -6,11 +6,13 @@ One command, no hand-edited pictures:
 
 Each figure is a plan with a fixed seed (``cspace plan --plot``), a C-space picture
 (``cspace show --plot``), the exact shortest path, the circles multi-query run, a small
-``cspace bench`` sweep's error-against-run-time figure, or the stability chart. PNGs
+``cspace bench`` sweep's error-against-run-time figure (drawn by
+:mod:`planners.plot_bench` from the sweep's results.json), or the stability chart. PNGs
 are written atomically (temporary file, then rename; :mod:`planners.plot` does it for
 the pictures it draws), so an interrupted run never leaves a half-written picture.
 ``--only`` takes figure names or group names (see ``--list``). The whole set takes
-well under two minutes on a laptop core.
+well under two minutes on a laptop core; the acceptance sweep behind
+``error_vs_time.png`` takes about ten and runs only when named (``--only acceptance``).
 """
 from __future__ import annotations
 
@@ -58,6 +60,38 @@ def plan_figure(scenario: str, planner: str | None = None, seed: int = SEED) -> 
     return draw
 
 
+def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False) -> Callable[[str], str]:
+    """A rotating robot's plan (scenarios/se2/), its footprint along the path; with ``animate``
+    also the GIF of ``cspace plan --animate`` beside the PNG (same name, .gif)."""
+
+    def draw(out: str) -> str:
+        from planners.animate import animate_path
+        from planners.plan import plan
+        from planners.plot import plot_result
+
+        res = plan(os.path.join(SCENARIOS, "se2", f"{scenario}.toml"), seed=seed)
+        plot_result(res, out)
+        if animate and res.solved:
+            animate_path(res, os.path.splitext(out)[0] + ".gif")
+        state = f"length {res.length:.6g}" if res.solved else "not solved"
+        return f"{res.planner} seed {res.seed}: {state}" + (" (+ GIF)" if animate and res.solved else "")
+
+    return draw
+
+
+def se2_slab_figure(scenario: str, theta: float) -> Callable[[str], str]:
+    """One angle slab's C-space of a rotating robot, as ``cspace show --space se2 --theta``."""
+
+    def draw(out: str) -> str:
+        from planners.cli import main
+
+        code = main(["show", os.path.join(SCENARIOS, "se2", f"{scenario}.toml"), "--theta", repr(theta),
+                     "--plot", out])
+        return f"slab of theta {theta:g} (exit {code})"
+
+    return draw
+
+
 def cspace_figure(scenario: str) -> Callable[[str], str]:
     """Workspace, C-obstacles and their convex pieces, as ``cspace show --plot``."""
 
@@ -101,30 +135,44 @@ def stability_figure(out: str) -> str:
 
 
 BENCH_ARGS = ["scenarios/bug_trap.toml", "--planners", "RRTConnect,RRTstar", "--times", "0.03,0.1,0.3",
-              "--runs", "5", "--workers", "2", "--quiet"]
+              "--runs", "5", "--workers", "2", "--quiet", "--no-plot"]
 
 
-def bench_figure(out: str) -> str:
-    """``cspace bench``'s error-against-run-time figure for a small sweep (copied atomically)."""
-    import json
-    import shutil
-    import subprocess
-    import tempfile
+def bench_figure(args: list[str] = BENCH_ARGS) -> Callable[[str], str]:
+    """``cspace bench ARGS``'s error-against-run-time figure, drawn from its results.json."""
 
-    folder = os.path.dirname(os.path.abspath(out))
-    work = tempfile.mkdtemp(prefix=".bench-", dir=folder)  # same file system: the rename is atomic
-    try:
-        cmd = [sys.executable, "-c", "from planners.cli import console; console()", "bench", *BENCH_ARGS, "--out", work]
-        proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
-        png = os.path.join(work, "error_vs_time.png")
-        if proc.returncode != 0 or not os.path.exists(png):
-            raise RuntimeError(f"cspace bench failed (exit {proc.returncode}): {proc.stderr.strip()[-500:]}")
-        os.replace(png, out)
-        with open(os.path.join(work, "results.json")) as fh:
-            rows = json.load(fh)["rows"]
-        return f"{len(rows)} runs, {sum(bool(r['solved']) for r in rows)} solved"
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
+    def draw(out: str) -> str:
+        import json
+        import shutil
+        import subprocess
+        import tempfile
+
+        from planners.plot_bench import plot_error_vs_time
+
+        work = tempfile.mkdtemp(prefix="cspace-bench-")
+        try:
+            cmd = [sys.executable, "-c", "from planners.cli import console; console()", "bench", *args, "--out", work]
+            proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=3600)
+            results = os.path.join(work, "results.json")
+            if proc.returncode != 0 or not os.path.exists(results):
+                raise RuntimeError(f"cspace bench failed (exit {proc.returncode}): {proc.stderr.strip()[-500:]}")
+            with open(results) as fh:
+                rows = json.load(fh)["rows"]
+            plot_error_vs_time(rows, out)  # written atomically
+            return f"{len(rows)} runs, {sum(bool(r['solved']) for r in rows)} solved"
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+
+    return draw
+
+
+# The acceptance sweep of the guide's error_vs_time.png: 4 scenarios x 4 planners x 5 budgets x 10
+# runs, 800 runs (about ten minutes on two workers). Drawn only when named: --only acceptance.
+ACCEPTANCE_ARGS = ["scenarios/basic.toml", "scenarios/maze.toml", "scenarios/narrow_passage.toml",
+                   "scenarios/bug_trap.toml", "--runs", "10", "--workers", "2", "--quiet", "--no-plot"]
+
+
+LONG_GROUPS = ("acceptance",)
 
 
 def figures() -> list[Figure]:
@@ -137,16 +185,25 @@ def figures() -> list[Figure]:
     for fam in FAMILIES:
         out.append(Figure(f"{fam}_cspace", "families", f"C-space of {fam}.toml", cspace_figure(fam)))
         out.append(Figure(f"{fam}_plan", "families", f"plan of {fam}.toml", plan_figure(fam)))
+    out.append(Figure("se2_piano_corridor", "se2", "SE(2): a bar round a corner (GIF beside it)",
+                      se2_plan_figure("piano_corridor", animate=True)))
+    out.append(Figure("se2_tee_slot", "se2", "SE(2): a T through a slot", se2_plan_figure("tee_slot")))
+    out.append(Figure("se2_car_maze", "se2", "SE(2): a car-shaped body through a maze", se2_plan_figure("car_maze")))
+    out.append(Figure("se2_tee_slot_slab", "se2", "SE(2): the slab C-space of theta = pi/2",
+                      se2_slab_figure("tee_slot", 1.5707963267948966)))
     out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
-    out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure))
+    out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure()))
+    out.append(Figure("error_vs_time", "acceptance", "cspace bench: the acceptance sweep (4 scenarios, 4 planners)",
+                      bench_figure(ACCEPTANCE_ARGS)))
     out.append(Figure("stability", "stability", "stability catalogue", stability_figure))
     return out
 
 
 def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
-    """The figures named by ``--only`` (names or groups, comma-separated); all when None."""
+    """The figures named by ``--only`` (names or groups, comma-separated); when None, all but
+    the long ones (group ``acceptance``)."""
     if not only:
-        return all_figs
+        return [f for f in all_figs if f.group not in LONG_GROUPS]
     keys = {k.strip() for k in only.split(",") if k.strip()}
     known = {f.name for f in all_figs} | {f.group for f in all_figs}
     unknown = keys - known
@@ -159,13 +216,14 @@ def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "figures"), help="folder for the PNGs")
-    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, circles, bench, stability)")
+    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, se2, circles, bench, "
+                                   "stability; acceptance, the long sweep, only when named)")
     ap.add_argument("--list", action="store_true", help="list the figures and exit")
     args = ap.parse_args(argv)
     figs = select(figures(), args.only)
     if args.list:
-        for f in figs:
-            print(f"{f.name:<24} {f.group:<10} {f.what}")
+        for f in figs if args.only else figures():
+            print(f"{f.name:<24} {f.group:<10} {f.what}" + (" (only when named)" if f.group in LONG_GROUPS else ""))
         return 0
     os.makedirs(args.out, exist_ok=True)
     t_all = time.perf_counter()

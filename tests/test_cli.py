@@ -133,7 +133,7 @@ def test_bad_input_exits_2_with_one_line(write_toml, tmp_path, name, text, field
 
 
 @pytest.mark.parametrize("args, field", [
-    (["--planner", "NoSuchPlanner"], "planner"),
+    (["--planner", "NoSuchPlanner"], "--planner"),
     (["--time", "0"], "--time"),
     (["--time", "-2"], "--time"),
     (["--plot", "x.gif"], "--plot"),

@@ -188,6 +188,18 @@ def test_cli_writes_json_and_plot(tmp_path, capsys):
     assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     out = capsys.readouterr().out
     assert f"{len(CASES)}/{len(CASES)} cases pass" in out and "FAIL" not in out
+    widest = max(out.splitlines(), key=len)
+    assert len(widest) <= 80, f"{len(widest)} columns: {widest!r}"  # fits a classic terminal
+    for name in CASES:  # every case is in the table, with its result on the next line
+        assert f"\n{name} " in out
+
+
+def test_table_fits_80_columns_with_failures_and_long_results():
+    rows = [{"case": "x" * 40, "layer": "hull", "result": "word " * 60, "error": None, "time_ms": 12345.6,
+             "passed": False}]
+    table = st.format_table(rows)
+    assert max(len(line) for line in table.splitlines()) <= 80
+    assert "FAIL" in table and " ".join(table.split()).count("word") == 60  # wrapped, nothing lost
 
 
 def test_cli_bad_output_path_is_input_error(tmp_path, capsys):

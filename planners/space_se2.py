@@ -1,0 +1,141 @@
+"""The SE(2) state space: OMPL's SE2StateSpace over the sliced C-space of a rotating robot.
+
+The planning routine talks to a state-space adapter (see :mod:`planners.spaces`, whose
+methods this one has); this is the one for robots that translate *and* rotate. OMPL interpolates x, y linearly and
+theta along the shorter arc; the validity checker asks the sliced C-space
+(:meth:`cspace.se2.SE2CSpace.pose_test`: a slab's certified FREE answer, else the exact
+test of the robot turned to theta) and the motion validator asks
+:meth:`cspace.se2.SE2CSpace.motion_free`, a certificate along the whole motion (never a
+sample). Weights as OMPL.app: R^2 x 1, SO(2) x 0.5.
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+
+import numpy as np
+
+SO2_WEIGHT = 0.5
+
+_classes: dict = {}
+
+
+def xy_length(path: np.ndarray) -> float:
+    """Length travelled by the reference point (the x, y part of the poses).
+
+    >>> xy_length(np.array([[0., 0, 0], [3, 4, 1], [3, 5, -1]]))
+    6.0
+    """
+    if len(path) < 2:
+        return 0.0
+    return float(np.hypot(*np.diff(path[:, :2], axis=0).T).sum())
+
+
+class SE2Space:
+    """Adapter for SE(2): poses (x, y, theta), OMPL states scaled by 2^k in x and y."""
+
+    dim = 3
+    name = "se2"
+    # Said when a sampling planner fails (the inscribed-disk rule has already been tried).
+    unsolved_hint = "try a longer --time, or more --slabs for a tighter C-space near obstacles"
+
+    def __init__(self, cspace, k: int | None = None):
+        from .spaces import frame_exponent
+
+        self.cspace = cspace
+        self.k = frame_exponent(cspace.bounds) if k is None else int(k)
+
+    def state_space(self):
+        from .ompl_glue import ompl
+
+        ob = ompl()[0]
+        space = ob.SE2StateSpace()
+        b = ob.RealVectorBounds(2)
+        xmin, xmax, ymin, ymax = (math.ldexp(float(v), self.k) for v in self.cspace.bounds)
+        b.setLow(0, xmin)
+        b.setHigh(0, xmax)
+        b.setLow(1, ymin)
+        b.setHigh(1, ymax)
+        space.setBounds(b)
+        space.setSubspaceWeight(1, SO2_WEIGHT)
+        return space
+
+    def set_state(self, state, pose) -> None:
+        """Write the pose (x, y, theta) into an OMPL SE(2) state (x, y scaled by 2^k)."""
+        state.setX(math.ldexp(float(pose[0]), self.k))
+        state.setY(math.ldexp(float(pose[1]), self.k))
+        state.setYaw(float(pose[2]))
+
+    def path_array(self, path) -> np.ndarray:
+        """An OMPL ``PathGeometric`` as an (N, 3) array of poses in the C-space's frame."""
+        k = -self.k
+        return np.array([(math.ldexp(s.getX(), k), math.ldexp(s.getY(), k), s.getYaw()) for s in path.getStates()],
+                        dtype=np.float64).reshape(-1, 3)
+
+    def validity(self):
+        test = self.cspace.pose_test()
+        if self.k:
+            k = -self.k
+            return lambda s: test(math.ldexp(s.getX(), k), math.ldexp(s.getY(), k), s.getYaw())
+        return lambda s: test(s.getX(), s.getY(), s.getYaw())
+
+    def motion_validator(self, si):
+        if "validator" not in _classes:
+            from .ompl_glue import ompl
+
+            ob = ompl()[0]
+
+            class CertifiedSE2MotionValidator(ob.MotionValidator):
+                """A motion is valid iff the robot, swept along OMPL's SE(2) interpolation,
+                touches nothing: certified by the sliced C-space, never sampled."""
+
+                def __init__(self, si, cspace, k):
+                    super().__init__(si)
+                    self.motion_free = cspace.motion_free
+                    self.k = -k
+
+                def checkMotion(self, s1, s2, *rest):
+                    k = self.k
+                    ok = self.motion_free((math.ldexp(s1.getX(), k), math.ldexp(s1.getY(), k), s1.getYaw()),
+                                          (math.ldexp(s2.getX(), k), math.ldexp(s2.getY(), k), s2.getYaw()))
+                    if rest and not ok:  # the (s1, s2, lastValid) form: report no progress
+                        with contextlib.suppress(Exception):
+                            rest[0].second = 0.0
+                    return ok
+
+            _classes["validator"] = CertifiedSE2MotionValidator
+        return _classes["validator"](si, self.cspace, self.k)
+
+    def pose(self, p) -> tuple:
+        """A pose as a tuple of 3 floats (theta 0 when only (x, y) is given).
+
+        >>> SE2Space.pose(None, [1, 2, 0.5]), SE2Space.pose(None, (1, 2))
+        ((1.0, 2.0, 0.5), (1.0, 2.0, 0.0))
+        """
+        return (float(p[0]), float(p[1]), float(p[2]) if len(p) > 2 else 0.0)
+
+    def is_free(self, pose) -> bool:
+        """Whether the robot at ``pose`` (x, y, theta) touches nothing."""
+        return bool(self.cspace.is_free(tuple(pose)))
+
+    def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
+        """Every motion certified free, from the start pose exactly to the goal pose exactly."""
+        start, goal = self.pose(start), self.pose(goal)
+        if len(path) < 2:
+            same = len(path) == 1 and tuple(path[0]) == start == goal
+            return same, "start equals goal" if same else "empty path"
+        if tuple(path[0]) != start or tuple(path[-1]) != goal:
+            return False, "path does not run exactly from the start pose to the goal pose"
+        for i in range(len(path) - 1):
+            if not self.cspace.motion_free(tuple(path[i]), tuple(path[i + 1])):
+                return False, f"motion {i} failed the certified test"
+        return True, "certified solution"
+
+    def length(self, path: np.ndarray) -> float:
+        """Length travelled by the reference point (the bound of the inscribed disk bounds it)."""
+        return xy_length(path)
+
+    def counts(self) -> tuple[int, int]:
+        """Checks made so far: (state checks, motion checks)."""
+        c = self.cspace.report()["checks"]
+        return c.get("states", 0), c.get("motions", 0)

@@ -1,0 +1,274 @@
+"""Rotating robots (SE(2)): validity and motion checks inside OMPL against peers, and plans.
+
+(V) Validity of a state inside OMPL. For each scene, ``si.probabilityOfValidState(N)``
+    (OMPL's own C++ loop: N uniform states from its sampler, one checker call each) is
+    timed for: a no-op callback; ours (the sliced C-space's pose test, as
+    ``planners.space_se2.SE2Space.validity()`` installs it); a shapely checker that
+    rotates and translates the robot to the state (``shapely.affinity`` on the robot
+    polygon, then ``STRtree.query`` and prepared ``intersects``); and, on a 2-D
+    ``RealVectorStateSpace`` over the same scene, the translation checker (the robot at
+    theta = 0, ``TranslationSpace.validity()``) -- the cost a state had before robots
+    could turn. Rounds are interleaved, CPU time; medians of per-round ratios.
+    Targets: ours <= 3x the translation checker; shapely >= 10x ours.
+(M) Motions. M seeded random motions between valid states (second state within OMPL's
+    default range, 0.2 x the space's maximum extent). Ours: ``SE2CSpace.motion_free``
+    (certified along the whole motion). Baseline: OMPL's default discrete motion
+    validator with the shapely checker at its default resolution (1 % of the space's
+    extent), ``si.checkMotion``. Timed per motion, interleaved, medians. Every motion
+    either accepts is then judged by an independent shapely sweep
+    (``scripts/sweep_oracle.py``: the robot's hull between poses 2e-3 rad apart, padded
+    by the arc's sagitta): "collides" when a sampled pose meets an obstacle, or the
+    padded sweep does and a 100x finer pose sampling finds the contact.
+    Targets: ours accepts 0 colliding motions; ours costs <= the baseline per motion.
+(T) Time to first solution: every bundled SE(2) scene (scenarios/se2/*.toml) except
+    those expected unsolvable, RRTConnect, 10 seeds, 10 s each, through
+    ``planners.plan`` (the routine of ``cspace plan``); solved count, median solve time,
+    median path length, and each path judged by the sweep oracle.
+
+Usage: python scripts/bench_se2.py [--quick] [--parts VMT] [--json FILE]
+"""
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import math
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+sys.path.insert(0, ROOT)
+
+from sweep_oracle import sweep_check  # noqa: E402
+
+from cspace.cspace import CSpace  # noqa: E402
+from cspace.scenario import load_scenario  # noqa: E402
+from cspace.se2 import SE2CSpace  # noqa: E402
+
+SE2_DIR = os.path.join(ROOT, "scenarios", "se2")
+VALIDITY_SCENES = ("car_maze.toml", "bug_trap.toml", "piano_corridor.toml")
+
+
+def shapely_se2_checker(sc):
+    """The peer: ``state -> bool``: the robot rotated and translated by shapely, STRtree + prepared intersects."""
+    import shapely
+    from shapely import affinity
+
+    obstacles = np.array([o.to_shapely() for o in sc.obstacles], dtype=object)
+    shapely.prepare(obstacles)
+    tree = shapely.STRtree(obstacles)
+    body = shapely.union_all([shapely.Polygon(r.polygon) for r in sc.robot])
+    xmin, xmax, ymin, ymax = sc.bounds
+    rot, tr, intersects, query = affinity.rotate, affinity.translate, shapely.intersects, tree.query
+
+    def is_valid(s) -> bool:
+        x, y = s.getX(), s.getY()
+        if not (xmin <= x <= xmax and ymin <= y <= ymax):
+            return False
+        moved = tr(rot(body, s.getYaw(), origin=(0, 0), use_radians=True), x, y)
+        cand = query(moved)
+        return not (len(cand) and intersects(obstacles[cand], moved).any())
+
+    return is_valid
+
+
+def _si(space_adapter, checker=None, motion_validator: bool = True):
+    from planners.ompl_glue import ompl
+
+    ob, og, ou = ompl()
+    ou.RNG.setSeed(1)
+    space = space_adapter.state_space()
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    ss.setStateValidityChecker(checker or space_adapter.validity())
+    keep = []
+    if motion_validator:
+        mv = space_adapter.motion_validator(si)
+        si.setMotionValidator(mv)
+        keep.append(mv)
+    si.setup()
+    return si, (ss, space, keep)
+
+
+def part_v(n: int, reps: int) -> list[dict]:
+    from planners.space_se2 import SE2Space
+    from planners.spaces import TranslationSpace
+
+    rows = []
+    for name in VALIDITY_SCENES:
+        sc = load_scenario(os.path.join(SE2_DIR, name))
+        se2 = SE2CSpace.from_scenario(sc, slabs=sc.slabs)
+        ours_space = SE2Space(se2)
+        si, keep = _si(ours_space)
+        tcs = CSpace(sc.bounds, [o.polygon for o in sc.obstacles], [r.polygon for r in sc.robot],
+                     obstacle_holes=[o.holes for o in sc.obstacles])
+        tspace = TranslationSpace(tcs)
+        tsi, tkeep = _si(tspace)
+        checkers = {"noop": (si, lambda s: True), "ours": (si, ours_space.validity()),
+                    "shapely": (si, shapely_se2_checker(sc)), "translation": (tsi, tspace.validity())}
+        sizes = {"noop": n, "ours": n, "shapely": max(n // 20, 200), "translation": n}
+        # warm-up: builds every slab the sampler reaches
+        for key, (s_i, fn) in checkers.items():
+            s_i.setStateValidityChecker(fn)
+            s_i.probabilityOfValidState(max(sizes[key] // 4, 200) if key != "ours" else 20 * n)
+        per = {k: [] for k in checkers}
+        frac = {}
+        for _ in range(reps):
+            for key, (s_i, fn) in checkers.items():
+                s_i.setStateValidityChecker(fn)
+                t = time.process_time()
+                frac[key] = s_i.probabilityOfValidState(sizes[key])
+                per[key].append((time.process_time() - t) / sizes[key])
+        ratio = lambda a, b: statistics.median(x / y for x, y in zip(per[a], per[b]))  # noqa: E731
+        rows.append({
+            "scene": sc.name, "slabs": se2.slabs, "slabs_built": len(se2._built),
+            "us_per_state": {k: 1e6 * statistics.median(v) for k, v in per.items()},
+            "valid_fraction": frac,
+            "ours_over_translation": ratio("ours", "translation"),
+            "shapely_over_ours": ratio("shapely", "ours"),
+            "ours_over_noop": ratio("ours", "noop"),
+        })
+    return rows
+
+
+def random_motions(sc, cs, m: int, seed: int):
+    """m motions between free poses, the second within 0.2 x the SE(2) maximum extent."""
+    rng = np.random.default_rng(seed)
+    xmin, xmax, ymin, ymax = sc.bounds
+    reach = 0.2 * (math.hypot(xmax - xmin, ymax - ymin) + 0.5 * math.pi)
+    out = []
+    while len(out) < m:
+        a = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-math.pi, math.pi))
+        if not cs.is_free(a):
+            continue
+        d = rng.normal(size=3)
+        d *= rng.uniform(0, reach) / np.linalg.norm(d)
+        b = (min(max(a[0] + d[0], xmin), xmax), min(max(a[1] + d[1], ymin), ymax),
+             math.remainder(a[2] + d[2] / 0.5, 2 * math.pi))
+        if b[2] >= math.pi:
+            b = (b[0], b[1], -math.pi)
+        if cs.is_free(b):
+            out.append((a, b))
+    return out
+
+
+def part_m(m: int) -> list[dict]:
+    from planners.space_se2 import SE2Space
+
+    rows = []
+    for name in VALIDITY_SCENES:
+        sc = load_scenario(os.path.join(SE2_DIR, name))
+        cs = SE2CSpace.from_scenario(sc, slabs=sc.slabs)
+        motions = random_motions(sc, cs, m, seed=7)
+        base_space = SE2Space(cs)
+        si, keep = _si(base_space, checker=shapely_se2_checker(sc), motion_validator=False)
+        space = keep[1]
+        s1, s2 = space.allocState(), space.allocState()
+        t_ours, t_base, ours_ok, base_ok = [], [], [], []
+        for i, (a, b) in enumerate(motions):
+            base_space.set_state(s1, a)
+            base_space.set_state(s2, b)
+            for who in ((0, 1) if i % 2 else (1, 0)):
+                t = time.process_time()
+                if who == 0:
+                    ours_ok.append(cs.motion_free(a, b))
+                    t_ours.append(time.process_time() - t)
+                else:
+                    base_ok.append(bool(si.checkMotion(s1, s2)))
+                    t_base.append(time.process_time() - t)
+        judge = {}
+
+        def collides(k):
+            if k not in judge:
+                path = np.array(motions[k])
+                r = sweep_check(sc, path)
+                if r["collides"] and not r["certain"]:
+                    r = sweep_check(sc, path, dtheta=2e-5, dxy=1e-5 * (sc.bounds[1] - sc.bounds[0]))
+                judge[k] = bool(r["certain"])
+            return judge[k]
+
+        ours_bad = sum(1 for k, ok in enumerate(ours_ok) if ok and collides(k))
+        base_bad = sum(1 for k, ok in enumerate(base_ok) if ok and collides(k))
+        rows.append({
+            "scene": sc.name, "motions": m,
+            "us_per_motion": {"ours": 1e6 * statistics.median(t_ours), "baseline": 1e6 * statistics.median(t_base)},
+            "mean_us_per_motion": {"ours": 1e6 * statistics.fmean(t_ours), "baseline": 1e6 * statistics.fmean(t_base)},
+            "accepted": {"ours": sum(ours_ok), "baseline": sum(base_ok)},
+            "accepted_colliding": {"ours": ours_bad, "baseline": base_bad},
+            "floor_decisions": cs.checks.get("motion_floor", 0),
+        })
+    return rows
+
+
+def part_t(seeds: int, budget: float) -> list[dict]:
+    from planners.plan import plan
+
+    rows = []
+    for f in sorted(glob.glob(os.path.join(SE2_DIR, "*.toml"))):
+        sc = load_scenario(f)
+        if sc.expect == "unsolvable":
+            continue
+        times, lengths, solved, bad = [], [], 0, 0
+        cs = None
+        for seed in range(seeds):
+            res = plan(sc, planner="RRTConnect", time=budget, seed=seed, cspace=cs)
+            cs = res.cspace
+            if res.solved:
+                solved += 1
+                times.append(res.timings["solve"])
+                lengths.append(res.length)
+                bad += bool(sweep_check(sc, res.path)["collides"])
+        rows.append({"scene": sc.name, "solved": solved, "seeds": seeds,
+                     "median_solve_s": statistics.median(times) if times else None,
+                     "median_length": statistics.median(lengths) if lengths else None,
+                     "colliding_paths": bad})
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer states, motions and seeds")
+    ap.add_argument("--parts", default="VMT")
+    ap.add_argument("--json", help="write the figures to this file")
+    a = ap.parse_args(argv)
+    out = {}
+    if "V" in a.parts:
+        out["validity"] = part_v(n=5000 if a.quick else 50000, reps=5 if a.quick else 11)
+        print("(V) validity inside OMPL, us per state (median of interleaved rounds, CPU time)")
+        print(f"  {'scene':16} {'K':>4} {'built':>5} {'noop':>7} {'transl.':>8} {'ours':>7} {'shapely':>8}"
+              f" {'ours/transl.':>12} {'shapely/ours':>12}")
+        for r in out["validity"]:
+            u = r["us_per_state"]
+            print(f"  {r['scene']:16} {r['slabs']:>4} {r['slabs_built']:>5} {u['noop']:7.2f} {u['translation']:8.2f}"
+                  f" {u['ours']:7.2f} {u['shapely']:8.2f} {r['ours_over_translation']:12.2f} {r['shapely_over_ours']:12.1f}")
+    if "M" in a.parts:
+        out["motions"] = part_m(m=100 if a.quick else 500)
+        print("(M) motions: ours certified vs OMPL discrete (shapely checker, 1 % resolution), us per motion")
+        print(f"  {'scene':16} {'ours':>9} {'baseline':>9} {'ratio':>6} {'acc. ours':>9} {'acc. base':>9}"
+              f" {'coll. ours':>10} {'coll. base':>10} {'floor':>6}")
+        for r in out["motions"]:
+            u, acc, bad = r["us_per_motion"], r["accepted"], r["accepted_colliding"]
+            print(f"  {r['scene']:16} {u['ours']:9.1f} {u['baseline']:9.1f} {u['ours'] / u['baseline']:6.2f}"
+                  f" {acc['ours']:9} {acc['baseline']:9} {bad['ours']:10} {bad['baseline']:10} {r['floor_decisions']:6}")
+    if "T" in a.parts:
+        out["plans"] = part_t(seeds=3 if a.quick else 10, budget=10.0)
+        print("(T) RRTConnect on the bundled SE(2) scenes, 10 s budget")
+        for r in out["plans"]:
+            ms = f"{r['median_solve_s']:.3f} s" if r["median_solve_s"] is not None else "-"
+            ml = f"{r['median_length']:.3f}" if r["median_length"] is not None else "-"
+            print(f"  {r['scene']:16} solved {r['solved']}/{r['seeds']}  median first solution {ms}"
+                  f"  median length {ml}  colliding paths {r['colliding_paths']}")
+    if a.json:
+        with open(a.json, "w") as fh:
+            json.dump(out, fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
