@@ -9,6 +9,9 @@ GIF with matplotlib's animation module and Pillow (a matplotlib dependency): no 
 from __future__ import annotations
 
 import math
+import os
+import shutil
+import tempfile
 
 import numpy as np
 
@@ -99,6 +102,11 @@ def animate_path(res, out: str, frames: int = 80, fps: int = 20, scenario=None) 
 
     anim = FuncAnimation(fig, frame, frames=len(poses), blit=False)
     fig.tight_layout()
-    with atomic_path(out) as tmp:
-        anim.save(tmp, writer=PillowWriter(fps=fps), dpi=80)
+    # Pillow picks the format from the file name, and atomic_path's temporary may have
+    # none (an O_TMPFILE is /proc/self/fd/N): render to a named .gif, then copy it over.
+    with tempfile.TemporaryDirectory() as staging:
+        staged = os.path.join(staging, "animation.gif")
+        anim.save(staged, writer=PillowWriter(fps=fps), dpi=80)
+        with atomic_path(out) as tmp, open(staged, "rb") as src, open(tmp, "wb") as dst:
+            shutil.copyfileobj(src, dst)
     plt.close(fig)
