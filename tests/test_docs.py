@@ -40,6 +40,8 @@ SKIP = {
     "pip install -e .": "installs packages: the suite runs inside the installed environment",
     'pip install -e ".[test]"': "installs packages: the suite runs inside the installed environment",
     "pytest": "the suite itself (it would run this test again)",
+    "CSPACE_FUZZ_EXAMPLES=3000 pytest tests/test_fuzz_cli.py": "the fuzz suite's long run (~12 000 cases, minutes); "
+                                                                "its default size runs in the suite",
     "python scripts/make_figures.py": "regenerates every figure into docs/ (~1 min, writes into the repository); "
                                       "tests/test_guide.py and test_make_figures.py cover its parts",
     "python scripts/make_benchmarks_page.py": "runs every bench script (minutes, writes docs/benchmarks.md); "
@@ -141,9 +143,13 @@ def _run_block(doc: str, line: int, body: str, tmp_path) -> list[str]:
                 skipped.append(f"{part!r}: {reason}")
                 continue
             argv = shlex.split(part)
+            run_env = dict(env)
+            while argv and re.fullmatch(r"[A-Z_][A-Z0-9_]*=.*", argv[0]):  # VAR=value prefixes
+                k, _, v = argv.pop(0).partition("=")
+                run_env[k] = v
             if argv[0] == "python":
                 argv[0] = sys.executable
-            proc = subprocess.run(argv, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+            proc = subprocess.run(argv, cwd=tmp_path, env=run_env, capture_output=True, text=True, timeout=300)
             assert proc.returncode == want, (
                 f"{doc}:{line}: `{part}` exited {proc.returncode}, the docs say {want}\n"
                 f"stdout: {proc.stdout[-2000:]}\nstderr: {proc.stderr[-2000:]}")

@@ -13,7 +13,7 @@ import re
 
 from conftest import ROOT
 
-UP = re.compile(r"(^|[/\\])\.\.([/\\]|$)")
+UP = re.compile(r"(^|[/\\])\.\.[/\\]")  # a literal path that climbs: "../x", "a/../../x"
 OUTSIDE_NAMES = ("peer-scenarios", "/work/", "shared/notes")
 
 
@@ -25,23 +25,36 @@ def _python_files() -> list[str]:
     return sorted(out)
 
 
+def _is_root(node) -> bool:
+    return isinstance(node, ast.Name) and node.id == "ROOT"
+
+
 def outside_references(source: str) -> list[tuple[int, str]]:
     """(line, what) of each place in ``source`` that points outside the repository.
 
+    Flagged: a literal path that climbs (``"../shared"``), a name of the development
+    machine's folders, ``dirname(ROOT)`` and ``join(ROOT, "..")`` (the folder above the
+    repository). A file's own ``join(HERE, "..")`` (tests/ up to the root) stays inside.
+
     >>> outside_references('p = os.path.join(ROOT, "..", "x")')
-    [(1, "'..'")]
-    >>> outside_references('p = os.path.dirname(ROOT)\\nq = "a..b"')
+    [(1, 'join(ROOT, "..")')]
+    >>> outside_references('p = os.path.dirname(ROOT)\\nq = "a..b"\\nr = os.path.join(HERE, "..", "scenarios")')
     [(1, 'dirname(ROOT)')]
     """
     found = []
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+    tree = ast.parse(source)
+    in_fstring = {id(v) for n in ast.walk(tree) if isinstance(n, ast.JoinedStr) for v in n.values}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in in_fstring:
             if UP.search(node.value) or any(n in node.value for n in OUTSIDE_NAMES):
                 found.append((node.lineno, repr(node.value)))
-        elif (isinstance(node, ast.Call) and isinstance(node.func, (ast.Attribute, ast.Name))
-              and getattr(node.func, "attr", getattr(node.func, "id", None)) == "dirname"
-              and node.args and isinstance(node.args[0], ast.Name) and node.args[0].id == "ROOT"):
-            found.append((node.lineno, "dirname(ROOT)"))
+        elif isinstance(node, ast.Call) and isinstance(node.func, (ast.Attribute, ast.Name)) and node.args:
+            name = getattr(node.func, "attr", getattr(node.func, "id", None))
+            if name == "dirname" and _is_root(node.args[0]):
+                found.append((node.lineno, "dirname(ROOT)"))
+            elif name == "join" and _is_root(node.args[0]) and any(
+                    isinstance(a, ast.Constant) and a.value == ".." for a in node.args[1:]):
+                found.append((node.lineno, 'join(ROOT, "..")'))
     return found
 
 
@@ -50,6 +63,7 @@ def test_the_checker_sees_the_old_fault():
     old = 'PEER = os.path.join(os.path.dirname(ROOT), "shared", "peer-scenarios", "ompl")'
     assert {w for _, w in outside_references(old)} == {"dirname(ROOT)", "'peer-scenarios'"}
     assert outside_references('open("../shared/x.toml")') == [(1, "'../shared/x.toml'")]
+    assert outside_references('t = f"{a:.3g}..{b:.3g} deg"') == []  # an f-string's "..", not a path
     assert outside_references('SCENARIOS = os.path.join(ROOT, "scenarios", "ompl")') == []
 
 
