@@ -242,11 +242,11 @@ def narrow_gap(sc, cspace, results: list):
     if not paths or cspace is None:
         return None
     xmin, xmax, ymin, ymax = sc.bounds
-    size = max(xmax - xmin, ymax - ymin)
+    below = GAP_FRACTION * max(xmax - xmin, ymax - ymin)
     free = free_space(cspace.pieces, cspace.bounds)
-    gaps = [g for g in (narrowest_gap(cspace.pieces, cspace.bounds, p, free=free) for p in paths) if g]
-    best = min(gaps, key=lambda g: g.width, default=None)
-    return best if best is not None and best.width < GAP_FRACTION * size else None
+    samples = max(16, 400 // len(paths))  # 400 in all: many queries are each sampled less
+    gaps = [narrowest_gap(cspace.pieces, cspace.bounds, p, samples=samples, free=free, below=below) for p in paths]
+    return min((g for g in gaps if g is not None), key=lambda g: g.width, default=None)
 
 
 def draw_inset(ax, sc, cspace, results: list, gap) -> object:

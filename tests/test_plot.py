@@ -169,12 +169,16 @@ def test_gap_is_the_corridor_width_wherever_the_path_crosses_it(y, w, t):
     g = narrowest_gap(_corridor(y, w), (0, 10, 0, 10), np.array([[1.0, py], [9.0, py]]))
     assert g.width == pytest.approx(w, rel=1e-9, abs=1e-12)
     assert 4.0 <= g.point[0] <= 6.0 and g.ends[0][0] == pytest.approx(g.point[0])
+    # Looking only for gaps below 1 (only the edges near the path): the same gap.
+    fast = narrowest_gap(_corridor(y, w), (0, 10, 0, 10), np.array([[1.0, py], [9.0, py]]), below=1.0)
+    assert fast.width == pytest.approx(w, rel=1e-9, abs=1e-12)
 
 
 def test_gap_in_open_space_is_the_extent_across_the_path():
     g = narrowest_gap([], (0, 10, 0, 4), np.array([[1.0, 1.0], [9.0, 1.0]]))
     assert g.width == pytest.approx(4.0)
     assert narrowest_gap([], (0, 10, 0, 4), np.array([[1.0, 1.0], [1.0, 1.0]])) is None
+    assert narrowest_gap([], (0, 10, 0, 4), np.array([[1.0, 1.0], [9.0, 1.0]]), below=3.9) is None
 
 
 def test_gap_ignores_theta_of_poses():
