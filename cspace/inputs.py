@@ -34,8 +34,11 @@ def _polygons_of(item, what: str) -> list:
 
 def _shell_and_holes(shell, holes: list, what: str) -> tuple[np.ndarray, list[np.ndarray]]:
     """Normalised shell (CCW) and holes (CW), checked finite and simple."""
-    ext = as_array(shell)
-    hs = [as_array(h) for h in holes]
+    try:  # the array gate's message, prefixed with the argument it is about
+        ext = as_array(shell)
+        hs = [as_array(h) for h in holes]
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{what}: {exc}") from None
     if not all(np.isfinite(p).all() for p in [ext] + hs):
         raise ValueError(f"{what}: coordinates must be finite")
     if len(ext) < 3:

@@ -99,7 +99,7 @@ def test_generate_shows_its_stages_on_a_terminal(monkeypatch, tmp_path):
     tty = terminal(monkeypatch)
     assert main(["generate", "maze", "--size", "4", "--out", str(tmp_path / "m.toml")]) == 0
     out = tty.getvalue()
-    assert "maze-4x4: exact search" in out, out[-500:]
+    assert "maze-4x4: free-space components" in out, out[-500:]
 
 
 def test_exact_plan_shows_its_search_on_a_terminal(monkeypatch):
