@@ -51,7 +51,7 @@ def as_array(polygon, copy: bool = True, nonempty: bool = False) -> np.ndarray:
     if not np.isfinite(pts).all():
         raise ValueError("coordinates must be finite, got NaN or an infinity")
     if nonempty and not len(pts):
-        raise ValueError("expected at least one point, got an empty array")
+        raise ValueError("an operand has no vertices (an empty array)")
     if len(pts) > 1 and pts[0, 0] == pts[-1, 0] and pts[0, 1] == pts[-1, 1]:
         pts = pts[:-1]
     return pts

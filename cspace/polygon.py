@@ -313,7 +313,10 @@ def is_simple(polygon) -> bool:
     """
     import shapely
 
-    p = as_array(polygon)
+    try:
+        p = as_array(polygon)
+    except ValueError:  # NaN, inf, a wrong shape: not a simple polygon (a predicate answers, it does not raise)
+        return False
     if len(p) < 3 or not np.isfinite(p).all():  # GEOS would warn about NaN; not simple anyway
         return False
     # Area decided exactly (a float area underflows to 0 for coordinates near 1e-160).

@@ -37,6 +37,7 @@ from .errors import InputError
 
 PLOT_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 TMP_PREFIX = ".cspace-tmp-"
+NAMED_EXTENSIONS = {".gif"}  # formats whose writer reads the file name's extension
 _TMP_NAME = re.compile(re.escape(TMP_PREFIX) + r"(\d+)-[0-9a-f]+(\.[A-Za-z0-9]*)?$")
 
 
@@ -183,10 +184,10 @@ _UMASK = _umask()
 
 
 @contextlib.contextmanager
-def _temporary(folder: str, ext: str):
+def _temporary(folder: str, ext: str, unnamed: bool = True):
     """An open temporary file in ``folder``: ``(fd, name)``, name None while unnamed (O_TMPFILE)."""
     fd = None
-    if hasattr(os, "O_TMPFILE") and os.path.isdir("/proc/self/fd"):
+    if unnamed and hasattr(os, "O_TMPFILE") and os.path.isdir("/proc/self/fd"):
         try:
             fd = os.open(folder, os.O_TMPFILE | os.O_RDWR | os.O_CLOEXEC, 0o666)
         except OSError as exc:
@@ -223,7 +224,9 @@ def atomic_path(path: str, option: str = "output"):
         real = os.path.realpath(path)  # a link is followed: its target is what gets replaced
         folder = os.path.dirname(real)
         clean_stale(folder)
-        with _temporary(folder, os.path.splitext(real)[1]) as (fd, name):
+        # Unnamed (O_TMPFILE) unless a writer needs the extension in the name (Pillow's GIF).
+        ext = os.path.splitext(real)[1]
+        with _temporary(folder, ext, unnamed=ext.lower() not in NAMED_EXTENSIONS) as (fd, name):
             if st is not None and stat.S_ISREG(st.st_mode):
                 os.fchmod(fd, stat.S_IMODE(st.st_mode))  # a replaced file keeps its permissions
             yield name or f"/proc/self/fd/{fd}"
