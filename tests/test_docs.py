@@ -40,8 +40,6 @@ SKIP = {
     "pip install -e .": "installs packages: the suite runs inside the installed environment",
     'pip install -e ".[test]"': "installs packages: the suite runs inside the installed environment",
     "pytest": "the suite itself (it would run this test again)",
-    "CSPACE_FUZZ_EXAMPLES=3000 pytest tests/test_fuzz_cli.py": "the fuzz suite's long run (~12 000 cases, minutes); "
-                                                                "its default size runs in the suite",
     "python scripts/make_figures.py": "regenerates every figure into docs/ (~1 min, writes into the repository); "
                                       "tests/test_guide.py and test_make_figures.py cover its parts",
     "python scripts/make_benchmarks_page.py": "runs every bench script (minutes, writes docs/benchmarks.md); "
