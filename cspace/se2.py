@@ -31,7 +31,7 @@ import numpy as np
 from .broadphase import GridIndex
 from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
 from .minkowski import minkowski_sum, reflect
-from .predicates import orient2d_xy
+from .polygon import point_in_convex
 from .scenario import Scenario, load_scenario
 from .se2_motion import SE2Motions, interpolate  # noqa: F401  (interpolate: part of this module's API)
 from .slab import (ANGLE_SLACK, TWO_PI, _edges, _typical_gap, default_slabs, robot_radius, rotate_piece,
@@ -296,7 +296,7 @@ class SE2CSpace(SE2Motions):
                 continue  # outside by more than the rounding
             self.checks["exact_sums"] += 1
             neg = reflect(rotate_piece(self.robot_pieces[j], th))
-            if _in_convex(minkowski_sum(self.obstacle_pieces[i], neg), x, y):
+            if point_in_convex(minkowski_sum(self.obstacle_pieces[i], neg), x, y) >= 0:
                 return False
         return True
 
@@ -360,17 +360,6 @@ class SE2CSpace(SE2Motions):
             "build_seconds": sum(d["seconds"] for d in self._built),
             "checks": dict(self.checks),
         }
-
-
-def _in_convex(p: np.ndarray, x: float, y: float) -> bool:
-    """Is (x, y) in the closed convex CCW polygon p (at least 3 vertices)? Exact."""
-    pts = p.tolist()
-    px, py = pts[-1]
-    for qx, qy in pts:
-        if orient2d_xy(px, py, qx, qy, x, y) < 0:
-            return False
-        px, py = qx, qy
-    return True
 
 
 def _pair_filter(o_edges: list, o_pts: list, r_pts: list, r_axes: list, x: float, y: float, margin: float) -> int:

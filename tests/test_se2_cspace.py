@@ -241,7 +241,8 @@ def test_inner_sets_are_inside_the_robot_at_every_angle_of_their_slab():
 def test_pair_filter_decides_like_the_exact_sum():
     """The float filter in front of the exact test never contradicts the exact sum, and defers near its boundary."""
     from cspace.minkowski import minkowski_sum, reflect
-    from cspace.se2 import _edges, _in_convex, _pair_filter
+    from cspace.polygon import point_in_convex
+    from cspace.se2 import _edges, _pair_filter
 
     rng = np.random.default_rng(17)
     O = np.array([[4.0, 4.0], [6.0, 4.5], [5.5, 6.0], [4.2, 5.5]])
@@ -263,7 +264,7 @@ def test_pair_filter_decides_like_the_exact_sum():
         n = np.array([p1[1] - p0[1], p0[0] - p1[0]])
         q = p0 + (p1 - p0) * t + n / np.linalg.norm(n) * float(rng.choice([-1, 1])) * 10.0 ** -float(rng.uniform(3, 17))
         side = _pair_filter(oe, op, r, axes, float(q[0]), float(q[1]), cs.pad)
-        inside = _in_convex(S, float(q[0]), float(q[1]))
+        inside = point_in_convex(S, float(q[0]), float(q[1])) >= 0
         if side == 0:
             undecided += 1
         else:
