@@ -233,10 +233,3 @@ def termination(time_limit: float, iterations: int | None = None):
 
     it = ob.PlannerTerminationCondition(spent)
     return ob.plannerOrTerminationCondition(timed, it), it
-
-
-def path_states(path, k: int = 0) -> list[tuple[float, float]]:
-    """States of a 2-D OMPL PathGeometric as (x, y) tuples, scaled back by 2^-k."""
-    import math
-
-    return [(math.ldexp(s[0], -k), math.ldexp(s[1], -k)) for s in path.getStates()]

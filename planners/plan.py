@@ -79,14 +79,17 @@ class PlanResult:
 
 
 def path_length(path: np.ndarray) -> float:
-    """Euclidean length of a polyline.
+    """Euclidean length of the polyline of reference points: the (x, y) columns (poses
+    (x, y, theta) of a rotating robot count their x, y).
 
     >>> path_length(np.array([[0., 0], [3, 4], [3, 5]]))
+    6.0
+    >>> path_length(np.array([[0., 0, 0], [3, 4, 1], [3, 5, -1]]))
     6.0
     """
     if len(path) < 2:
         return 0.0
-    return float(np.hypot(*np.diff(path, axis=0).T).sum())
+    return float(np.hypot(*np.diff(path[:, :2], axis=0).T).sum())
 
 
 MAX_TIME = 1e8  # seconds (about three years); OMPL's steady clock overflows near 8e9 s

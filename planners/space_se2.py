@@ -15,20 +15,12 @@ import math
 
 import numpy as np
 
+from .plan import path_length
+from .spaces import frame_exponent, verify_path
+
 SO2_WEIGHT = 0.5
 
 _classes: dict = {}
-
-
-def xy_length(path: np.ndarray) -> float:
-    """Length travelled by the reference point (the x, y part of the poses).
-
-    >>> xy_length(np.array([[0., 0, 0], [3, 4, 1], [3, 5, -1]]))
-    6.0
-    """
-    if len(path) < 2:
-        return 0.0
-    return float(np.hypot(*np.diff(path[:, :2], axis=0).T).sum())
 
 
 class SE2Space:
@@ -40,8 +32,6 @@ class SE2Space:
     unsolved_hint = "try a longer --time, or more --slabs for a tighter C-space near obstacles"
 
     def __init__(self, cspace, k: int | None = None):
-        from .spaces import frame_exponent
-
         self.cspace = cspace
         self.k = frame_exponent(cspace.bounds) if k is None else int(k)
 
@@ -120,20 +110,12 @@ class SE2Space:
 
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every motion certified free, from the start pose exactly to the goal pose exactly."""
-        start, goal = self.pose(start), self.pose(goal)
-        if len(path) < 2:
-            same = len(path) == 1 and tuple(path[0]) == start == goal
-            return same, "start equals goal" if same else "empty path"
-        if tuple(path[0]) != start or tuple(path[-1]) != goal:
-            return False, "path does not run exactly from the start pose to the goal pose"
-        for i in range(len(path) - 1):
-            if not self.cspace.motion_free(tuple(path[i]), tuple(path[i + 1])):
-                return False, f"motion {i} failed the certified test"
-        return True, "certified solution"
+        return verify_path(path, self.pose(start), self.pose(goal), self.cspace.motion_free, step="motion",
+                           test="certified", ends="the start pose to the goal pose")
 
     def length(self, path: np.ndarray) -> float:
         """Length travelled by the reference point (the bound of the inscribed disk bounds it)."""
-        return xy_length(path)
+        return path_length(path)
 
     def counts(self) -> tuple[int, int]:
         """Checks made so far: (state checks, motion checks)."""

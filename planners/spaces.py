@@ -26,6 +26,8 @@ import math
 
 import numpy as np
 
+from .plan import path_length
+
 
 def frame_exponent(bounds) -> int:
     """The power of two k OMPL's states are scaled by: 0 for scenes of ordinary size.
@@ -138,26 +140,36 @@ class TranslationSpace:
 
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every segment exactly free, and the path runs from the start to the goal exactly."""
-        start, goal = tuple(map(float, start)), tuple(map(float, goal))
-        if len(path) < 2:
-            same = len(path) == 1 and tuple(path[0]) == start == goal
-            return same, "start equals goal" if same else "empty path"
-        if tuple(path[0]) != start or tuple(path[-1]) != goal:
-            return False, "path does not run exactly from start to goal"
-        for i in range(len(path) - 1):
-            if not self.cspace.segment_free(path[i], path[i + 1]):
-                return False, f"segment {i} failed the exact test"
-        return True, "exact solution"
+        return verify_path(path, tuple(map(float, start)), tuple(map(float, goal)), self.cspace.segment_free)
 
     def length(self, path: np.ndarray) -> float:
         """Euclidean length of the polyline of reference points."""
-        if len(path) < 2:
-            return 0.0
-        return float(np.hypot(*np.diff(path, axis=0).T).sum())
+        return path_length(path)
 
     def counts(self) -> tuple[int, int]:
         """Checks made so far: (state checks, motion checks)."""
         return self.cspace.point_count(), self.cspace.checks["segments"]
+
+
+def verify_path(path: np.ndarray, start: tuple, goal: tuple, step_free, *, step: str = "segment",
+                test: str = "exact", ends: str = "start to goal") -> tuple[bool, str]:
+    """The adapters' verification: the path runs from ``start`` exactly to ``goal`` exactly
+    and ``step_free(a, b)`` accepts each of its steps (one point: start equals goal).
+
+    >>> verify_path(np.array([[0., 0], [1, 0]]), (0.0, 0.0), (1.0, 0.0), lambda a, b: True)
+    (True, 'exact solution')
+    >>> verify_path(np.array([[0., 0], [1, 0]]), (0.0, 0.0), (2.0, 0.0), lambda a, b: True)
+    (False, 'path does not run exactly from start to goal')
+    """
+    if len(path) < 2:
+        same = len(path) == 1 and tuple(path[0]) == start == goal
+        return same, "start equals goal" if same else "empty path"
+    if tuple(path[0]) != start or tuple(path[-1]) != goal:
+        return False, f"path does not run exactly from {ends}"
+    for i in range(len(path) - 1):
+        if not step_free(tuple(path[i]), tuple(path[i + 1])):
+            return False, f"{step} {i} failed the {test} test"
+    return True, f"{test} solution"
 
 
 _classes: dict = {}
