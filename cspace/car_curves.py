@@ -11,6 +11,18 @@ The words themselves come from :mod:`cspace.dubins` and :mod:`cspace.reeds_shepp
 in units of the radius; this module scales, walks and interpolates them exactly as OMPL's
 ``DubinsStateSpace`` / ``ReedsSheppStateSpace::interpolate`` do (relative coordinates in radii,
 scaled and added to the start at the end), so poses agree with OMPL's to rounding.
+
+Two things to know when certifying these curves:
+
+- Ties: where two words have exactly the same length (a Dubins goal straight behind the start:
+  LSL or RSR), OMPL may drive the other one. Poses along a motion must therefore come from
+  :func:`pose_along` / :func:`knots` on these segments, never from OMPL's ``interpolate``.
+- Dubins between poses closer than about 1e-3 radii: OMPL's tolerances (a squared tangent length
+  down to −1e-7 read as 0, a turn within 0.5e-6 of a full one read as none, a single straight
+  step along the heading for poses under 1e-6 radii apart) leave its curve, and ours, up to
+  2e-6 radii and 1e-6 rad short of q1; OMPL's ``interpolate`` then jumps to q1 at t = 1. The
+  end of :func:`knots` is the curve's true end, to be compared with q1. Reeds–Shepp curves end
+  at q1 to rounding.
 """
 from __future__ import annotations
 
