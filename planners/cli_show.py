@@ -30,7 +30,7 @@ def run(args) -> int:
     from cspace.cspace import CSpace
 
     sc = load_scenario(args.scenario, space=args.space)
-    if sc.space == "se2":
+    if sc.rotates:
         return _show_se2(sc, args, fmt)
     cs = CSpace.from_scenario(sc)
     rep = cs.report()

@@ -184,4 +184,11 @@ def car_sweep_check(sc, path, segments_of, radius: float, dangle: float = 2e-3, 
                         res["undecided"] += 1  # closer than the sampling resolves: not a proof either way
             pose = end
         res["end_gap"] = max(res["end_gap"], math.hypot(pose[0] - b[0], pose[1] - b[1]))
+        if tree_obs is not None and (pose[0], pose[1]) != (b[0], b[1]):
+            # The curve's end is joined to the target pose by a straight SE(2) motion.
+            join = sweep_check(sc, np.array([[pose[0], pose[1], math.remainder(pose[2], 2 * math.pi)], list(b)]))
+            if join["collides"]:
+                res["collides"] = True
+                res["certain"] = join["certain"]
+                return res
     return res
