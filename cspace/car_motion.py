@@ -49,10 +49,29 @@ def _normals(p: np.ndarray) -> np.ndarray:
     return np.column_stack([e[:, 1], -e[:, 0]])
 
 
+def _unit_planes(pieces: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every piece's edge lines as unit outward normals and offsets, padded to the largest
+    edge count with copies of the piece's first line: arrays of shape (pieces, edges)."""
+    k = max((len(p) for p in pieces), default=0)
+    ux = np.zeros((len(pieces), k))
+    uy = np.zeros((len(pieces), k))
+    off = np.zeros((len(pieces), k))
+    for i, p in enumerate(pieces):
+        n = _normals(p)
+        ln = np.hypot(n[:, 0], n[:, 1])
+        ln[ln == 0.0] = 1.0
+        nx, ny = n[:, 0] / ln, n[:, 1] / ln
+        o = nx * p[:, 0] + ny * p[:, 1]
+        m = len(p)
+        ux[i, :m], uy[i, :m], off[i, :m] = nx, ny, o
+        ux[i, m:], uy[i, m:], off[i, m:] = nx[0], ny[0], o[0]
+    return ux, uy, off
+
+
 class CarMotions:
     """The car-like motion queries of :class:`cspace.se2.SE2CSpace` (a mixin)."""
 
-    _car_axes: dict
+    _car_planes = None
 
     def curve_free(self, q0, segments, radius: float, q1=None) -> bool:
         """Is every pose of the segment chain from q0 free? Certified (see module doc).
@@ -79,18 +98,29 @@ class CarMotions:
             self.checks["motion_collisions"] += 1
             return False
         budget = [MAX_HULLS]
+        # The knots (segment ends, wrapped) and, first, a probe of a few exact poses (each
+        # knot and each segment's middle): a colliding curve is usually refused here at
+        # the cost of a handful of pose tests. The probe only ever answers "not free".
+        chain = []
         for kind, length in segments:
             length = float(length)
             if length == 0.0:
                 continue
             end = advance(pose, kind, length, radius)
-            end = (end[0], end[1], wrap_angle(end[2]))
-            if kind == "S":
-                if not self.motion_free(pose, (end[0], end[1], pose[2])):  # one fixed angle: exact
-                    return False
-            elif not self._arc_free(pose, kind, length, radius, budget):
+            chain.append((pose, kind, length, (end[0], end[1], wrap_angle(end[2]))))
+            pose = chain[-1][3]
+        for start, kind, length, end in chain:
+            mid = advance(start, kind, 0.5 * length, radius)
+            if not (self._pose(*end) and self._pose(mid[0], mid[1], wrap_angle(mid[2]))):
+                self.checks["motion_collisions"] += 1
                 return False
-            pose = end
+        # Then the certificates: straight segments (exact, cheap) before arcs.
+        for start, kind, length, end in chain:
+            if kind == "S" and not self.motion_free(start, (end[0], end[1], start[2])):  # one fixed angle
+                return False
+        for start, kind, length, end in chain:
+            if kind != "S" and not self._arc_free(start, kind, length, radius, budget):
+                return False
         if q1 is not None:
             q1 = (float(q1[0]), float(q1[1]), wrap_angle(float(q1[2])))
             if pose != q1 and not self.motion_free(pose, q1):
@@ -106,10 +136,14 @@ class CarMotions:
         rx, ry = x - cx, y - cy
         # The robot's pieces at the arc's start, in the frame centred at c (a point robot: the point).
         rel = np.array([[rx, ry]])
-        pieces = [rotate_piece(p, th) + rel for p in self.robot_pieces] or [rel]
-        normals = [_normals(p) for p in pieces]
+        arrays = [rotate_piece(p, th) + rel for p in self.robot_pieces] or [rel]
+        pieces = [p.tolist() for p in arrays]
+        normals = [_normals(p).tolist() for p in arrays]
         reach = math.hypot(rx, ry) + self.radius
         scale = self.scale + abs(cx) + abs(cy) + reach
+        # The robot stays within `reach` of c while it turns: only obstacle pieces nearer
+        # than that (a lower bound of the distance, see _within) can be met.
+        near = self._within(cx, cy, reach, scale)
         lo, hi = min(0.0, A), max(0.0, A)
         n = max(1, math.ceil((hi - lo) / ARC_CHUNK))
         stack = [(lo + (hi - lo) * (i / n), lo + (hi - lo) * ((i + 1) / n)) for i in range(n - 1, -1, -1)]
@@ -121,7 +155,8 @@ class CarMotions:
                 return False  # the reference point leaves the bounds
             budget[0] -= 1
             self.checks["arc_sweeps"] += 1
-            if not any(self._turn_hits(p, nrm, cx, cy, a, b, scale) for p, nrm in zip(pieces, normals)):
+            if not near.size or not any(self._turn_hits(p, nrm, cx, cy, a, b, scale, near)
+                                        for p, nrm in zip(pieces, normals)):
                 continue
             m = 0.5 * (a + b)
             c, s = math.cos(m), math.sin(m)
@@ -135,9 +170,27 @@ class CarMotions:
             stack.append((a, m))
         return True
 
-    def _turn_hits(self, piece, normals, cx: float, cy: float, a: float, b: float, scale: float) -> bool:
-        """Might the convex piece (about the centre c), turned through every angle of [a, b]
-        (b − a ≤ π/4), meet an obstacle piece? False is a certificate; True may be wrong.
+    def _within(self, cx: float, cy: float, reach: float, scale: float) -> np.ndarray:
+        """Indices of the obstacle pieces that may come within ``reach`` of (cx, cy).
+
+        A piece is out of reach when one of its edge lines has the point on its outer
+        side farther than ``reach``: the distance to that line bounds the distance to
+        the piece from below. The margin 2δ (:func:`cspace.slab.slab_pad` of the
+        coordinates) covers the rounding of the unit normals and the products."""
+        planes = self._car_planes
+        if planes is None:
+            planes = self._car_planes = _unit_planes(self.obstacle_pieces)
+        ux, uy, off = planes
+        if not len(off):
+            return np.zeros(0, dtype=np.intp)
+        gap = (ux * cx + uy * cy - off).max(axis=1)
+        return np.flatnonzero(gap <= reach + 2.0 * slab_pad(scale))
+
+    def _turn_hits(self, piece: list, normals: list, cx: float, cy: float, a: float, b: float, scale: float,
+                   near: np.ndarray) -> bool:
+        """Might the convex piece (vertex list about the centre c), turned through every
+        angle of [a, b] (b − a ≤ π/4), meet an obstacle piece? False is a certificate;
+        True may be wrong (it only costs a refinement).
 
         Every turned vertex lies in its triangle T(v) = {R_a v, R_b v, R_m v / cos(Δ/2)}
         (note, section 1), so the turned piece lies in H = conv ⋃ T(v), padded by δ
@@ -146,49 +199,50 @@ class CarMotions:
         3n triangle points (plus δ·(|nx| + |ny|) for the pad). The axes tried are the
         obstacle piece's edge normals and the piece's own edge normals turned to a, m
         and b; an axis separates only with a gap above a further δ·|n|, which covers
-        the rounding of the projections. Missing axes only cost a refinement.
+        the rounding of the projections. Plain floats: the pieces are small.
         """
         h = 0.5 * (b - a)
         m = a + h
+        k = 1.0 / math.cos(h)
+        ca, sa, cb, sb, cm, sm = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(m), math.sin(m)
         pts = []
-        for ang, k in ((a, 1.0), (b, 1.0), (m, 1.0 / math.cos(h))):
-            c, s = math.cos(ang) * k, math.sin(ang) * k
-            pts.append(piece @ np.array([[c, s], [-s, c]]))
-        pts = np.concatenate(pts) + np.array([cx, cy])
-        d = slab_pad(max(float(np.abs(pts).max()) * math.sqrt(2.0), scale))
-        lo, hi = pts.min(axis=0) - d, pts.max(axis=0) + d
-        cand = np.flatnonzero((self._olo[:, 0] <= hi[0]) & (self._ohi[:, 0] >= lo[0])
-                              & (self._olo[:, 1] <= hi[1]) & (self._ohi[:, 1] >= lo[1]))
+        for x, y in piece:
+            pts.append((x * ca - y * sa + cx, x * sa + y * ca + cy))
+            pts.append((x * cb - y * sb + cx, x * sb + y * cb + cy))
+            pts.append(((x * cm - y * sm) * k + cx, (x * sm + y * cm) * k + cy))
+        xs = [p[0] for p in pts]
+        ys = [p[1] for p in pts]
+        x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+        d = slab_pad(max(max(-x0, x1, -y0, y1) * 1.5, scale))
+        olo, ohi = self._olo[near], self._ohi[near]
+        cand = near[(olo[:, 0] <= x1 + d) & (ohi[:, 0] >= x0 - d) & (olo[:, 1] <= y1 + d) & (ohi[:, 1] >= y0 - d)]
         if not cand.size:
             return False
-        # The piece's normals turned to a, m and b: candidate axes of H's own edges.
-        axes = []
-        for ang in (a, m, b):
-            c, s = math.cos(ang), math.sin(ang)
-            axes.append(normals @ np.array([[c, s], [-s, c]]))
-        axes = np.concatenate(axes)
-        grow_r = d * (np.abs(axes).sum(axis=1) + np.hypot(axes[:, 0], axes[:, 1]))
-        h_max = (pts @ axes.T).max(axis=0) + grow_r  # H's support along the turned normals
+        axes = None
         for i in cand.tolist():
-            on, off, grow_o = self._obstacle_axes(i, d)
-            if ((pts @ on.T).min(axis=0) - off > grow_o).any():
-                continue  # beyond one of the obstacle piece's edges
-            if ((self.obstacle_pieces[i] @ axes.T).min(axis=0) - h_max > grow_r).any():
-                continue  # the obstacle piece beyond H along a turned normal
-            return True
+            separated = False
+            for nx, ny, off, ln in self._obstacle_edges[i]:  # beyond one of the obstacle's edges?
+                lo = min(nx * px + ny * py for px, py in pts)
+                if lo - off > d * (abs(nx) + abs(ny) + ln):
+                    separated = True
+                    break
+            if separated:
+                continue
+            if axes is None:  # the piece's normals turned to a, m and b, with H's support along them
+                axes = []
+                for nx, ny in normals:
+                    for c, s in ((ca, sa), (cm, sm), (cb, sb)):
+                        ax, ay = nx * c - ny * s, nx * s + ny * c
+                        g = d * (abs(ax) + abs(ay) + math.hypot(ax, ay))
+                        axes.append((ax, ay, max(ax * px + ay * py for px, py in pts) + g, g))
+            obst = self.obstacle_lists[i]
+            for ax, ay, top, g in axes:  # the obstacle beyond H along a turned normal?
+                if min(ax * ox + ay * oy for ox, oy in obst) - top > g:
+                    separated = True
+                    break
+            if not separated:
+                return True
         return False
-
-    def _obstacle_axes(self, i: int, d: float):
-        """Obstacle piece i's outward edge normals, their offsets (max of n·o) and the margin
-        δ·(2|n|₁ + |n|) an axis needs (the pad of H and the rounding of the projections)."""
-        got = self._car_axes.get(i)
-        if got is None:
-            p = self.obstacle_pieces[i]
-            nrm = _normals(p)
-            got = self._car_axes[i] = (nrm, (p * nrm).sum(axis=1),
-                                       np.abs(nrm).sum(axis=1) + np.hypot(nrm[:, 0], nrm[:, 1]))
-        nrm, off, w = got
-        return nrm, off, d * w
 
     def _arc_in_bounds(self, cx: float, cy: float, rx: float, ry: float, a: float, b: float) -> bool:
         """Does the reference point's arc (about c, from c + R_a r to c + R_b r) stay in bounds?

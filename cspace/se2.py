@@ -103,7 +103,6 @@ class SE2CSpace(SE2Motions, CarMotions):
         self._robot_lists = [p.tolist() for p in self.robot_pieces]
         self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
         self._pair_grid()
-        self._car_axes: dict = {}  # obstacle piece -> its separating axes (car_motion)
         self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
                        "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0,
                        "curves": 0, "arcs": 0, "arc_sweeps": 0}

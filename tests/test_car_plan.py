@@ -149,3 +149,12 @@ def test_a_car_path_is_drawn_along_its_curves():
     assert steps.max() <= 0.05 * (1 + 1e-9)
     assert steps.sum() == pytest.approx(res.length, rel=1e-3)  # chords of an arc: a hair shorter
     assert math.isclose(poses[-1, 0], sc.goal[0]) and math.isclose(poses[-1, 1], sc.goal[1])
+
+
+def test_bench_car_runs_and_ours_accepts_no_colliding_motion():
+    bench = load_script("bench_car")
+    rows = bench.part_m(m=4)
+    assert {r["scene"] for r in rows} == {load_scenario(f).name for f in CARS}
+    for r in rows:
+        assert r["accepted_colliding"]["ours"] == 0
+        assert r["us_per_motion"]["ours"] > 0 and r["us_per_motion"]["discrete"] > 0
