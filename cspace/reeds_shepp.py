@@ -177,6 +177,7 @@ GROUPS = (
     (PI, ((_lrslr, "LRSLR", lambda t, u, v: (t, -HALF_PI, u, -HALF_PI, v), False),)),
 )
 _SWAP = str.maketrans("LR", "RL")
+_MIRROR = {word: word.translate(_SWAP) for _, group in GROUPS for _, word, _, _ in group}
 
 
 def reeds_shepp_frame(q0, q1, radius: float) -> tuple[float, float, float]:
@@ -197,17 +198,19 @@ def _group_candidates(x: float, y: float, phi: float, group):
     cp, sp = math.cos(phi), math.sin(phi)
     for solve, word, layout, backwards in group:
         bx, by = (x * cp + y * sp, x * sp - y * cp) if backwards else (x, y)
-        for gx, gy, gphi, sign, w in (
-            (bx, by, phi, 1.0, word),
-            (-bx, by, -phi, -1.0, word),
-            (bx, -by, -phi, 1.0, word.translate(_SWAP)),
-            (-bx, -by, phi, -1.0, word.translate(_SWAP)),
+        mirror = _MIRROR[word]
+        for gx, gy, gphi, flip, w in (
+            (bx, by, phi, False, word),
+            (-bx, by, -phi, True, word),
+            (bx, -by, -phi, False, mirror),
+            (-bx, -by, phi, True, mirror),
         ):
             tuv = solve(gx, gy, gphi)
             if tuv is not None:
                 t, u, v = tuv
                 cost = abs(t) + 2.0 * abs(u) + abs(v) if word == "LRLR" else abs(t) + abs(u) + abs(v)
-                yield w, tuple(sign * e for e in layout(t, u, v)), cost
+                lengths = layout(t, u, v)
+                yield w, tuple(-e for e in lengths) if flip else lengths, cost
 
 
 def reeds_shepp_candidates(x: float, y: float, phi: float) -> list[tuple[str, tuple[float, ...]]]:
