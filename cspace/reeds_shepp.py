@@ -2,9 +2,10 @@
 
 The start is the origin with heading 0, the goal (x, y, φ) in the start's frame, the turning
 radius 1. Reeds and Shepp proved that a shortest path is one of 48 words of at most five
-segments; their section 8 gives each family in closed form for one "base" word, L+S+L+ (8.1),
-L+S+R+ (8.2), L+R−L (8.3/8.4), L+R+L−R− (8.7), L+R−L−R+ (8.8), L+R−S−L− (8.9), L+R−S−R− (8.10)
-and L+R−S−L−R+ (8.11) (the signs: forward +, reverse −). The other words follow by symmetry:
+segments; their section 8 gives each family in closed form for one "base" word: L+S+L+ (8.1),
+L+S+R+ (8.2), L+R−L (8.3/8.4), L+R+L−R− (8.7), L+R−L−R+ (8.8), L+R−S−L− (8.9),
+L+R−S−R− (8.10) and L+R−S−L−R+ (8.11) (signs: forward +, reverse −). The other words follow
+by symmetry:
 
 - time flip: driving the word in reverse ((x, y, φ) -> (−x, y, −φ)) negates every length;
 - reflection across the x axis ((x, y, φ) -> (x, −y, −φ)) swaps L and R;
@@ -13,9 +14,9 @@ and L+R−S−L−R+ (8.11) (the signs: forward +, reverse −). The other words
 
 A solution is (t, u, v) (turns in radians, straights in radii; signs give the direction); the
 fixed quarter turns of the CCSC and CCSCC families are ±π/2. The choice copies OMPL's
-``ReedsSheppStateSpace``: the same candidates (the paper's formulas with the two misprints of
-8.3 and 8.11 corrected), the same admissibility tolerance, the same order, a later candidate
-replacing the best only when strictly shorter.
+``ReedsSheppStateSpace``: the same candidates (the paper's formulas, 8.3 and 8.11 in the form
+OMPL corrects them to), the same admissibility tolerance, the same order, and its comparison
+(a later candidate replaces the best only when strictly shorter).
 """
 from __future__ import annotations
 
@@ -85,8 +86,8 @@ def _lrl(x, y, phi):
 def _tau_omega(u, v, xi, eta, phi):
     # The first and last turns of a CCCC word whose middle turns are u and v, given the goal's
     # circle centre (ξ, η) relative to the start's: solve the two position equations for τ
-    # (two roots a half turn apart; the sign of t2 says which one closes the chain), then
-    # the heading equation gives ω.
+    # (atan2 gives it up to a half turn; the sign of t2 picks the branch that closes the
+    # chain), then the heading equation gives ω.
     delta = angle_pi(u - v)
     a = math.sin(u) - math.sin(delta)
     b = math.cos(u) - math.cos(delta) - 1.0
@@ -122,8 +123,8 @@ def _lrlr_b(x, y, phi):
 
 
 def _lrsl(x, y, phi):
-    # 8.9 L+R−(π/2) S− L−: after the quarter turn the straight is tangent to the goal's left
-    # circle; ρ is the distance between the left centres, r = sqrt(ρ² − 4) the tangent length.
+    # 8.9 L+R−(π/2) S− L−: with ρ the distance between the start's and the goal's left centres,
+    # the reverse straight is sqrt(ρ² − 4) − 2 long (u = 2 − sqrt(ρ² − 4) <= 0).
     rho, theta = _polar(x - math.sin(phi), y - 1.0 + math.cos(phi))
     if rho < 2.0:
         return None
@@ -176,6 +177,7 @@ GROUPS = (
     (PI, ((_lrslr, "LRSLR", lambda t, u, v: (t, -HALF_PI, u, -HALF_PI, v), False),)),
 )
 _SWAP = str.maketrans("LR", "RL")
+_MIRROR = {word: word.translate(_SWAP) for _, group in GROUPS for _, word, _, _ in group}
 
 
 def reeds_shepp_frame(q0, q1, radius: float) -> tuple[float, float, float]:
@@ -196,17 +198,19 @@ def _group_candidates(x: float, y: float, phi: float, group):
     cp, sp = math.cos(phi), math.sin(phi)
     for solve, word, layout, backwards in group:
         bx, by = (x * cp + y * sp, x * sp - y * cp) if backwards else (x, y)
-        for gx, gy, gphi, sign, w in (
-            (bx, by, phi, 1.0, word),
-            (-bx, by, -phi, -1.0, word),
-            (bx, -by, -phi, 1.0, word.translate(_SWAP)),
-            (-bx, -by, phi, -1.0, word.translate(_SWAP)),
+        mirror = _MIRROR[word]
+        for gx, gy, gphi, flip, w in (
+            (bx, by, phi, False, word),
+            (-bx, by, -phi, True, word),
+            (bx, -by, -phi, False, mirror),
+            (-bx, -by, phi, True, mirror),
         ):
             tuv = solve(gx, gy, gphi)
             if tuv is not None:
                 t, u, v = tuv
                 cost = abs(t) + 2.0 * abs(u) + abs(v) if word == "LRLR" else abs(t) + abs(u) + abs(v)
-                yield w, tuple(sign * e for e in layout(t, u, v)), cost
+                lengths = layout(t, u, v)
+                yield w, tuple(-e for e in lengths) if flip else lengths, cost
 
 
 def reeds_shepp_candidates(x: float, y: float, phi: float) -> list[tuple[str, tuple[float, ...]]]:
