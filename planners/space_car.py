@@ -95,9 +95,17 @@ class CarSpace(SE2Space):
         return _classes["validator"](si, self)
 
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
-        """Every curve between consecutive poses certified free, from the start pose to the goal pose."""
-        return verify_path(path, self.pose(start), self.pose(goal), self.motion_free, step="curve",
-                           test="certified", ends="the start pose to the goal pose")
+        """Every curve between consecutive poses certified free, from the start pose to the goal pose.
+
+        A Dubins curve is one-way (the curve from b to a is not the one from a to b
+        reversed); planners that use a motion in both directions (PRM, PRMstar,
+        BKPIECE1, ...) can return paths that fail here, and the message says so."""
+        ok, msg = verify_path(path, self.pose(start), self.pose(goal), self.motion_free, step="curve",
+                              test="certified", ends="the start pose to the goal pose")
+        if not ok and self.name == "dubins":
+            msg += (" (Dubins curves are one-way: planners that use a motion in both directions, such as "
+                    "PRM, PRMstar and BKPIECE1, return such paths; use RRT, RRTConnect, RRTstar or BITstar)")
+        return ok, msg
 
     def length(self, path: np.ndarray) -> float:
         """The distance driven: the sum of the curves' lengths (OMPL's metric of the space).

@@ -158,3 +158,17 @@ def test_bench_car_runs_and_ours_accepts_no_colliding_motion():
     for r in rows:
         assert r["accepted_colliding"]["ours"] == 0
         assert r["us_per_motion"]["ours"] > 0 and r["us_per_motion"]["discrete"] > 0
+
+
+def test_a_failed_dubins_path_says_curves_are_one_way():
+    """Planners that use motions both ways (PRM, ...) can return Dubins paths that fail the
+    certified re-check; the message says why and which planners to use."""
+    from planners.plan import _adapter, _build_cspace
+
+    sc = load_scenario(os.path.join(SCENARIOS, "car", "maze.toml"))
+    ad = _adapter(sc, _build_cspace(sc))
+    through_wall = np.array([sc.start, (3.0, 8.5, 0.0), sc.goal])  # straight up through the wall at y = 5.5
+    ok, msg = ad.verify(through_wall, sc.start, sc.goal)
+    assert not ok and "one-way" in msg and "RRTConnect" in msg
+    ok, msg = ad.verify(through_wall[::-1], sc.goal, sc.start)
+    assert not ok
