@@ -303,3 +303,15 @@ def test_a_map_without_start_says_so(tmp_path, capsys):
     code = main(["plan", y])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and ": start: " in err[0] and "--start" in err[0]
+
+
+def test_a_cfg_without_pycollada_says_how_to_get_it(tmp_path, capsys, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "collada", None)  # as if pycollada were not installed
+    cfg = tmp_path / "p.cfg"
+    cfg.write_text("[problem]\nrobot = r.dae\nworld = w.dae\nstart.x = 0\nstart.y = 0\ngoal.x = 1\ngoal.y = 1\n")
+    out = tmp_path / "s.toml"
+    code = main(["import", str(cfg), "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "pycollada" in err[0] and ".[io]" in err[0] and not out.exists()
