@@ -21,6 +21,9 @@ from .scenario import ScenarioError, scenario_from_dict
 MAP_SUFFIXES = (".yaml", ".yml")
 CFG_SUFFIXES = (".cfg",)
 SUFFIXES = MAP_SUFFIXES + CFG_SUFFIXES
+# A map's default simplification tolerance, in cells: 2 lets Douglas-Peucker (within 0.8 cell)
+# straighten a diagonal staircase (its corners are 0.71 cell off the diagonal); 1 would not.
+DEFAULT_TOLERANCE_CELLS = 2.0
 
 
 @dataclass
@@ -32,7 +35,7 @@ class ImportOptions:
     (a ``.cfg`` names its own robot). ``start`` and ``goal`` are ``(x, y)`` or
     ``(x, y, theta)`` (a ``.cfg`` gives its own, which these override).
     ``unknown`` is ``"obstacle"`` or ``"free"``; ``tolerance`` is the largest
-    simplification error in world units (None: one cell of a map; 0: the exact
+    simplification error in world units (None: two cells of a map; 0: the exact
     staircase of cells).
     """
 
@@ -106,7 +109,7 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     t_read = time.perf_counter() - t0
     exact = staircase(grid)
     exact = shapely.transform(exact, lambda c: c - 1.0)  # padded units to cell units (exact on integers)
-    tol = res if options.tolerance is None else options.tolerance
+    tol = DEFAULT_TOLERANCE_CELLS * res if options.tolerance is None else options.tolerance
     result = simplify_conservative(exact, tol / res)
     t_trace = time.perf_counter() - t0 - t_read
     error = _largest_error(result, exact) * res

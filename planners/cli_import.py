@@ -36,7 +36,7 @@ def add_import_options(p) -> None:
     g.add_argument("--unknown", choices=("obstacle", "free"), default=None,
                    help="a map's unknown cells: obstacle (default) or free")
     g.add_argument("--tolerance", type=float, help="largest simplification error of a map's obstacles, in map "
-                                                   "units (default: one cell; 0: the exact staircase of cells)")
+                                                   "units (default: two cells; 0: the exact staircase of cells)")
 
 
 IMPORT_FLAGS = ("robot", "radius", "polygon", "start", "goal", "unknown", "tolerance")
