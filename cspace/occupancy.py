@@ -163,8 +163,12 @@ def read_map_yaml(path) -> MapInfo:
 
 
 def _number(x, path: str, key: str, positive: bool = False) -> float:
-    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(float(x)):
-        raise ScenarioError(path, key, f"must be a finite number, got {x!r}")
+    try:
+        finite = not isinstance(x, bool) and isinstance(x, (int, float)) and math.isfinite(float(x))
+    except OverflowError:  # an integer beyond the doubles
+        finite = False
+    if not finite:
+        raise ScenarioError(path, key, f"must be a finite number, got {str(x)[:60]}")
     if positive and not x > 0:
         raise ScenarioError(path, key, f"must be positive, got {x!r}")
     return float(x)
@@ -199,6 +203,9 @@ def read_image(info: MapInfo, yaml_path: str) -> tuple[np.ndarray, np.ndarray | 
         raise ScenarioError(yaml_path, field_, f"{info.image}: no such file") from None
     except ScenarioError:
         raise
+    except Image.DecompressionBombError:
+        raise ScenarioError(info.image, field_, f"over {MAX_PIXELS} pixels: a map needs 1 to {MAX_PIXELS} "
+                                                "cells") from None
     except (OSError, ValueError, SyntaxError) as exc:  # Pillow: unreadable, truncated, not an image
         raise ScenarioError(info.image, field_, f"cannot read the image ({str(exc)[:120]})") from None
     if arr.ndim == 2:
@@ -223,16 +230,15 @@ def classify(values: np.ndarray, alpha: np.ndarray | None, info: MapInfo) -> np.
     >>> classify(np.array([[0, 254, 205]], dtype=np.uint8), None, info).tolist()
     [[1, 0, -1]]
     """
-    v = values.astype(np.float64)
+    # One class per grey level (a 256-entry table), then one lookup per cell.
+    v = np.arange(256, dtype=np.float64)
     if info.negate:
         v = 255.0 - v
+    p = v / 100.0 if info.mode == "raw" else (255.0 - v) / 255.0
+    table = np.where(p > info.occupied_thresh, 1, np.where(p < info.free_thresh, 0, -1)).astype(np.int8)
     if info.mode == "raw":
-        p = v / 100.0
-        out = np.where(p > info.occupied_thresh, 1, np.where(p < info.free_thresh, 0, -1)).astype(np.int8)
-        out[v > 100] = -1  # 255 is unknown; 101..254 are no occupancy value: unknown too
-        return out
-    p = (255.0 - v) / 255.0
-    out = np.where(p > info.occupied_thresh, 1, np.where(p < info.free_thresh, 0, -1)).astype(np.int8)
+        table[v > 100] = -1  # 255 is unknown; 101..254 are no occupancy value: unknown too
+    out = table[values]
     if info.mode == "scale" and alpha is not None:
         out[alpha == 0] = -1
     return out

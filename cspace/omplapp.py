@@ -28,6 +28,7 @@ problem is planned as its geometric problem, and says so.
 from __future__ import annotations
 
 import os
+import warnings
 
 import numpy as np
 
@@ -108,6 +109,14 @@ def read_mesh(cfg_path: str, key: str, name: str):
     if not mesh.lower().endswith(".dae"):
         raise ScenarioError(cfg_path, key, f"{name}: only COLLADA (.dae) meshes are read")
     raw = read_input(mesh)
+    with warnings.catch_warnings():  # pycollada's numpy.matrix use warns on every load
+        warnings.simplefilter("ignore", PendingDeprecationWarning)
+        return _read_collada(collada, raw, cfg_path, mesh, key)
+
+
+def _read_collada(collada, raw: bytes, cfg_path: str, mesh: str, key: str):
+    from .meshes import to_plane
+
     try:
         import io
 

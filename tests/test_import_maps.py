@@ -327,3 +327,19 @@ def test_the_bench_script_runs_small(monkeypatch, capsys):
     assert bench.main() == 0
     out = capsys.readouterr().out
     assert "read image (peer)" in out and "C-space build" in out and "targets" in out
+
+
+def test_show_draws_an_imported_map(tmp_path, capsys):
+    y = write_map(tmp_path, blobs(40, 60, seed=2, unknown=False))
+    png = tmp_path / "c.png"
+    assert main(["show", y, "--radius", "0.05", "--start", "0.1,0.1", "--goal", "0.1,0.1", "--plot", str(png)]) in (0, 2)
+    out, err = capsys.readouterr()
+    assert ("C-obstacle pieces" in out and png.stat().st_size > 10_000) or ": start: " in err
+
+
+def test_huge_numbers_in_the_yaml_are_one_line(tmp_path, capsys):
+    y = write_map(tmp_path, blobs(20, 20, 1))
+    text = open(y).read()
+    open(y, "w").write(text.replace("resolution: 0.05", "resolution: " + "9" * 400))
+    code, err, out = run_import(capsys, tmp_path, y)
+    assert code == 2 and len(err) == 1 and ": resolution: " in err[0] and len(err[0]) < 300

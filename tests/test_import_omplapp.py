@@ -216,3 +216,87 @@ def test_bad_problems_are_one_line(tmp_path, capsys, case, field):
     assert code == 2 and len(err) == 1 and err[0].startswith("error: ") and len(err[0]) < 300, err
     assert f": {field}: " in err[0], err
     assert not out.exists()
+
+
+def sketchup_box(x0, x1, y0, y1, z0, z1, matrix: str) -> str:
+    """A COLLADA file written the way OMPL.app's resources are (SketchUp 8): Z_UP, a node with a
+    scaling matrix inside an outer node, normals inside <vertices>, each face with its own four
+    corners, front faces and back faces as two triangle sets of two materials."""
+    faces = []  # (corners, normal) of the six faces of the box
+    for axis in range(3):
+        for side, (lo, hi) in ((0, (x0, x1)), (1, (y0, y1)), (2, (z0, z1)))[axis:axis + 1]:
+            for val, sign in ((lo, -1.0), (hi, 1.0)):
+                others = [a for a in range(3) if a != axis]
+                bounds = [(x0, x1), (y0, y1), (z0, z1)]
+                quad = []
+                for u, v in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                    p = [0.0, 0.0, 0.0]
+                    p[axis] = val
+                    p[others[0]] = bounds[others[0]][u]
+                    p[others[1]] = bounds[others[1]][v]
+                    quad.append(p)
+                n = [0.0, 0.0, 0.0]
+                n[axis] = sign
+                faces.append((quad, n))
+    pos, nor, front, back = [], [], [], []
+    for quad, n in faces:
+        k = len(pos) // 3
+        for p in quad:  # front face corners
+            pos += p
+            nor += n
+        front += [k, k + 1, k + 2, k, k + 2, k + 3]
+        k = len(pos) // 3
+        for p in quad:  # the same corners again for the back face, normal reversed
+            pos += p
+            nor += [-c for c in n]
+        back += [k + 2, k + 1, k, k + 3, k + 2, k]
+    f = " ".join(f"{v:.7f}" for v in pos)
+    g = " ".join(f"{v:.7f}" for v in nor)
+    return f"""<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+ <asset><up_axis>Z_UP</up_axis></asset>
+ <library_visual_scenes><visual_scene id="ID1"><node name="SketchUp"><node id="ID2" name="instance_0">
+  <matrix>{matrix}</matrix>
+  <instance_geometry url="#ID3"><bind_material><technique_common>
+   <instance_material symbol="Material2" target="#ID9"><bind_vertex_input semantic="UVSET0" input_semantic="TEXCOORD" input_set="0" /></instance_material>
+   <instance_material symbol="Material3" target="#ID4"><bind_vertex_input semantic="UVSET0" input_semantic="TEXCOORD" input_set="0" /></instance_material>
+  </technique_common></bind_material></instance_geometry>
+ </node></node></visual_scene></library_visual_scenes>
+ <library_geometries><geometry id="ID3"><mesh>
+  <source id="ID6"><float_array id="ID11" count="{len(pos)}">{f}</float_array><technique_common>
+   <accessor count="{len(pos) // 3}" source="#ID11" stride="3"><param name="X" type="float" /><param name="Y" type="float" /><param name="Z" type="float" /></accessor></technique_common></source>
+  <source id="ID7"><float_array id="ID12" count="{len(nor)}">{g}</float_array><technique_common>
+   <accessor count="{len(nor) // 3}" source="#ID12" stride="3"><param name="X" type="float" /><param name="Y" type="float" /><param name="Z" type="float" /></accessor></technique_common></source>
+  <vertices id="ID8"><input semantic="POSITION" source="#ID6" /><input semantic="NORMAL" source="#ID7" /></vertices>
+  <triangles count="{len(front) // 3}" material="Material3"><input offset="0" semantic="VERTEX" source="#ID8" /><p>{" ".join(map(str, front))}</p></triangles>
+  <triangles count="{len(back) // 3}" material="Material2"><input offset="0" semantic="VERTEX" source="#ID8" /><p>{" ".join(map(str, back))}</p></triangles>
+ </mesh></geometry></library_geometries>
+ <library_materials><material id="ID4" name="material_0"><instance_effect url="#ID5" /></material>
+  <material id="ID9" name="material_1"><instance_effect url="#ID10" /></material></library_materials>
+ <library_effects><effect id="ID5"><profile_COMMON><technique sid="COMMON"><lambert><diffuse><color>1 0 0 1</color></diffuse></lambert></technique></profile_COMMON></effect>
+  <effect id="ID10"><profile_COMMON><technique sid="COMMON"><lambert><diffuse><color>1 1 1 1</color></diffuse></lambert></technique></profile_COMMON></effect></library_effects>
+ <scene><instance_visual_scene url="#ID1" /></scene>
+</COLLADA>
+"""
+
+
+def test_a_sketchup_style_problem(tmp_path):
+    # The robot: a box 0.05 x 0.0787402 x 0.025 scaled by 100 and moved by -2.475 in x, Z_UP: in the
+    # plane (x, z) it is [-2.475, 2.525] x [-1.25, 1.25], its vertex mean (0.025, 0).
+    robot = sketchup_box(0, 0.05, -0.0787402, 0, -0.0125, 0.0125,
+                         "100 0 0 -2.475 0 100 0 0 0 0 100 0 0 0 0 1")
+    # The world: a wall 10 x 2 (plane x from 5 to 15, plane y from -1 to 1) scaled by 10.
+    world = sketchup_box(0.5, 1.5, -0.08, 0, -0.1, 0.1, "10 0 0 0 0 10 0 0 0 0 10 0 0 0 0 1")
+    (tmp_path / "robot.dae").write_text(robot)
+    (tmp_path / "world.dae").write_text(world)
+    cfg = tmp_path / "p.cfg"
+    cfg.write_text("[problem]\nrobot = robot.dae\nworld = world.dae\nstart.x = -10\nstart.y = 0\nstart.theta = 0\n"
+                   "goal.x = 25\ngoal.y = 0\ngoal.theta = 3.14159\nvolume.min.x = -30\nvolume.min.y = -30\n"
+                   "volume.max.x = 30\nvolume.max.y = 30\n")
+    imp = import_file(cfg)
+    r = shapely.Polygon(imp.data["robot"]["polygon"])
+    assert r.symmetric_difference(shapely.box(-2.5, -1.25, 2.5, 1.25)).area < 1e-5
+    w = shapely.Polygon(imp.data["obstacles"][0]["polygon"])
+    assert len(imp.data["obstacles"]) == 1 and w.symmetric_difference(shapely.box(5, -1, 15, 1)).area < 1e-5
+    assert any("Z_UP" in line for line in imp.report)
+    assert load_scenario(cfg).space == "se2"
