@@ -110,7 +110,10 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     exact = staircase(grid)
     exact = shapely.transform(exact, lambda c: c - 1.0)  # padded units to cell units (exact on integers)
     tol = DEFAULT_TOLERANCE_CELLS * res if options.tolerance is None else options.tolerance
-    result = simplify_conservative(exact, tol / res)
+    # World coordinates round once (x = origin + X * resolution): a simplified vertex moves by
+    # about an ulp of the largest coordinate, which the growth covers (64 of them, in cells).
+    rounding = 64 * np.finfo(float).eps * (max(abs(ox), abs(oy)) + max(w, h) * res + res) / res
+    result = simplify_conservative(exact, tol / res, margin=rounding)
     t_trace = time.perf_counter() - t0 - t_read
     error = _largest_error(result, exact) * res
 

@@ -293,11 +293,12 @@ def staircase(blocked: np.ndarray):
     return shapely.simplify(shapely.union_all(boxes), 0.0)  # collinear vertices out (exact on integers)
 
 
-def simplify_conservative(geom, tolerance: float):
+def simplify_conservative(geom, tolerance: float, margin: float = 0.0):
     """``geom`` simplified within ``tolerance`` and grown so it still contains ``geom``.
 
     Douglas-Peucker within a = tolerance / 2.5, then a mitred growth by a (limit 1.5 a)
-    (plus a margin of 1e-6 a): contains ``geom``, within ``tolerance`` of it.
+    plus 1e-6 a plus ``margin`` (the rounding of the caller's change of frame): contains
+    ``geom``, within ``tolerance`` (+ 2.5 ``margin``) of it.
 
     >>> import shapely
     >>> g = shapely.Polygon([(0, 0), (10, 0), (10, 1), (9, 1), (9, 1.2), (0, 1.2)])
@@ -310,7 +311,7 @@ def simplify_conservative(geom, tolerance: float):
         return geom
     a = tolerance / (1.0 + MITRE)
     simple = shapely.simplify(geom, a, preserve_topology=True)
-    grown = shapely.buffer(simple, a * (1.0 + 1e-6), join_style="mitre", mitre_limit=MITRE)
+    grown = shapely.buffer(simple, a * (1.0 + 1e-6) + margin, join_style="mitre", mitre_limit=MITRE)
     return shapely.simplify(shapely.union(grown, geom), 0.0)  # the union is a no-op but for rounding
 
 
