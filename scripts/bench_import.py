@@ -107,32 +107,35 @@ def run(args, img: np.ndarray, folder: str) -> int:
 
     times = {"read image (peer)": []} | {f"import {k}": [] for k in opts}
     builds, counts = {k: [] for k in opts}, {}
+    cpu = {name: [] for name in list(times) + [f"C-space build {k}" for k in opts]}
+
+    def timed(name, fn, into):
+        t, c = time.perf_counter(), time.process_time()
+        out = fn()
+        into.append(time.perf_counter() - t)
+        cpu[name].append(time.process_time() - c)  # the machine may be shared: CPU time beside wall time
+        return out
+
     for _ in range(args.reps):  # interleaved: each rep runs every variant once
-        t = time.perf_counter()
-        read_only()
-        times["read image (peer)"].append(time.perf_counter() - t)
+        timed("read image (peer)", read_only, times["read image (peer)"])
         for k, o in opts.items():
-            t = time.perf_counter()
-            imp = import_file(yaml, o)
-            times[f"import {k}"].append(time.perf_counter() - t)
+            imp = timed(f"import {k}", lambda: import_file(yaml, o), times[f"import {k}"])
             sc = scenario_from_dict(imp.data, yaml)
-            t = time.perf_counter()
-            cs = CSpace.from_scenario(sc)
-            builds[k].append(time.perf_counter() - t)
+            cs = timed(f"C-space build {k}", lambda: CSpace.from_scenario(sc), builds[k])
             counts[k] = (len(sc.obstacles), sum(len(s.polygon) + sum(len(h) for h in s.holes) for s in sc.obstacles),
                          cs.report()["pieces"], next(line for line in imp.report if line.startswith("obstacles:")))
     peer = statistics.median(times["read image (peer)"])
-    print(f"{'step':<28} {'median s':>9} {'x peer':>8}")
-    for k, ts in times.items():
+    print(f"{'step':<32} {'median s':>9} {'x peer':>8} {'CPU s':>8}")
+    rows = list(times.items()) + [(f"C-space build {k}", ts) for k, ts in builds.items()]
+    for name, ts in rows:
         m = statistics.median(ts)
-        print(f"{k:<28} {m:9.3f} {m / peer:8.1f}")
-    for k, ts in builds.items():
-        m = statistics.median(ts)
-        print(f"{'C-space build ' + k:<28} {m:9.3f} {m / peer:8.1f}")
+        print(f"{name:<32} {m:9.3f} {m / peer:8.1f} {statistics.median(cpu[name]):8.3f}")
     for k, (n, v, pieces, line) in counts.items():
         print(f"{k}: {n} obstacles, {v} vertices, {pieces} C-obstacle pieces; report: {line}")
-    target = all(statistics.median(times[f"import {k}"]) < 10 and statistics.median(builds[k]) < 10 for k in opts)
-    print(f"targets (import < 10 s, C-space < 10 s): {'met' if target else 'NOT met'}")
+    k = next(iter(opts))  # the targets are for the default import
+    target = statistics.median(times[f"import {k}"]) < 10 and statistics.median(builds[k]) < 10
+    print(f"targets for the default import (import < 10 s, C-space < 10 s, wall time): "
+          f"{'met' if target else 'NOT met'}")
     return 0
 
 
