@@ -67,7 +67,14 @@ def is_import(path) -> bool:
 
 
 def import_file(path, options: ImportOptions | None = None) -> Imported:
-    """Import a map YAML or an OMPL.app cfg into a scenario dict and a report."""
+    """Import a map YAML or an OMPL.app cfg into a scenario dict and a report.
+
+    >>> import os
+    >>> root = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps")
+    >>> imp = import_file(os.path.join(root, "office.yaml"), ImportOptions(start=(0.5, 0.5), goal=(9.5, 6.5)))
+    >>> len(imp.data["obstacles"]), imp.data["bounds"]["xmax"]
+    (54, 11.0)
+    """
     path = os.fspath(path)
     options = options or ImportOptions()
     if options.unknown not in ("obstacle", "free"):
@@ -82,13 +89,29 @@ def import_file(path, options: ImportOptions | None = None) -> Imported:
 
 
 def load_imported(path, space: str | None = None, options: ImportOptions | None = None):
-    """:func:`import_file`, then validated into a :class:`cspace.scenario.Scenario`."""
+    """:func:`import_file`, then validated into a :class:`cspace.scenario.Scenario`.
+
+    >>> import os
+    >>> root = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps")
+    >>> sc = load_imported(os.path.join(root, "office.yaml"),
+    ...                    options=ImportOptions(robot={"radius": 0.2}, start=(0.5, 0.5), goal=(9.5, 6.5)))
+    >>> sc.robot_kind, sc.start, sc.space
+    ('disk', (0.5, 0.5), 'translation')
+    """
     imp = import_file(path, options)
     return scenario_from_dict(imp.data, os.fspath(path), space=space)
 
 
 def import_map(path: str, options: ImportOptions) -> Imported:
-    """A ROS map (YAML + image) as a scenario dict: obstacles traced conservatively."""
+    """A ROS map (YAML + image) as a scenario dict: obstacles traced conservatively.
+
+    >>> import os
+    >>> root = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps")
+    >>> imp = import_map(os.path.join(root, "office.yaml"), ImportOptions(start=(0.5, 0.5), goal=(9.5, 6.5),
+    ...                                                                   tolerance=0.0))
+    >>> imp.report[2]
+    'obstacles: 58 traced (482 vertices, 1 holes) -> 58 after simplification (482 vertices, 1 holes)'
+    """
     import shapely
 
     from .occupancy import (classify, fill_corner_touches, polygons_of, read_image, read_map_yaml,

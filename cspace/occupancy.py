@@ -176,7 +176,12 @@ def _number(x, path: str, key: str, positive: bool = False) -> float:
 
 def read_image(info: MapInfo, yaml_path: str) -> tuple[np.ndarray, np.ndarray | None]:
     """The image as (H, W) uint8 channel averages (``map_server``'s value) and its alpha
-    channel or None; 8-bit grey, grey+alpha, RGB, RGBA, palette and 1-bit images."""
+    channel or None; 8-bit grey, grey+alpha, RGB, RGBA, palette and 1-bit images.
+
+    >>> f = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps", "office.yaml")
+    >>> values, alpha = read_image(read_map_yaml(f), f); values.shape, values.dtype.name, alpha
+    ((180, 240), 'uint8', None)
+    """
     field_ = "image"
     try:
         from PIL import Image

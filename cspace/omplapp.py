@@ -96,18 +96,23 @@ def _number(problem: dict, key: str, path: str, default=None) -> float:
 
 def read_mesh(cfg_path: str, key: str, name: str):
     """The triangles of mesh ``name`` (the cfg's ``key``: robot or world) in the plane,
-    (N, 3, 2), and the plane coordinates of its distinct corners (for the centre)."""
-    from .meshes import to_plane
+    (N, 3, 2), the plane coordinates of its distinct corners (for the centre), its up
+    axis and unit. A missing file is a one-line error naming the cfg's field:
 
-    try:
-        import collada
-    except ImportError:
-        raise ScenarioError(cfg_path, key, f"reading COLLADA meshes needs pycollada: {IO_HINT}") from None
+    >>> read_mesh("p.cfg", "world", "no_such_mesh.dae")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    cspace.scenario.ScenarioError: p.cfg: world: mesh file no_such_mesh.dae not found (looked in ...)
+    """
     mesh = name if os.path.isabs(name) else os.path.join(os.path.dirname(os.path.abspath(cfg_path)), name)
     if not os.path.exists(mesh):
         raise ScenarioError(cfg_path, key, f"mesh file {name} not found (looked in {os.path.dirname(mesh)})")
     if not mesh.lower().endswith(".dae"):
         raise ScenarioError(cfg_path, key, f"{name}: only COLLADA (.dae) meshes are read")
+    try:
+        import collada
+    except ImportError:
+        raise ScenarioError(cfg_path, key, f"reading COLLADA meshes needs pycollada: {IO_HINT}") from None
     raw = read_input(mesh)
     with warnings.catch_warnings():  # pycollada's numpy.matrix use warns on every load
         warnings.simplefilter("ignore", PendingDeprecationWarning)
@@ -172,7 +177,15 @@ def _distinct_corners(prim, tri3: np.ndarray, idx: np.ndarray, up: str) -> np.nd
 
 
 def import_cfg(path: str, options: ImportOptions) -> Imported:
-    """An OMPL.app 2-D problem as an SE(2) scenario dict and a report."""
+    """An OMPL.app 2-D problem as an SE(2) scenario dict and a report.
+
+    >>> import tempfile
+    >>> f = os.path.join(tempfile.mkdtemp(), "p.cfg"); _ = open(f, "w").write("[problem]\\nrobot = r.dae\\n")
+    >>> import_cfg(f, ImportOptions())  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    cspace.scenario.ScenarioError: ...p.cfg: world: missing (the mesh file of the robot and of the world)
+    """
     from .meshes import footprint, polygons
 
     cfg = read_cfg(path)

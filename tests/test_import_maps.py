@@ -15,7 +15,7 @@ from PIL import Image
 
 from cspace.imported import ImportOptions, import_file, load_imported
 from cspace.occupancy import MapInfo, classify, parse_flat_yaml
-from cspace.scenario import ScenarioError, load_scenario
+from cspace.scenario import load_scenario
 from planners.cli import main
 
 FREE, OCC, UNK = 254, 0, 205  # map_server's grey levels (trinary, not negated)
@@ -311,6 +311,8 @@ def test_a_cfg_without_pycollada_says_how_to_get_it(tmp_path, capsys, monkeypatc
     import sys
 
     monkeypatch.setitem(sys.modules, "collada", None)  # as if pycollada were not installed
+    (tmp_path / "r.dae").write_text("<COLLADA/>")  # present: the missing reader is what is reported
+    (tmp_path / "w.dae").write_text("<COLLADA/>")
     cfg = tmp_path / "p.cfg"
     cfg.write_text("[problem]\nrobot = r.dae\nworld = w.dae\nstart.x = 0\nstart.y = 0\ngoal.x = 1\ngoal.y = 1\n")
     out = tmp_path / "s.toml"

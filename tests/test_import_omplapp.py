@@ -49,7 +49,7 @@ def lift(tris: np.ndarray, up: str) -> np.ndarray:
 
 def write_dae(path: str, parts: list, up: str = "Y_UP", unit: float | None = None):
     """A COLLADA file; ``parts`` are (triangles (N, 3, 3), 4x4 node matrix or None), one node each."""
-    from collada import asset, geometry, material, scene, source
+    from collada import geometry, material, scene, source
 
     mesh = collada.Collada()
     mesh.assetInfo.upaxis = up
@@ -77,7 +77,6 @@ def write_dae(path: str, parts: list, up: str = "Y_UP", unit: float | None = Non
     mesh.scene = mesh.scenes[0]
     mesh.assetInfo.save()
     mesh.write(path)
-    del asset
 
 
 ROBOT = shapely.Polygon([(0, 0), (4, 0), (4, 1), (1, 1), (1, 3), (0, 3)])  # an L: its vertex mean is not its box's
