@@ -347,3 +347,23 @@ def test_huge_numbers_in_the_yaml_are_one_line(tmp_path, capsys):
     open(y, "w").write(text.replace("resolution: 0.05", "resolution: " + "9" * 400))
     code, err, out = run_import(capsys, tmp_path, y)
     assert code == 2 and len(err) == 1 and ": resolution: " in err[0] and len(err[0]) < 300
+
+
+@pytest.mark.parametrize("mode, negate", [("raw", 0), ("scale", 0), ("trinary", 1), ("raw", 1)])
+def test_modes_end_to_end_cover_the_cells_map_server_blocks(tmp_path, mode, negate):
+    rng = np.random.default_rng(11)
+    img = rng.integers(0, 256, (30, 40)).astype(np.uint8)
+    img[rng.random((30, 40)) < 0.7] = 0 if (mode == "raw") != bool(negate) else 255  # mostly free
+    y = write_map(tmp_path, img, resolution=0.2, origin=(1.0, -1.0, 0.0), mode=mode, extra=f"negate: {negate}\n")
+    imp = import_file(y, options(tolerance=0.0))
+    # map_server's rule, written out again: v (negated first), raw: p = v / 100 (over 100: unknown),
+    # else p = (255 - v) / 255; blocked unless p < free_thresh (occupied and unknown are obstacles).
+    v = 255 - img.astype(int) if negate else img.astype(int)
+    p = v / 100.0 if mode == "raw" else (255 - v) / 255.0
+    free = (p < 0.196) & ~((v > 100) if mode == "raw" else np.zeros(v.shape, bool))
+    u = union_of(imp.data)
+    assert shapely.covers(u, cell_squares(~free, 0.2, (1.0, -1.0))).all()
+    # and no free cell inside, but those filled where blocked cells touched only at a corner (counted)
+    filled = sum(int(w.split(": ")[1].split()[0]) for w in imp.warnings if "touched only at a corner" in w)
+    inside = shapely.intersects(u, shapely.buffer(cell_squares(free, 0.2, (1.0, -1.0)), -1e-9)).sum()
+    assert inside == filled
