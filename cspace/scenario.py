@@ -184,10 +184,14 @@ class Scenario:
 # Loading
 
 
-def load_scenario(path, space: str | None = None, turning_radius: float | None = None) -> Scenario:
+def load_scenario(path, space: str | None = None, turning_radius: float | None = None, options=None) -> Scenario:
     """Read and validate a TOML scenario file; ``space`` (``"translation"``, ``"se2"``,
     ``"dubins"`` or ``"reeds-shepp"``) overrides the file's ``space`` (``--space`` on the
     command line), ``turning_radius`` its ``turning_radius`` (``--turning-radius``).
+
+    A ROS map (``.yaml``) or an OMPL.app problem (``.cfg``) is imported
+    (:mod:`cspace.imported`); ``options`` (an :class:`cspace.imported.ImportOptions`)
+    give what such a file does not say: the robot, a map's start and goal.
 
     >>> import tempfile, os
     >>> d = tempfile.mkdtemp(); f = os.path.join(d, "s.toml")
@@ -197,6 +201,10 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
     (0.9, 0.9)
     """
     path = os.fspath(path)
+    if path.lower().endswith((".yaml", ".yml", ".cfg")):  # the suffixes of cspace.imported
+        from .imported import load_imported
+
+        return load_imported(path, space=space, options=options, turning_radius=turning_radius)
     raw = read_input(path)
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in raw[:4096]:
         raise ScenarioError(path, "file", "UTF-16 or binary, not UTF-8 text (save the file as UTF-8)")

@@ -22,6 +22,7 @@ COMMANDS = {
     "bench": "planners.bench",
     "stability": "planners.stability",
     "generate": "planners.generate",
+    "import": "planners.cli_import",
 }
 
 

@@ -12,7 +12,8 @@ def register(sub) -> None:
                        description="Plan a path for a translating robot, a rotating one (--space se2) or a car "
                                    "(--space dubins / reeds-shepp); "
                                    "exit 0 solved, 1 not solved, 2 bad input.")
-    p.add_argument("scenario", help="scenario TOML file")
+    p.add_argument("scenario", help="scenario TOML file, or a ROS map (.yaml) or OMPL.app problem (.cfg) to "
+                                    "import on the fly (see the options for imported files)")
     p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, else RRTConnect")
     p.add_argument("--time", type=number, help="time limit in seconds; default: the scenario's, else 1")
     p.add_argument("--seed", type=integer, help="random seed; default: the scenario's, else 0")
@@ -26,6 +27,9 @@ def register(sub) -> None:
     p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
     p.add_argument("--json", help="write the result as JSON")
     p.add_argument("--verbose", "-v", action="store_true", help="print the C-space report and OMPL's messages")
+    from .cli_import import add_import_options
+
+    add_import_options(p)
     p.set_defaults(run=run)
 
 
@@ -77,6 +81,9 @@ def run(args) -> int:
                          f"({OMPL_HINT})\n")
         args.planner = "exact"
     check_input(src)
+    from .cli_import import import_options
+
+    options = import_options(args, src)
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[src]) if args.plot is not None else None
     if args.animate is not None:
         check_output(args.animate, "--animate", {".gif": "gif"}, inputs=[src])
@@ -89,7 +96,19 @@ def run(args) -> int:
         from .ompl_glue import ompl
 
         ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
-    res = plan(src, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
+    scenario = src
+    if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
+        from cspace.imported import import_file
+        from cspace.scenario import scenario_from_dict
+
+        imp = import_file(src, options)
+        for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate")):
+            if out is not None:
+                check_output(out, opt, inputs=imp.inputs)
+        for w in imp.warnings:
+            sys.stderr.write(f"warning: {w}\n")
+        scenario = scenario_from_dict(imp.data, src, space=args.space)
+    res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
                simplify=not args.no_simplify, all_queries=args.all_queries,
                space=args.space, slabs=args.slabs, turning_radius=args.turning_radius)
     print(summary(res, verbose=args.verbose))

@@ -13,6 +13,9 @@ def register(sub) -> None:
     from .cli_plan import add_space_options, number
 
     add_space_options(p)
+    from .cli_import import add_import_options
+
+    add_import_options(p)
     p.add_argument("--theta", type=number, default=0.0,
                    help="SE(2): draw the C-space of the angle slab that holds this angle (radians, default 0)")
     p.add_argument("--verbose", "-v", action="store_true")
@@ -29,7 +32,9 @@ def run(args) -> int:
     check_distinct([(args.json, "--json"), (args.plot, "--plot")])
     from cspace.cspace import CSpace
 
-    sc = load_scenario(args.scenario, space=args.space)
+    from .cli_import import import_options
+
+    sc = load_scenario(args.scenario, space=args.space, options=import_options(args, args.scenario))
     if sc.rotates:
         return _show_se2(sc, args, fmt)
     cs = CSpace.from_scenario(sc)

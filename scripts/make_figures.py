@@ -143,6 +143,29 @@ def circles_figure(time_limit: float = 1.0, seed: int = 0) -> Callable[[str], st
     return draw
 
 
+# The guide's ROS map: the robot, start and goal its commands use.
+MAP = os.path.join(SCENARIOS, "maps", "office.yaml")
+MAP_ROBOT = os.path.join(SCENARIOS, "maps", "robot.toml")
+MAP_START, MAP_GOAL = (0.5, 0.5), (9.5, 6.5)
+
+
+def map_figure(seed: int = SEED) -> Callable[[str], str]:
+    """The ROS map imported and planned, as ``cspace plan office.yaml --robot robot.toml --plot``."""
+
+    def draw(out: str) -> str:
+        from cspace.imported import ImportOptions, load_imported
+        from planners.cli_import import read_robot
+        from planners.plan import plan
+        from planners.plot import plot_result
+
+        opts = ImportOptions(robot=read_robot(MAP_ROBOT), start=MAP_START, goal=MAP_GOAL)
+        res = plan(load_imported(MAP, options=opts), seed=seed)
+        plot_result(res, out)
+        return f"{res.planner} seed {res.seed}: " + (f"length {res.length:.6g}" if res.solved else "not solved")
+
+    return draw
+
+
 def stability_figure(out: str) -> str:
     """The stability catalogue's chart, as ``cspace stability --plot``."""
     from planners import stability
@@ -215,6 +238,7 @@ def figures() -> list[Figure]:
     out.append(Figure("car_u_turn", "car", "car: a three-point turn in a narrow street", car_plan_figure("u_turn")))
     out.append(Figure("car_loading_dock", "car", "car: backing into a loading bay", car_plan_figure("loading_dock")))
     out.append(Figure("car_maze", "car", "car: Dubins through a maze", car_plan_figure("maze")))
+    out.append(Figure("map_office", "maps", "a ROS occupancy map imported and planned", map_figure()))
     out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
     out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure()))
     out.append(Figure("error_vs_time", "acceptance", "cspace bench: the acceptance sweep (4 scenarios, 4 planners)",
@@ -240,7 +264,7 @@ def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "figures"), help="folder for the PNGs")
-    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, se2, circles, bench, "
+    ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, se2, maps, circles, bench, "
                                    "stability; acceptance, the long sweep, only when named)")
     ap.add_argument("--list", action="store_true", help="list the figures and exit")
     args = ap.parse_args(argv)
