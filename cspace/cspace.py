@@ -360,9 +360,7 @@ class CSpace:
         # ends with a border cell (3) and a border row follows the last: a point up
         # to a cell past the top or right edge reads a border cell, one further raises
         # IndexError (inf: OverflowError), so only the lower edges need a comparison.
-        flat = idx.state.astype(np.uint8).tobytes()
-        border = bytes([3])
-        rows = [flat[r * nx:(r + 1) * nx] + border for r in range(ny)] + [border * (nx + 1)]
+        rows = idx.state_rows()
         exact = self._is_free_exact
         mixed = self._mixed_cell_test()
         xmin, xmax, ymin, ymax = self.bounds
