@@ -39,10 +39,15 @@ from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
 from .polygon import invalid_reason, is_convex, normalize
 from .slab import wrap_angle
 
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+
+
+def _toml():
+    """The TOML reader, imported when a file is read (not by ``import cspace``)."""
+    try:  # Python >= 3.11
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+    return tomllib
 
 
 class ScenarioError(ValueError):
@@ -195,6 +200,7 @@ def load_scenario(path, space: str | None = None) -> Scenario:
         text = raw.decode("utf-8-sig")  # a byte-order mark is allowed and skipped
     except UnicodeDecodeError as exc:
         raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
+    tomllib = _toml()
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
