@@ -515,9 +515,41 @@ class _Validator:
         return shapes, kind
 
     def obstacles(self, lst, tol: float) -> list[Shape]:
+        """The obstacles, in order, as :meth:`shape` reads each one.
+
+        Plain polygons (no holes) have their numbers read here and their geometry
+        checked and normalised in batches (:func:`cspace.polygon_batch.normalize_many`);
+        any the batch does not decide, and every other obstacle, go through
+        :meth:`shape`. The first faulty obstacle in file order is the one reported,
+        as if each were read in turn.
+        """
         if not isinstance(lst, list):
             raise self.err("obstacles", "must be an array of tables [[obstacles]]")
-        return [self.shape(t, f"obstacles[{i}]", tol, allow_holes=True) for i, t in enumerate(lst)]
+        from .polygon_batch import normalize_many
+
+        out: list = [None] * len(lst)
+        plain, arrays = [], []
+        fault = None
+        for i, t in enumerate(lst):
+            try:
+                if isinstance(t, dict) and "polygon" in t and set(t) <= {"polygon", "holes"} and \
+                        t.get("holes", []) == [] and isinstance(t["polygon"], list):
+                    pts = t["polygon"]
+                    field = f"obstacles[{i}].polygon"
+                    arrays.append(np.array([self.point(p, f"{field}[{j}]") for j, p in enumerate(pts)],
+                                           dtype=np.float64).reshape(-1, 2))
+                    plain.append(i)
+                else:
+                    out[i] = self.shape(t, f"obstacles[{i}]", tol, allow_holes=True)
+            except ScenarioError as exc:
+                fault = (i, exc)  # raised below, unless an earlier obstacle has a fault
+                break
+        for i, got in zip(plain, normalize_many(arrays)):
+            out[i] = Shape(got[0], [], None, convex=got[1]) if got is not None else \
+                self.shape(lst[i], f"obstacles[{i}]", tol, allow_holes=True)  # the scalar route decides
+        if fault is not None:
+            raise fault[1]
+        return out
 
     def planner(self, t) -> dict:
         if not isinstance(t, dict):
