@@ -21,6 +21,8 @@ from array import array
 
 import numpy as np
 
+from .polygon import piece_boxes
+
 FREE, MIXED, BLOCKED = 0, 1, 2
 
 # Relative margin for the certified cell classification: far above the rounding
@@ -43,11 +45,15 @@ def _ints(a: np.ndarray) -> array:
     return out
 
 
-def _box_share(p: np.ndarray, xmin: float, xmax: float, ymin: float, ymax: float) -> float:
-    """Fraction of the bounds covered by p's bounding box (clipped to the bounds)."""
-    bw = min(float(p[:, 0].max()), xmax) - max(float(p[:, 0].min()), xmin)
-    bh = min(float(p[:, 1].max()), ymax) - max(float(p[:, 1].min()), ymin)
-    return max(bw, 0.0) * max(bh, 0.0) / ((xmax - xmin) * (ymax - ymin))
+def _box_shares(lo: np.ndarray, hi: np.ndarray, xmin: float, xmax: float, ymin: float, ymax: float) -> np.ndarray:
+    """Fraction of the bounds covered by each piece's bounding box (clipped to the bounds).
+
+    >>> _box_shares(np.array([[-1., 0]]), np.array([[1., 2]]), 0.0, 2.0, 0.0, 2.0).tolist()
+    [0.5]
+    """
+    bw = np.minimum(hi[:, 0], xmax) - np.maximum(lo[:, 0], xmin)
+    bh = np.minimum(hi[:, 1], ymax) - np.maximum(lo[:, 1], ymin)
+    return np.maximum(bw, 0.0) * np.maximum(bh, 0.0) / ((xmax - xmin) * (ymax - ymin))
 
 
 class GridIndex:
@@ -67,11 +73,12 @@ class GridIndex:
         self.bounds = (xmin, xmax, ymin, ymax)
         n = len(pieces)
         w, h = xmax - xmin, ymax - ymin
+        self._lo, self._hi = piece_boxes(pieces)  # each piece's box, in one pass
         if cells is None:
             cells = int(min(max(1024 * n, 1 << 16), 1 << 20))
             # Large, overlapping pieces (comb sums) would each cover a big share of that
             # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
-            cover = sum(_box_share(p, xmin, xmax, ymin, ymax) for p in pieces)
+            cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist())
             if cover * cells > _PAIR_BUDGET:
                 cells = max(int(_PAIR_BUDGET / cover), 1 << 12)
         nx = max(1, min(4096, int(round(math.sqrt(cells * w / h)))))
@@ -86,7 +93,9 @@ class GridIndex:
         # error scales with the scene's extent; the shift itself may round by up to
         # an ulp of the largest coordinate, which the margin also covers.
         self.ox, self.oy = 0.5 * (xmin + xmax), 0.5 * (ymin + ymax)
-        big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] + [float(np.abs(p).max()) for p in pieces])
+        full = np.isfinite(self._lo[:, 0])  # non-empty pieces
+        big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] +
+                  ([float(max(np.abs(self._lo[full]).max(), np.abs(self._hi[full]).max()))] if full.any() else []))
         self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
         state = np.zeros(nx * ny, dtype=np.int8)
         blocker = np.full(nx * ny, -1, dtype=np.int64)
@@ -206,8 +215,7 @@ class GridIndex:
         # Bit e stands for the edge ending at vertex e: slot i (edge i -> i+1) is bit (i + 1) % n.
         weights = np.where(valid, np.left_shift(np.int64(1), (slot[None, :] + 1) % sizes[:, None]), 0)
         # Each piece's box of cells (widened by the margin), clipped to the grid.
-        lo_xy = np.array([pieces[k].min(axis=0) for k in ks])
-        hi_xy = np.array([pieces[k].max(axis=0) for k in ks])
+        lo_xy, hi_xy = self._lo[ks], self._hi[ks]
         i0 = np.maximum(np.floor((lo_xy[:, 0] - m - self.x0) * self.inv_w), 0).astype(np.int64)
         i1 = np.minimum(np.floor((hi_xy[:, 0] + m - self.x0) * self.inv_w), self.nx - 1).astype(np.int64)
         j0 = np.maximum(np.floor((lo_xy[:, 1] - m - self.y0) * self.inv_h), 0).astype(np.int64)

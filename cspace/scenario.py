@@ -404,6 +404,13 @@ class _Validator:
             raise self.err(field, f"{a} and {b} exclude each other ({hint})")
 
     def number(self, x, field: str, positive: bool = False) -> float:
+        # The common cases first (a scene may hold 10^6 numbers): a finite float within
+        # the supported magnitude (NaN and inf fail the comparison), a modest int.
+        if not positive:
+            if type(x) is float and -MAX_MAGNITUDE <= x <= MAX_MAGNITUDE:
+                return x
+            if type(x) is int and -(1 << 53) <= x <= 1 << 53:
+                return float(x)
         if x is None:
             raise self.err(field, "missing (a number is required)")
         if isinstance(x, bool) or not isinstance(x, (int, float)):
@@ -629,7 +636,7 @@ class CollisionProbe:
 
         self._shapely = shapely
         self._sc = sc
-        self._geoms = [ob.to_shapely() for ob in sc.obstacles]
+        self._geoms = _shapely_obstacles(sc.obstacles)
         self._tree = shapely.STRtree(self._geoms) if self._geoms else None
 
     def first_hit(self, x: float, y: float, theta: float = 0.0) -> int | None:
@@ -642,6 +649,24 @@ class CollisionProbe:
             body = shapely.Point(x, y)
         hits = self._tree.query(body, predicate="intersects")
         return int(hits.min()) if len(hits) else None
+
+
+def _shapely_obstacles(obstacles: list) -> list:
+    """``[ob.to_shapely() for ob in obstacles]``, polygons without holes made in batches of
+    one vertex count (one shapely call each instead of one per obstacle)."""
+    import shapely
+
+    out = [None] * len(obstacles)
+    groups: dict = {}
+    for i, ob in enumerate(obstacles):
+        if ob.holes:
+            out[i] = ob.to_shapely()
+        else:
+            groups.setdefault(len(ob.polygon), []).append(i)
+    for idx in groups.values():
+        for i, g in zip(idx, shapely.polygons(np.stack([obstacles[i].polygon for i in idx])).tolist()):
+            out[i] = g
+    return out
 
 
 def first_collision(sc: Scenario, x: float, y: float) -> int | None:
