@@ -30,8 +30,24 @@ FREE, MIXED, BLOCKED = 0, 1, 2
 _MARGIN = 1e-9
 
 
+# Boxes wider than this many cells are classified row by row (GridIndex._scan_rows).
+SCAN_COLUMNS = 8
+
 # Most (piece, cell) pairs the build classifies, before the grid is coarsened.
 _PAIR_BUDGET = float(1 << 22)
+
+
+def _runs(rows: np.ndarray, jj: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """The cells (row, i, j) of the column runs [lo, hi] of each row (empty where lo > hi).
+
+    >>> [x.tolist() for x in _runs(np.array([5, 6]), np.array([0, 1]), np.array([2, 4]), np.array([3, 3]))]
+    [[5, 5], [2, 3], [0, 0]]
+    """
+    n = np.maximum(hi - lo + 1, 0)
+    total = int(n.sum())
+    k = np.repeat(np.arange(len(n)), n)
+    i = lo[k] + (np.arange(total) - np.repeat(np.cumsum(n) - n, n))
+    return rows[k], i, jj[k]
 
 
 def _ints(a: np.ndarray) -> array:
@@ -222,30 +238,125 @@ class GridIndex:
         j1 = np.minimum(np.floor((hi_xy[:, 1] + m - self.y0) * self.inv_h), self.ny - 1).astype(np.int64)
         W = np.maximum(i1 - i0 + 1, 0)
         H = np.maximum(j1 - j0 + 1, 0)
-        counts = W * H
-        total = int(counts.sum())
-        row = np.repeat(np.arange(K), counts)
-        t = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
-        ii = i0[row] + t % W[row]
-        jj = j0[row] + t // W[row]
-        inside = np.empty(total, dtype=bool)
-        separated = np.empty(total, dtype=bool)
-        masks = np.empty(total, dtype=np.int64)
-        step = max(1, (1 << 21) // E)
-        for s in range(0, total, step):
-            r = row[s : s + step]
-            cx0 = (self.x0 - self.ox) + ii[s : s + step] * self.cw
-            cy0 = (self.y0 - self.oy) + jj[s : s + step] * self.ch
-            d = cx0[:, None] * nrm[r, :, 0]
-            d += cy0[:, None] * nrm[r, :, 1]
-            d -= c[r]
-            strictly_in = d <= -m - hi[r]
-            inside[s : s + step] = strictly_in.all(axis=1)
-            masks[s : s + step] = ((~strictly_in) * weights[r]).sum(axis=1)
-            separated[s : s + step] = (d >= m - lo[r]).any(axis=1)
-        keep = ~separated
+        x_off, y_off, cw, ch = self.x0 - self.ox, self.y0 - self.oy, self.cw, self.ch
+
+        def evaluate(row, ii, jj):
+            """inside, separated, mask of the cells (piece row[k], cell ii[k], jj[k])."""
+            n = len(row)
+            inside = np.empty(n, dtype=bool)
+            separated = np.empty(n, dtype=bool)
+            masks = np.empty(n, dtype=np.int64)
+            step = max(1, (1 << 21) // E)
+            for s in range(0, n, step):
+                r = row[s : s + step]
+                cx0 = x_off + ii[s : s + step] * cw
+                cy0 = y_off + jj[s : s + step] * ch
+                d = cx0[:, None] * nrm[r, :, 0]
+                d += cy0[:, None] * nrm[r, :, 1]
+                d -= c[r]
+                strictly_in = d <= -m - hi[r]
+                inside[s : s + step] = strictly_in.all(axis=1)
+                masks[s : s + step] = ((~strictly_in) * weights[r]).sum(axis=1)
+                separated[s : s + step] = (d >= m - lo[r]).any(axis=1)
+            return inside, separated, masks
+
+        # Pieces at most SCAN_COLUMNS cells wide: every cell of their box is evaluated.
+        # Wider ones row by row (_scan_rows): per row and edge the column where the edge's
+        # test flips is found exactly, so only the cells near the boundary are evaluated.
+        narrow_box = W <= SCAN_COLUMNS
+        parts = []
+        dense = np.flatnonzero(narrow_box & (W * H > 0))
+        if len(dense):
+            counts = (W * H)[dense]
+            total = int(counts.sum())
+            row = np.repeat(dense, counts)
+            t = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+            ii = i0[row] + t % W[row]
+            jj = j0[row] + t // W[row]
+            inside, separated, masks = evaluate(row, ii, jj)
+            keep = ~separated
+            parts.append((row[keep], ii[keep], jj[keep], inside[keep], masks[keep]))
+        scan = np.flatnonzero(~narrow_box & (H > 0))
+        if len(scan):
+            parts += self._scan_rows(scan, i0, i1, j0, H, nrm, c, hi, lo, evaluate)
+        if not parts:
+            z = np.zeros(0, dtype=np.int64)
+            return z, z, np.zeros(0, dtype=bool), z
+        row, ii, jj, inside, masks = (np.concatenate(x) for x in zip(*parts))
         pid = np.asarray(ks, dtype=np.int64)[row]
-        return pid[keep], (jj * self.nx + ii)[keep], inside[keep], masks[keep]
+        return pid, jj * self.nx + ii, inside, masks
+
+    def _scan_rows(self, pieces, i0, i1, j0, H, nrm, c, hi, lo, evaluate) -> list:
+        """:meth:`_classify_many`'s cells of wide boxes, row by row, the same answers.
+
+        Along a row the classification value d = ((x0 - ox) + i cw) n_x + (cy n_y) - c of
+        an edge is evaluated in floats, each operation rounded monotonically, so as a
+        function of the column i it is monotone (with the sign of n_x; constant when
+        n_x is 0 or NaN). Each edge's "strictly inside" and "separating" tests therefore
+        flip at most once along the row, at a column found exactly by bisection on the
+        same float expression. Cells inside for every edge are inside (no edge near
+        them: mask 0), cells separated by an edge are dropped, and only the cells in
+        between are evaluated in full, as the dense route does.
+        """
+        m, x_off, y_off, cw, ch = self.margin, self.x0 - self.ox, self.y0 - self.oy, self.cw, self.ch
+        out = []
+        E = nrm.shape[1]
+        per = max(1, (1 << 20) // E)  # rows per block
+        rows_all = np.repeat(pieces, H[pieces])
+        local = np.arange(len(rows_all)) - np.repeat(np.cumsum(H[pieces]) - H[pieces], H[pieces])
+        for s in range(0, len(rows_all), per):
+            rr = rows_all[s : s + per]
+            jj = j0[rr] + local[s : s + per]
+            n0 = nrm[rr, :, 0]
+            yterm = (y_off + jj * ch)[:, None] * nrm[rr, :, 1]
+            cc = c[rr]
+            t_in, t_sep = -m - hi[rr], m - lo[rr]
+            a, b = i0[rr][:, None], i1[rr][:, None]
+            pos, neg = n0 > 0, n0 < 0
+
+            def d_at(i):
+                d = (x_off + i * cw) * n0
+                d += yterm
+                d -= cc
+                return d
+
+            def flip(test):
+                """First column where test(d) turns True (monotone False..True), b + 1 if none."""
+                L = np.broadcast_to(a, n0.shape).copy()
+                U = np.broadcast_to(b + 1, n0.shape).copy()
+                while True:
+                    act = L < U
+                    if not act.any():
+                        return L
+                    mid = (L + U) // 2
+                    f = test(d_at(np.minimum(mid, b))) & act
+                    U = np.where(f, mid, U)
+                    L = np.where(act & ~f, mid + 1, L)
+
+            d0 = d_at(a)
+            # strictly inside edge e: a prefix of the row (n_x > 0), a suffix (n_x < 0), all or none
+            f_in = flip(lambda d: np.where(pos, ~(d <= t_in), d <= t_in))
+            lo_in = np.where(pos, a, np.where(neg, f_in, np.where(d0 <= t_in, a, b + 1)))
+            hi_in = np.where(pos, f_in - 1, np.where(neg, b, np.where(d0 <= t_in, b, a - 1)))
+            # not separated by edge e: likewise
+            f_ns = flip(lambda d: np.where(pos, d >= t_sep, ~(d >= t_sep)))
+            lo_ns = np.where(pos, a, np.where(neg, f_ns, np.where(~(d0 >= t_sep), a, b + 1)))
+            hi_ns = np.where(pos, f_ns - 1, np.where(neg, b, np.where(~(d0 >= t_sep), b, a - 1)))
+            in_lo, in_hi = lo_in.max(axis=1), hi_in.min(axis=1)
+            ns_lo, ns_hi = lo_ns.max(axis=1), hi_ns.min(axis=1)
+            in_lo, in_hi = np.maximum(in_lo, ns_lo), np.minimum(in_hi, ns_hi)
+            has_in = in_lo <= in_hi
+            # runs of cells: inside [in_lo, in_hi]; to evaluate: the rest of [ns_lo, ns_hi]
+            left_hi = np.where(has_in, in_lo - 1, ns_hi)
+            right_lo = np.where(has_in, in_hi + 1, ns_hi + 1)
+            cells = [_runs(rr, jj, ns_lo, left_hi), _runs(rr, jj, right_lo, ns_hi)]
+            er, ei, ej = (np.concatenate(x) for x in zip(*cells))
+            inside, separated, masks = evaluate(er, ei, ej)
+            keep = ~separated
+            out.append((er[keep], ei[keep], ej[keep], inside[keep], masks[keep]))
+            ir, ic, ij = _runs(rr, jj, in_lo, in_hi)
+            out.append((ir, ic, ij, np.ones(len(ir), dtype=bool), np.zeros(len(ir), dtype=np.int64)))
+        return out
 
     def _classify(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cells that closed convex ``p`` may meet, which of them lie inside ``p``, and for
