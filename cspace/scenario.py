@@ -542,9 +542,12 @@ class _Validator:
                 if isinstance(t, dict) and "polygon" in t and set(t) <= {"polygon", "holes"} and \
                         t.get("holes", []) == [] and isinstance(t["polygon"], list):
                     pts = t["polygon"]
-                    field = f"obstacles[{i}].polygon"
-                    arrays.append(np.array([self.point(p, f"{field}[{j}]") for j, p in enumerate(pts)],
-                                           dtype=np.float64).reshape(-1, 2))
+                    arr = _plain_points(pts)
+                    if arr is None:  # something to report, or to convert with care: point by point
+                        field = f"obstacles[{i}].polygon"
+                        arr = np.array([self.point(p, f"{field}[{j}]") for j, p in enumerate(pts)],
+                                       dtype=np.float64).reshape(-1, 2)
+                    arrays.append(arr)
                     plain.append(i)
                 else:
                     out[i] = self.shape(t, f"obstacles[{i}]", tol, allow_holes=True)
@@ -649,6 +652,30 @@ class CollisionProbe:
             body = shapely.Point(x, y)
         hits = self._tree.query(body, predicate="intersects")
         return int(hits.min()) if len(hits) else None
+
+
+def _plain_points(pts: list) -> np.ndarray | None:
+    """``[[x, y], ...]`` of plain floats and ints, all finite and within the supported
+    magnitude, as an (N, 2) array (what :meth:`_Loader.point` gives point by point);
+    None for anything else (a bool, a string, a huge int, NaN...), which the loader
+    then reads point by point to word its error.
+
+    >>> _plain_points([[0, 1.5], [2, 3]]).tolist(), _plain_points([[0, True]]), _plain_points([[0, float("nan")]])
+    ([[0.0, 1.5], [2.0, 3.0]], None, None)
+    """
+    for p in pts:
+        if type(p) is not list or len(p) != 2:
+            return None
+        x, y = p
+        if (type(x) is not float and type(x) is not int) or (type(y) is not float and type(y) is not int):
+            return None
+    try:
+        arr = np.array(pts, dtype=np.float64).reshape(-1, 2)
+    except (OverflowError, ValueError):
+        return None
+    if not len(arr) or not np.abs(arr).max() <= MAX_MAGNITUDE:  # NaN and inf fail too
+        return None
+    return arr
 
 
 def _shapely_obstacles(obstacles: list) -> list:
