@@ -535,30 +535,43 @@ class _Validator:
         from .polygon_batch import normalize_many
 
         out: list = [None] * len(lst)
-        plain, arrays = [], []
+        raw: dict = {}  # obstacle -> its plain [[x, y], ...] list
         fault = None
         for i, t in enumerate(lst):
+            if isinstance(t, dict) and "polygon" in t and set(t) <= {"polygon", "holes"} and \
+                    t.get("holes", []) == [] and _plain_list(t["polygon"]):
+                raw[i] = t["polygon"]
+                continue
             try:
-                if isinstance(t, dict) and "polygon" in t and set(t) <= {"polygon", "holes"} and \
-                        t.get("holes", []) == [] and isinstance(t["polygon"], list):
-                    pts = t["polygon"]
-                    arr = _plain_points(pts)
-                    if arr is None:  # something to report, or to convert with care: point by point
-                        field = f"obstacles[{i}].polygon"
-                        arr = np.array([self.point(p, f"{field}[{j}]") for j, p in enumerate(pts)],
-                                       dtype=np.float64).reshape(-1, 2)
-                    arrays.append(arr)
-                    plain.append(i)
-                else:
-                    out[i] = self.shape(t, f"obstacles[{i}]", tol, allow_holes=True)
+                out[i] = self.shape(t, f"obstacles[{i}]", tol, allow_holes=True)
             except ScenarioError as exc:
-                fault = (i, exc)  # raised below, unless an earlier obstacle has a fault
+                fault = exc  # raised below, unless an earlier obstacle has a fault
                 break
-        for i, got in zip(plain, normalize_many(arrays)):
-            out[i] = Shape(got[0], [], None, convex=got[1]) if got is not None else \
-                self.shape(lst[i], f"obstacles[{i}]", tol, allow_holes=True)  # the scalar route decides
+        # Plain lists: converted per vertex count in one numpy call, then checked and
+        # normalised in batches; what either step does not accept is read by shape().
+        slow = []
+        groups: dict = {}
+        for i, pts in raw.items():
+            groups.setdefault(len(pts), []).append(i)
+        for n, idx in groups.items():
+            try:
+                block = np.array([raw[i] for i in idx], dtype=np.float64).reshape(len(idx), n, 2)
+            except (OverflowError, ValueError):  # an int too large for a double, somewhere
+                slow += idx
+                continue
+            fine = (np.abs(block) <= MAX_MAGNITUDE).all(axis=(1, 2)) if n else np.zeros(len(idx), dtype=bool)
+            good = [i for i, f in zip(idx, fine.tolist()) if f]
+            slow += [i for i, f in zip(idx, fine.tolist()) if not f]
+            rows = np.flatnonzero(fine)
+            for i, got in zip(good, normalize_many(list(block[rows]))):
+                if got is None:
+                    slow.append(i)
+                else:
+                    out[i] = Shape(got[0], [], None, convex=got[1])
+        for i in sorted(slow):  # in file order: the first faulty one raises, worded as always
+            out[i] = self.shape(lst[i], f"obstacles[{i}]", tol, allow_holes=True)
         if fault is not None:
-            raise fault[1]
+            raise fault
         return out
 
     def planner(self, t) -> dict:
@@ -654,28 +667,22 @@ class CollisionProbe:
         return int(hits.min()) if len(hits) else None
 
 
-def _plain_points(pts: list) -> np.ndarray | None:
-    """``[[x, y], ...]`` of plain floats and ints, all finite and within the supported
-    magnitude, as an (N, 2) array (what :meth:`_Loader.point` gives point by point);
-    None for anything else (a bool, a string, a huge int, NaN...), which the loader
-    then reads point by point to word its error.
+def _plain_list(pts) -> bool:
+    """Whether ``pts`` is a non-empty ``[[x, y], ...]`` of plain floats and ints (no bool,
+    no string): the loader's batched route; the values are checked after conversion.
 
-    >>> _plain_points([[0, 1.5], [2, 3]]).tolist(), _plain_points([[0, True]]), _plain_points([[0, float("nan")]])
-    ([[0.0, 1.5], [2.0, 3.0]], None, None)
+    >>> _plain_list([[0, 1.5], [2, 3]]), _plain_list([[0, True]]), _plain_list([[0, 1, 2]])
+    (True, False, False)
     """
+    if type(pts) is not list or not pts:
+        return False
     for p in pts:
         if type(p) is not list or len(p) != 2:
-            return None
+            return False
         x, y = p
         if (type(x) is not float and type(x) is not int) or (type(y) is not float and type(y) is not int):
-            return None
-    try:
-        arr = np.array(pts, dtype=np.float64).reshape(-1, 2)
-    except (OverflowError, ValueError):
-        return None
-    if not len(arr) or not np.abs(arr).max() <= MAX_MAGNITUDE:  # NaN and inf fail too
-        return None
-    return arr
+            return False
+    return True
 
 
 def _shapely_obstacles(obstacles: list) -> list:

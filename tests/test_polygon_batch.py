@@ -73,6 +73,13 @@ def test_loader_reports_the_first_fault_in_file_order():
         scenario_from_dict(scene([tri, bad_hole, bowtie]))
     with pytest.raises(ScenarioError, match=r"obstacles\[0\]\.polygon\[1\]\[1\]"):
         scenario_from_dict(scene([bad_number, bowtie]))
+    huge = {"polygon": [[1, 1], [2, 1e300], [1, 2]]}  # beyond 2^400: found after the batch conversion
+    with pytest.raises(ScenarioError, match=r"obstacles\[1\]\.polygon\[1\]\[1\]: .* beyond"):
+        scenario_from_dict(scene([tri, huge, bowtie]))
+    with pytest.raises(ScenarioError, match=r"obstacles\[1\]\.polygon: not a simple polygon"):
+        scenario_from_dict(scene([tri, bowtie, huge, bad_hole]))
+    with pytest.raises(ScenarioError, match=r"obstacles\[0\]\.polygon\[0\]\[0\]: .* too large"):
+        scenario_from_dict(scene([{"polygon": [[2**1100, 1], [2, 1], [1, 2]]}, bowtie]))
 
 
 def test_loaded_obstacles_are_the_scalar_normalisation():
