@@ -595,11 +595,20 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
     order = np.argsort(lo[:, 0], kind="stable")
     removed: dict[int, int] = {}
     # Pairs (q, p), p != q, whose box lies inside q's box (closed), each q's in the order of
-    # ``order``: an STRtree of the boxes proposes them ("covers"), the exact comparisons keep them.
+    # ``order``. A piece inside q has its first vertex in q: an STRtree of the pieces
+    # proposes the pieces holding each first vertex (near-linear, where boxes of long
+    # thin pieces overlap by the thousand), the exact box comparisons and the exact
+    # vertex test below decide. (Pieces of fewer than 3 vertices: boxes covering boxes.)
     import shapely
 
-    boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
-    qs, ps = shapely.STRtree(boxes).query(boxes, predicate="covers")
+    sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
+    if (sizes >= 3).all():
+        rings = shapely.linearrings(np.concatenate(pieces), indices=np.repeat(np.arange(n), sizes))
+        firsts = shapely.points(np.array([p[0] for p in pieces]))
+        ps, qs = shapely.STRtree(shapely.polygons(rings)).query(firsts, predicate="intersects")
+    else:
+        boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
+        qs, ps = shapely.STRtree(boxes).query(boxes, predicate="covers")
     inside = (ps != qs) & (lo[ps, 0] >= lo[qs, 0]) & (hi[ps, 0] <= hi[qs, 0]) & (lo[ps, 1] >= lo[qs, 1]) & \
         (hi[ps, 1] <= hi[qs, 1])
     qs, ps = qs[inside], ps[inside]

@@ -56,8 +56,11 @@ def _normalize_block(A: np.ndarray) -> list:
     turn = orient2d_many(prev.reshape(-1, 2), A.reshape(-1, 2), nxt.reshape(-1, 2)).reshape(M, n)
     magnitude = np.abs(A).max(axis=(1, 2))
     ok = ~repeat & (turn != 0).all(axis=1) & (magnitude >= SAFE_MIN) & (magnitude < SAFE_MAX)
-    if ok.any():
-        ok[ok] = shapely.is_valid(shapely.polygons(A[ok]))
+    # Simple without asking GEOS when star-shaped about the vertex mean (see _star_shaped);
+    # GEOS's validity test is quadratic on stars (their spikes' envelopes all overlap).
+    ask = ok & ~_star_shaped(A, turn)
+    if ask.any():
+        ok[ask] = shapely.is_valid(shapely.polygons(A[ask]))
     # The lowest (then leftmost) vertex, as polygon.lowest_index picks it.
     y = A[:, :, 1]
     x_low = np.where(y == y.min(axis=1)[:, None], A[:, :, 0], np.inf)
@@ -70,9 +73,37 @@ def _normalize_block(A: np.ndarray) -> list:
     B = np.take_along_axis(A, order[:, :, None], axis=1)
     # is_convex: every turn of one sign, and the boundary turning once (2 pi) in all.
     one_sign = (turn > 0).all(axis=1) | (turn < 0).all(axis=1)
-    e = nxt - A
+    e = np.roll(B, -1, axis=1) - B  # on the normalised rings, as is_convex(normalize(p)) sees them
     ang = np.arctan2(e[:, :, 1], e[:, :, 0])
     d = np.diff(np.concatenate([ang, ang[:, :1]], axis=1), axis=1)
     d = (d + math.pi) % (2 * math.pi) - math.pi
     convex = one_sign & (np.abs(np.abs(d.sum(axis=1)) - 2 * math.pi) < 1.0)
     return [(B[k], bool(convex[k])) if ok[k] else None for k in range(M)]
+
+
+def _star_shaped(A: np.ndarray, turn: np.ndarray) -> np.ndarray:
+    """Per polygon of the ``(M, n, 2)`` block: certainly simple, by one exact argument.
+
+    With c the (rounded) mean of the vertices: if every triangle (c, v_i, v_i+1) turns
+    strictly the same way (exact predicate) and the angles they subtend add up to one
+    turn, the rays from c through the vertices come in strictly monotone order over a
+    single turn. Each edge then lies in its own wedge between two consecutive rays,
+    touching the rays only at its ends and never passing through c; wedges of
+    non-adjacent edges share only c, adjacent ones only the ray through their common
+    vertex. So edges meet only at shared vertices and no vertex repeats: the polygon is
+    simple. (The angles are summed in floats; the sum is an exact multiple of 2 pi up
+    to n roundings, so |sum - 2 pi| < 1 decides the number of turns.)
+
+    >>> sq = np.array([[[0., 0], [2, 0], [2, 2], [0, 2]], [[0., 0], [2, 2], [2, 0], [0, 2]]])
+    >>> _star_shaped(sq, np.ones((2, 4))).tolist()
+    [True, False]
+    """
+    M, n = A.shape[0], A.shape[1]
+    c = np.broadcast_to(A.mean(axis=1)[:, None, :], A.shape)
+    nxt = np.roll(A, -1, axis=1)
+    wedge = orient2d_many(c.reshape(-1, 2), A.reshape(-1, 2), nxt.reshape(-1, 2)).reshape(M, n)
+    same = (wedge > 0).all(axis=1) | (wedge < 0).all(axis=1)
+    u, w = A - c, nxt - c
+    ang = np.abs(np.arctan2(u[:, :, 0] * w[:, :, 1] - u[:, :, 1] * w[:, :, 0],
+                            u[:, :, 0] * w[:, :, 0] + u[:, :, 1] * w[:, :, 1]))
+    return same & (np.abs(ang.sum(axis=1) - 2 * math.pi) < 1.0)

@@ -253,7 +253,7 @@ def _median(xs):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help=f"scenes {', '.join(QUICK_SCENES)}, RRTConnect, 3 seeds, 2 s")
+    ap.add_argument("--quick", action="store_true", help=f"scenes {', '.join(QUICK_SCENES)}, RRTConnect, 3 seeds, 5 s")
     ap.add_argument("--seeds", type=int, default=None)
     ap.add_argument("--time", type=float, default=None, help="time limit per run, seconds (default 10)")
     ap.add_argument("--scenes", default=None, help="comma-separated scene stems")
@@ -262,7 +262,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     names = set(args.scenes.split(",")) if args.scenes else (set(QUICK_SCENES) if args.quick else None)
     seeds = args.seeds or (3 if args.quick else 10)
-    tlim = args.time or (2.0 if args.quick else 10.0)
+    tlim = args.time or (5.0 if args.quick else 10.0)
     planners = args.planners.split(",") if args.planners else (["RRTConnect"] if args.quick else list(PLANNERS))
 
     prepared = []

@@ -264,7 +264,7 @@ def splice(old: str, new: str, names: set) -> str:
 
     >>> old = "# B\n\n## Reproduce\n\n```sh\nmake\n```\n\n## a\n\nold a\n\n## b\n\nold b\n"
     >>> new = "# B\n\n## Reproduce\n\n```sh\nmake\npython b\npython c\n```\n\n## b\n\nnew b\n\n## c\n\nnew c\n"
-    >>> print(splice(old, new, {"b", "c"}))
+    >>> print(splice(old, new, {"b", "c"}), end="")
     # B
     <BLANKLINE>
     ## Reproduce
@@ -304,7 +304,7 @@ def splice(old: str, new: str, names: set) -> str:
             have |= names
         out.append(fresh[name] if name in names and name in fresh else text)
     out += [fresh[n] for n in sorted(names) if n in fresh and n not in have]
-    return "".join(out)
+    return "".join(t.rstrip("\n") + "\n\n" for t in out if t.strip())
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -95,3 +95,15 @@ def test_loaded_obstacles_are_the_scalar_normalisation():
     for o, raw in zip(sc.obstacles, obs):
         want = normalize(np.array(raw["polygon"]), ccw=True)
         assert np.array_equal(o.polygon, want) and o.convex == is_convex(want) and o.holes == []
+
+
+def test_stars_are_simple_without_geos_and_match_the_scalar_route():
+    a = np.arange(2000) * 2 * math.pi / 2000
+    r = np.where(np.arange(2000) % 2 == 0, 10.0, 4.0)
+    star = np.column_stack([50 + r * np.cos(a), 50 + r * np.sin(a)])
+    from cspace.polygon_batch import _star_shaped
+
+    assert _star_shaped(star[None], np.ones((1, 2000))).tolist() == [True]
+    twice = np.vstack([star[::2], star[::2]])[::1]  # the same vertices wound twice: not simple
+    assert _star_shaped(twice[None], np.ones((1, 2000))).tolist() == [False]
+    check([star, star[::-1].copy(), twice])
