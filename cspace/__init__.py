@@ -2,26 +2,57 @@
 
 The geometry layer: numpy + shapely only, never OMPL or matplotlib. Polygons are
 ``(N, 2)`` float64 arrays, counter-clockwise. See ``docs/architecture.md``.
-"""
-from .predicates import orient2d, orient2d_many, cross_sign
-from .polygon import as_array, signed_area, normalize, is_convex, is_simple, lowest_first
-from .disk import disk_polygon, disk_sides, disk_error
-from .scenario import Scenario, Shape, Query, ScenarioError, load_scenario, scenario_from_dict
-from .hull import convex_hull
-from .minkowski import minkowski_sum, reflect
-from .halfplane import halfplanes, support, support_point, erode
-from .gjk import Distance, gjk_distance, gjk_intersects
-from .epa import Penetration, epa_penetration
-from .decompose import convex_decompose
-from .pairsums import pairwise_sums
-from .convolution import convolution_cycles, convex_sums_with
-from .nonconvex import minkowski_pieces, minkowski_sum_nonconvex
-from .cspace import CSpace, decompose_obstacles, decompose_robot
-from .slab import (rotate, rotate_piece, wrap_angle, slab_hull, slab_inner, slab_pad, slab_of, slab_range,
-                   inscribed_radius, inscribed_polygon, default_slabs, robot_radius)
-from .se2_motion import interpolate
-from .se2 import SE2CSpace
-from .direct import DirectChecker, cspace_band
-from .shortest import ShortestPath, shortest_path
 
+Names load on first use (PEP 562): ``import cspace`` costs numpy and little more, and
+``cspace.X`` or ``from cspace import X`` imports X's module then.
+"""
+from __future__ import annotations
+
+import importlib
+
+# name -> the module (of this package) that defines it
+_NAMES = {
+    "orient2d": "predicates", "orient2d_many": "predicates", "cross_sign": "predicates",
+    "as_array": "polygon", "signed_area": "polygon", "normalize": "polygon", "is_convex": "polygon",
+    "is_simple": "polygon", "lowest_first": "polygon",
+    "disk_polygon": "disk", "disk_sides": "disk", "disk_error": "disk",
+    "Scenario": "scenario", "Shape": "scenario", "Query": "scenario", "ScenarioError": "scenario",
+    "load_scenario": "scenario", "scenario_from_dict": "scenario",
+    "convex_hull": "hull",
+    "minkowski_sum": "minkowski", "reflect": "minkowski",
+    "halfplanes": "halfplane", "support": "halfplane", "support_point": "halfplane", "erode": "halfplane",
+    "Distance": "gjk", "gjk_distance": "gjk", "gjk_intersects": "gjk",
+    "Penetration": "epa", "epa_penetration": "epa",
+    "convex_decompose": "decompose",
+    "pairwise_sums": "pairsums",
+    "convolution_cycles": "convolution", "convex_sums_with": "convolution",
+    "minkowski_pieces": "nonconvex", "minkowski_sum_nonconvex": "nonconvex",
+    "CSpace": "cspace", "decompose_obstacles": "cspace", "decompose_robot": "cspace",
+    "rotate": "slab", "rotate_piece": "slab", "wrap_angle": "slab", "slab_hull": "slab", "slab_inner": "slab",
+    "slab_pad": "slab", "slab_of": "slab", "slab_range": "slab", "inscribed_radius": "slab",
+    "inscribed_polygon": "slab", "default_slabs": "slab", "robot_radius": "slab",
+    "interpolate": "se2_motion",
+    "SE2CSpace": "se2",
+    "DirectChecker": "direct", "cspace_band": "direct",
+    "ShortestPath": "shortest", "shortest_path": "shortest",
+}
+
+__all__ = sorted(_NAMES)
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str):
+    if name in _NAMES:
+        value = getattr(importlib.import_module("." + _NAMES[name], __name__), name)
+        globals()[name] = value
+        return value
+    try:  # a submodule: ``cspace.se2`` after ``import cspace``, as when every module loaded eagerly
+        return importlib.import_module(f".{name}", __name__)
+    except ModuleNotFoundError as exc:
+        if exc.name != f"{__name__}.{name}":
+            raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

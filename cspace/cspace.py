@@ -28,6 +28,7 @@ import numpy as np
 from .broadphase import BLOCKED, FREE, GridIndex
 from .pieces import PieceSet
 from .inputs import query_points
+from .polygon import piece_boxes
 from .predicates import orient2d_many
 from .scenario import MAX_MAGNITUDE, MIN_EXTENT, Scenario, load_scenario
 
@@ -47,6 +48,10 @@ class Stage:
 
 
 SMALL_GRID = 4096  # cells: a grid this small is also the segment walk's grid
+# Minkowski sums of pieces of at most PAIR_BATCH_EDGES vertices are batched, about
+# PAIR_BATCH_CELLS (obstacle edge, robot edge) comparisons per batch.
+PAIR_BATCH_EDGES = 64
+PAIR_BATCH_CELLS = 1 << 20
 
 
 def _check_range(bounds: tuple, shapes: list) -> None:
@@ -55,7 +60,8 @@ def _check_range(bounds: tuple, shapes: list) -> None:
     xmin, xmax, ymin, ymax = bounds
     if not (xmin < xmax and ymin < ymax):
         raise ValueError(f"CSpace: bounds {bounds} are empty (need xmin < xmax and ymin < ymax)")
-    big = max([abs(v) for v in bounds] + [float(np.abs(p).max()) for p in shapes if len(p)])
+    pts = [p for p in shapes if len(p)]
+    big = max([abs(v) for v in bounds] + ([float(np.abs(np.concatenate(pts)).max())] if pts else []))
     if not big <= MAX_MAGNITUDE:
         raise ValueError(f"CSpace: a coordinate of magnitude {big:.3g} is beyond the supported 2^400")
     if max(xmax - xmin, ymax - ymin) < MIN_EXTENT:
@@ -63,13 +69,15 @@ def _check_range(bounds: tuple, shapes: list) -> None:
 
 
 def decompose_obstacles(obstacles: list[np.ndarray], holes: list[list[np.ndarray]] | None = None,
-                        of: list[int] | None = None) -> tuple[list[np.ndarray], np.ndarray, int]:
+                        of: list[int] | None = None,
+                        convex: list[bool] | None = None) -> tuple[list[np.ndarray], np.ndarray, int]:
     """Convex pieces of the obstacles: (pieces, owning obstacle of each piece, obstacles split).
 
     Convex obstacles without holes are kept as they are; the others go through
     :func:`cspace.decompose.convex_decompose`. ``of[k]``, if given, is the input obstacle
-    shell k came from (a MultiPolygon gives several shells). Shared by :class:`CSpace`
-    and the SE(2) C-space, which decomposes once for all its slabs.
+    shell k came from (a MultiPolygon gives several shells); ``convex[k]``, if given, is
+    the loader's exact :func:`cspace.polygon.is_convex` of shell k (not computed again).
+    Shared by :class:`CSpace` and the SE(2) C-space, which decomposes once for all its slabs.
 
     >>> p, owner, split = decompose_obstacles([np.array([[0., 0], [2, 0], [2, 2], [0, 2]])])
     >>> len(p), owner.tolist(), split
@@ -81,7 +89,7 @@ def decompose_obstacles(obstacles: list[np.ndarray], holes: list[list[np.ndarray
     pieces, owner, split = [], [], 0
     for k, (poly, hs) in enumerate(zip(obstacles, holes)):
         i = k if of is None else of[k]
-        if not hs and is_convex(poly):
+        if not hs and (convex[k] if convex is not None else is_convex(poly)):
             parts = [np.asarray(poly, dtype=np.float64)]
         else:
             from .decompose import convex_decompose
@@ -133,10 +141,12 @@ class CSpace:
         robot_is_disk: bool = False,
         grid_cells: int | None = None,
         normalized: bool = False,
+        obstacle_convex: list[bool] | None = None,
     ):
         # Obstacles and robot parts: (N, 2) arrays in either orientation or shapely Polygons /
         # MultiPolygons (cspace.inputs); ``normalized`` says they are already the loader's
-        # CCW, cleaned, validated arrays (from_scenario), so that work is not done twice.
+        # CCW, cleaned, validated arrays (from_scenario), so that work is not done twice;
+        # ``obstacle_convex`` then gives their exact convexity (Shape.convex).
         self.bounds = tuple(float(v) for v in bounds)
         self.stages: list[Stage] = []
         owner = None
@@ -149,7 +159,8 @@ class CSpace:
             obstacles, holes, owner = obstacle_shapes(obstacles, obstacle_holes)
             robot = robot_parts(robot)
         _check_range(self.bounds, obstacles + robot)
-        self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes, owner)
+        convex = obstacle_convex if normalized else None
+        self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes, owner, convex)
         self.robot_pieces = self._decompose_robot(robot, robot_is_disk)
         raw, raw_owner = self._sum()
         self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
@@ -194,15 +205,16 @@ class CSpace:
             robot_is_disk=sc.robot_kind == "disk",
             grid_cells=grid_cells,
             normalized=True,
+            obstacle_convex=[o.convex for o in sc.obstacles],
         )
         cs.scenario = sc
         if not isinstance(scenario, Scenario):
             cs.stages.insert(0, Stage("load", True, load_s, {"obstacles": len(sc.obstacles)}))
         return cs
 
-    def _decompose_obstacles(self, obstacles, holes, of=None):
+    def _decompose_obstacles(self, obstacles, holes, of=None, convex=None):
         t = time.perf_counter()
-        pieces, owner, split = decompose_obstacles(obstacles, holes, of)
+        pieces, owner, split = decompose_obstacles(obstacles, holes, of, convex)
         self.stages.append(
             Stage("decompose_obstacles", split > 0, time.perf_counter() - t,
                   {"obstacles": len(obstacles), "decomposed": split, "pieces": len(pieces)},
@@ -229,19 +241,16 @@ class CSpace:
             n = len(self.obstacle_pieces)
             self._raw_pairs = [(i, -1) for i in range(n)]
             return list(self.obstacle_pieces), self.obstacle_of
-        from .minkowski import minkowski_sum, reflect
+        from .minkowski import reflect
 
         neg = [reflect(r) for r in self.robot_pieces]
-        out, owner, pairs = [], [], []
-        for i, (p, o) in enumerate(zip(self.obstacle_pieces, self.obstacle_of)):
-            for j, r in enumerate(neg):
-                out.append(minkowski_sum(p, r))
-                owner.append(o)
-                pairs.append((i, j))
-        self._raw_pairs = pairs
+        out = pair_sums(self.obstacle_pieces, neg)
+        nr = len(neg)
+        owner = np.repeat(np.asarray(self.obstacle_of, dtype=np.int64), nr)
+        self._raw_pairs = [(i, j) for i in range(len(self.obstacle_pieces)) for j in range(nr)]
         self.stages.append(Stage("minkowski", True, time.perf_counter() - t,
                                  {"pairs": len(out), "robot_pieces": len(neg)}))
-        return out, np.array(owner, dtype=np.int64)
+        return out, owner
 
     def _prune(self, pieces, owner):
         """Drop pieces that cannot meet the bounds, and pieces inside another piece.
@@ -253,10 +262,8 @@ class CSpace:
         t = time.perf_counter()
         xmin, xmax, ymin, ymax = self.bounds
         before = len(pieces)
-        keep = [
-            k for k, p in enumerate(pieces)
-            if len(p) and p[:, 0].min() <= xmax and p[:, 0].max() >= xmin and p[:, 1].min() <= ymax and p[:, 1].max() >= ymin
-        ]
+        lo, hi = piece_boxes(pieces)  # an empty piece: lo = inf, hi = -inf, dropped
+        keep = np.flatnonzero((lo[:, 0] <= xmax) & (hi[:, 0] >= xmin) & (lo[:, 1] <= ymax) & (hi[:, 1] >= ymin)).tolist()
         outside = before - len(keep)
         pieces = [pieces[k] for k in keep]
         pairs = [[self._raw_pairs[k]] for k in keep]
@@ -360,9 +367,7 @@ class CSpace:
         # ends with a border cell (3) and a border row follows the last: a point up
         # to a cell past the top or right edge reads a border cell, one further raises
         # IndexError (inf: OverflowError), so only the lower edges need a comparison.
-        flat = idx.state.astype(np.uint8).tobytes()
-        border = bytes([3])
-        rows = [flat[r * nx:(r + 1) * nx] + border for r in range(ny)] + [border * (nx + 1)]
+        rows = idx.state_rows()
         exact = self._is_free_exact
         mixed = self._mixed_cell_test()
         xmin, xmax, ymin, ymax = self.bounds
@@ -586,20 +591,34 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
     n = len(pieces)
     if n < 2:
         return {}
-    lo = np.array([p.min(axis=0) for p in pieces])
-    hi = np.array([p.max(axis=0) for p in pieces])
+    lo, hi = piece_boxes(pieces)
     order = np.argsort(lo[:, 0], kind="stable")
     removed: dict[int, int] = {}
-    lo_sorted = lo[order, 0]
-    for q in range(n):
+    # Pairs (q, p), p != q, whose box lies inside q's box (closed), each q's in the order of
+    # ``order``. A piece inside q has its first vertex in q: an STRtree of the pieces
+    # proposes the pieces holding each first vertex (near-linear, where boxes of long
+    # thin pieces overlap by the thousand), the exact box comparisons and the exact
+    # vertex test below decide. (Pieces of fewer than 3 vertices: boxes covering boxes.)
+    import shapely
+
+    sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
+    if (sizes >= 3).all():
+        rings = shapely.linearrings(np.concatenate(pieces), indices=np.repeat(np.arange(n), sizes))
+        firsts = shapely.points(np.array([p[0] for p in pieces]))
+        ps, qs = shapely.STRtree(shapely.polygons(rings)).query(firsts, predicate="intersects")
+    else:
+        boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
+        qs, ps = shapely.STRtree(boxes).query(boxes, predicate="covers")
+    inside = (ps != qs) & (lo[ps, 0] >= lo[qs, 0]) & (hi[ps, 0] <= hi[qs, 0]) & (lo[ps, 1] >= lo[qs, 1]) & \
+        (hi[ps, 1] <= hi[qs, 1])
+    qs, ps = qs[inside], ps[inside]
+    rank = np.empty(n, dtype=np.int64)
+    rank[order] = np.arange(n)
+    by = np.lexsort((rank[ps], qs))
+    qs, ps = qs[by], ps[by]
+    cut = np.flatnonzero(np.diff(qs)) + 1
+    for q, cand in zip(qs[np.r_[0, cut]].tolist() if len(qs) else [], np.split(ps, cut) if len(qs) else []):
         if q in removed:
-            continue
-        # pieces whose box lies inside q's box
-        j0 = np.searchsorted(lo_sorted, lo[q, 0], side="left")
-        j1 = np.searchsorted(lo_sorted, hi[q, 0], side="right")
-        cand = order[j0:j1]
-        cand = cand[(cand != q) & (hi[cand, 0] <= hi[q, 0]) & (lo[cand, 1] >= lo[q, 1]) & (hi[cand, 1] <= hi[q, 1])]
-        if not cand.size:
             continue
         Q = pieces[q]
         s, e = Q, np.roll(Q, -1, axis=0)
@@ -613,3 +632,41 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
             if (sides >= 0).all():
                 removed[p] = q
     return removed
+
+
+def pair_sums(obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray]) -> list[np.ndarray]:
+    """``[minkowski_sum(p, r) for p in obstacle_pieces for r in robot_pieces]``: pairs of
+    small pieces in batches (:func:`cspace.pairsums.pairwise_sums`, equal array for
+    array), large ones one by one (a batch compares every edge with every edge).
+
+    >>> sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1]])
+    >>> [s.tolist() for s in pair_sums([sq], [sq - 1])]
+    [[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]]
+    """
+    from .minkowski import minkowski_sum
+    from .pairsums import pairwise_sums
+
+    nr = len(robot_pieces)
+    out: list = [None] * (len(obstacle_pieces) * nr)
+    small_r = [j for j, r in enumerate(robot_pieces) if len(r) <= PAIR_BATCH_EDGES]
+    small_o = [i for i, p in enumerate(obstacle_pieces) if len(p) <= PAIR_BATCH_EDGES]
+    if small_r and small_o:
+        rb = [robot_pieces[j] for j in small_r]
+        redges = sum(len(r) for r in rb)
+        start = 0
+        while start < len(small_o):  # chunks of about PAIR_BATCH_CELLS edge comparisons
+            stop, used = start, 0
+            while stop < len(small_o) and (stop == start or (used + len(obstacle_pieces[small_o[stop]])) * redges
+                                           <= PAIR_BATCH_CELLS):
+                used += len(obstacle_pieces[small_o[stop]])
+                stop += 1
+            chunk = small_o[start:stop]
+            sums = pairwise_sums([obstacle_pieces[c] for c in chunk], rb)
+            for a, c in enumerate(chunk):
+                for b, j in enumerate(small_r):
+                    out[c * nr + j] = sums[a * len(rb) + b]
+            start = stop
+    for k in range(len(out)):
+        if out[k] is None:
+            out[k] = minkowski_sum(obstacle_pieces[k // nr], robot_pieces[k % nr])
+    return out

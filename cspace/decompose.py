@@ -167,45 +167,73 @@ def _diagonal_ranks(rings: list, pts: np.ndarray, d: np.ndarray) -> np.ndarray:
 
 def _hertel_mehlhorn(tris: np.ndarray, pts: np.ndarray, diagonals: list) -> list[list[int]]:
     """Merge triangles across the diagonals, tried in the given order, while the
-    merge stays convex; return the pieces as index cycles."""
-    pieces = {k: t for k, t in enumerate(tris.tolist())}
-    owner: dict = {}  # directed edge (u, v) -> piece holding it
-    for k, (a, b, c) in pieces.items():
-        owner[(a, b)] = owner[(b, c)] = owner[(c, a)] = k
+    merge stays convex; return the pieces as index cycles.
+
+    A piece is a cycle of vertex indices held as successor and predecessor maps, so a
+    merge splices the smaller piece into the larger one (O(smaller), never a copy of a
+    growing piece: a star of 10^5 spikes merges into one centre in O(n log n), not
+    O(n^2)). Pieces are named by union-find: an edge keeps the name it was created
+    with, ``find`` gives its current piece. The result is the list-based merge's:
+    the same pieces in the same order, each cycle read from the same vertex.
+    """
+    succ: list = []
+    pred: list = []
+    for a, b, c in tris.tolist():
+        succ.append({a: b, b: c, c: a})
+        pred.append({b: a, c: b, a: c})
+    parent = list(range(len(succ)))
+    slot = list(range(len(succ)))  # the position a piece is listed at: its first triangle's
+    start = [t[0] for t in tris.tolist()]  # where its cycle is read from
+
+    def find(k: int) -> int:
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    owner: dict = {}  # directed edge (u, v) -> a name of the piece holding it
+    for k, sp in enumerate(succ):
+        for u, v in sp.items():
+            owner[(u, v)] = k
     xy = pts.tolist()
     for u, v in diagonals:
         a, b = owner.get((u, v)), owner.get((v, u))
-        if a is None or b is None or a == b:
+        if a is None or b is None:
             continue
-        q = pieces[b]
-        merged = _merge(pieces[a], q, u, v, xy, owner)
-        if merged is None:
+        a, b = find(a), find(b)
+        if a == b:
             continue
-        del pieces[b]
-        pieces[a] = merged
-        # Only b's edges change hands (those _merge dropped, and the diagonal, are gone).
-        for e in zip(q, q[1:] + q[:1]):
-            if owner.get(e) == b:
-                owner[e] = a
-        owner.pop((u, v), None)
-        owner.pop((v, u), None)
-    return list(pieces.values())
+        _merge(a, b, u, v, succ, pred, parent, slot, start, xy, owner)
+    reps = sorted((slot[k], k) for k in range(len(succ)) if parent[k] == k)
+    out = []
+    for _, k in reps:
+        sp = succ[k]
+        first = start[k]
+        cycle, w = [first], sp[first]
+        while w != first:
+            cycle.append(w)
+            w = sp[w]
+        out.append(cycle)
+    return out
 
 
-def _merge(p: list, q: list, u: int, v: int, xy: list, owner: dict) -> list | None:
-    """p holds edge u->v, q holds v->u; their union if it is convex at u and at v.
+def _merge(a: int, b: int, u: int, v: int, succ: list, pred: list, parent: list, slot: list, start: list,
+           xy: list, owner: dict) -> bool:
+    """Piece a holds edge u->v, piece b holds v->u; merge them if the union is convex at
+    u and at v (the cycle runs v, a's path to u, u, b's path to v). Returns whether it did.
 
     A corner the merge makes straight is dropped at once: it stays straight (pieces
     only grow, so no later merge can be convex there), and the edges through it can
     no longer be merged across, so they leave ``owner``.
     """
-    i = p.index(u)
-    j = q.index(v)
-    merged = p[i + 1:] + p[:i] + q[j + 1:] + q[:j]  # v ... (p's path to u) u ... (q's path to v)
-    n = len(merged)
+    sa, pa, sb, pb = succ[a], pred[a], succ[b], pred[b]
+    small_map, other = (sb, sa) if len(sb) <= len(sa) else (sa, sb)
+    if any(w in other for w in small_map if w != u and w != v):
+        return False  # a third shared vertex (a degenerate sliver): the cycle would repeat it
     straight = []
-    for k in (n - len(q) + 1, 0):  # the positions of u and v
-        (ax, ay), (bx, by), (cx, cy) = xy[merged[k - 1]], xy[merged[k]], xy[merged[(k + 1) % n]]
+    # the corner at u: pred_a(u), u, succ_b(u); at v: pred_b(v), v, succ_a(v)
+    for w, (p0, p2) in ((u, (pa[u], sb[u])), (v, (pb[v], sa[v]))):
+        (ax, ay), (bx, by), (cx, cy) = xy[p0], xy[w], xy[p2]
         # orient2d's stage-A filter inline (most corners are decided here), else exact.
         left = (ax - cx) * (by - cy)
         right = (ay - cy) * (bx - cx)
@@ -214,14 +242,37 @@ def _merge(p: list, q: list, u: int, v: int, xy: list, owner: dict) -> list | No
             continue
         turn = -1 if right - left > bound > 1e-280 else orient2d_xy(ax, ay, bx, by, cx, cy)
         if turn < 0:
-            return None
+            return False
         if turn == 0:
-            straight.append(k)
-    for k in sorted(straight, reverse=True):
-        owner.pop((merged[k - 1], merged[k]), None)
-        owner.pop((merged[k], merged[(k + 1) % len(merged)]), None)
-        del merged[k]
-    return merged
+            straight.append(w)
+    # Splice: the merged successor map is a's and b's, except u -> succ_b(u) and
+    # v -> succ_a(v); the predecessor map likewise, u <- pred_a(u) and v <- pred_b(v).
+    # The smaller piece's entries are copied into the larger one's maps.
+    big, small = (a, b) if len(sa) >= len(sb) else (b, a)
+    S, P = succ[big], pred[big]
+    skip_s, skip_p = (v, u) if big == a else (u, v)
+    for w, x in succ[small].items():
+        if w != skip_s:
+            S[w] = x
+    for x, w in pred[small].items():
+        if x != skip_p:
+            P[x] = w
+    succ[small], pred[small] = {}, {}
+    parent[small] = big
+    slot[big] = slot[a]  # the merged piece is listed where a was
+    start[big] = v  # the cycle as the list-based merge wrote it: from v
+    owner.pop((u, v), None)
+    owner.pop((v, u), None)
+    for w in straight:  # u first, then v, as before: the two are never neighbours
+        p0, p2 = P[w], S[w]
+        owner.pop((p0, w), None)
+        owner.pop((w, p2), None)
+        S[p0] = p2
+        P[p2] = p0
+        del S[w], P[w]
+        if start[big] == w:
+            start[big] = p2
+    return True
 
 
 def _finish(pts: np.ndarray, cycles: list) -> list[np.ndarray]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .polygon import piece_boxes, ring_neighbours
 from .predicates import orient2d_cols, orient2d_xy
 
 
@@ -29,18 +30,18 @@ class PieceSet:
         self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
         sizes = np.array([len(p) for p in self.pieces], dtype=np.int64)
         self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-        if self.pieces:
-            self.start = np.concatenate(self.pieces)
-            self.end = np.concatenate([np.roll(p, -1, axis=0) for p in self.pieces])
-            lo = np.array([p.min(axis=0) for p in self.pieces])
-            hi = np.array([p.max(axis=0) for p in self.pieces])
+        if self.pieces:  # packed in one pass each (a scene may hold 10^5 pieces)
+            self.start = np.concatenate(self.pieces).reshape(-1, 2)
+            self.end = self.start[ring_neighbours(sizes)[1]]
+            lo, hi = piece_boxes(self.pieces)
         else:
             self.start = self.end = np.zeros((0, 2))
             lo = hi = np.zeros((0, 2))
         self.owner = np.repeat(np.arange(len(self.pieces)), sizes)
         self.lo, self.hi = lo, hi
         # Scalar copies for the one-piece hot path.
-        self._lists = [p.tolist() for p in self.pieces]
+        flat, cut = self.start.tolist(), self.offsets.tolist()
+        self._lists = [flat[cut[k]:cut[k + 1]] for k in range(len(self.pieces))]
 
     def __len__(self) -> int:
         return len(self.pieces)

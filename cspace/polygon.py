@@ -172,6 +172,27 @@ def collinear_extent(points) -> np.ndarray:
     return np.array([lo, hi])
 
 
+def piece_boxes(pieces: list) -> tuple[np.ndarray, np.ndarray]:
+    """Each piece's bounding box, ``(lo, hi)`` as two ``(n, 2)`` arrays, in one pass over
+    all the vertices (what ``p.min(axis=0)``, ``p.max(axis=0)`` give piece by piece; an
+    empty piece gets lo = +inf, hi = -inf).
+
+    >>> lo, hi = piece_boxes([np.array([[0., 1], [2, 0], [1, 3]]), np.zeros((0, 2)), np.array([[5., 5], [6, 7]])])
+    >>> lo.tolist(), hi.tolist()
+    ([[0.0, 0.0], [inf, inf], [5.0, 5.0]], [[2.0, 3.0], [-inf, -inf], [6.0, 7.0]])
+    """
+    n = len(pieces)
+    lo, hi = np.full((n, 2), np.inf), np.full((n, 2), -np.inf)
+    sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
+    full = np.flatnonzero(sizes > 0)
+    if len(full):
+        pts = np.concatenate([pieces[k] for k in full.tolist()] if len(full) < n else pieces).reshape(-1, 2)
+        starts = np.cumsum(sizes[full]) - sizes[full]
+        lo[full] = np.minimum.reduceat(pts, starts, axis=0)
+        hi[full] = np.maximum.reduceat(pts, starts, axis=0)
+    return lo, hi
+
+
 def ring_neighbours(sizes) -> tuple[np.ndarray, np.ndarray]:
     """For rings of the given sizes stored one after another, each vertex's
     predecessor and successor along its own ring (indices into the concatenation).

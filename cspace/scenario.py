@@ -40,10 +40,15 @@ from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
 from .polygon import invalid_reason, is_convex, normalize
 from .slab import wrap_angle
 
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+
+
+def _toml():
+    """The TOML reader, imported when a file is read (not by ``import cspace``)."""
+    try:  # Python >= 3.11
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+    return tomllib
 
 
 class ScenarioError(ValueError):
@@ -212,6 +217,7 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
         text = raw.decode("utf-8-sig")  # a byte-order mark is allowed and skipped
     except UnicodeDecodeError as exc:
         raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
+    tomllib = _toml()
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -433,6 +439,13 @@ class _Validator:
             raise self.err(field, f"{a} and {b} exclude each other ({hint})")
 
     def number(self, x, field: str, positive: bool = False) -> float:
+        # The common cases first (a scene may hold 10^6 numbers): a finite float within
+        # the supported magnitude (NaN and inf fail the comparison), a modest int.
+        if not positive:
+            if type(x) is float and -MAX_MAGNITUDE <= x <= MAX_MAGNITUDE:
+                return x
+            if type(x) is int and -(1 << 53) <= x <= 1 << 53:
+                return float(x)
         if x is None:
             raise self.err(field, "missing (a number is required)")
         if isinstance(x, bool) or not isinstance(x, (int, float)):
@@ -544,9 +557,57 @@ class _Validator:
         return shapes, kind
 
     def obstacles(self, lst, tol: float) -> list[Shape]:
+        """The obstacles, in order, as :meth:`shape` reads each one.
+
+        Plain polygons (no holes) have their numbers read here and their geometry
+        checked and normalised in batches (:func:`cspace.polygon_batch.normalize_many`);
+        any the batch does not decide, and every other obstacle, go through
+        :meth:`shape`. The first faulty obstacle in file order is the one reported,
+        as if each were read in turn.
+        """
         if not isinstance(lst, list):
             raise self.err("obstacles", "must be an array of tables [[obstacles]]")
-        return [self.shape(t, f"obstacles[{i}]", tol, allow_holes=True) for i, t in enumerate(lst)]
+        from .polygon_batch import normalize_many
+
+        out: list = [None] * len(lst)
+        raw: dict = {}  # obstacle -> its plain [[x, y], ...] list
+        fault = None
+        for i, t in enumerate(lst):
+            if isinstance(t, dict) and "polygon" in t and set(t) <= {"polygon", "holes"} and \
+                    t.get("holes", []) == [] and _plain_list(t["polygon"]):
+                raw[i] = t["polygon"]
+                continue
+            try:
+                out[i] = self.shape(t, f"obstacles[{i}]", tol, allow_holes=True)
+            except ScenarioError as exc:
+                fault = exc  # raised below, unless an earlier obstacle has a fault
+                break
+        # Plain lists: converted per vertex count in one numpy call, then checked and
+        # normalised in batches; what either step does not accept is read by shape().
+        slow = []
+        groups: dict = {}
+        for i, pts in raw.items():
+            groups.setdefault(len(pts), []).append(i)
+        for n, idx in groups.items():
+            try:
+                block = np.array([raw[i] for i in idx], dtype=np.float64).reshape(len(idx), n, 2)
+            except (OverflowError, ValueError):  # an int too large for a double, somewhere
+                slow += idx
+                continue
+            fine = (np.abs(block) <= MAX_MAGNITUDE).all(axis=(1, 2)) if n else np.zeros(len(idx), dtype=bool)
+            good = [i for i, f in zip(idx, fine.tolist()) if f]
+            slow += [i for i, f in zip(idx, fine.tolist()) if not f]
+            rows = np.flatnonzero(fine)
+            for i, got in zip(good, normalize_many(list(block[rows]))):
+                if got is None:
+                    slow.append(i)
+                else:
+                    out[i] = Shape(got[0], [], None, convex=got[1])
+        for i in sorted(slow):  # in file order: the first faulty one raises, worded as always
+            out[i] = self.shape(lst[i], f"obstacles[{i}]", tol, allow_holes=True)
+        if fault is not None:
+            raise fault
+        return out
 
     def planner(self, t) -> dict:
         if not isinstance(t, dict):
@@ -626,7 +687,7 @@ class CollisionProbe:
 
         self._shapely = shapely
         self._sc = sc
-        self._geoms = [ob.to_shapely() for ob in sc.obstacles]
+        self._geoms = _shapely_obstacles(sc.obstacles)
         self._tree = shapely.STRtree(self._geoms) if self._geoms else None
 
     def first_hit(self, x: float, y: float, theta: float = 0.0) -> int | None:
@@ -639,6 +700,42 @@ class CollisionProbe:
             body = shapely.Point(x, y)
         hits = self._tree.query(body, predicate="intersects")
         return int(hits.min()) if len(hits) else None
+
+
+def _plain_list(pts) -> bool:
+    """Whether ``pts`` is a non-empty ``[[x, y], ...]`` of plain floats and ints (no bool,
+    no string): the loader's batched route; the values are checked after conversion.
+
+    >>> _plain_list([[0, 1.5], [2, 3]]), _plain_list([[0, True]]), _plain_list([[0, 1, 2]])
+    (True, False, False)
+    """
+    if type(pts) is not list or not pts:
+        return False
+    for p in pts:
+        if type(p) is not list or len(p) != 2:
+            return False
+        x, y = p
+        if (type(x) is not float and type(x) is not int) or (type(y) is not float and type(y) is not int):
+            return False
+    return True
+
+
+def _shapely_obstacles(obstacles: list) -> list:
+    """``[ob.to_shapely() for ob in obstacles]``, polygons without holes made in batches of
+    one vertex count (one shapely call each instead of one per obstacle)."""
+    import shapely
+
+    out = [None] * len(obstacles)
+    groups: dict = {}
+    for i, ob in enumerate(obstacles):
+        if ob.holes:
+            out[i] = ob.to_shapely()
+        else:
+            groups.setdefault(len(ob.polygon), []).append(i)
+    for idx in groups.values():
+        for i, g in zip(idx, shapely.polygons(np.stack([obstacles[i].polygon for i in idx])).tolist()):
+            out[i] = g
+    return out
 
 
 def first_collision(sc: Scenario, x: float, y: float) -> int | None:

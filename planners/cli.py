@@ -10,11 +10,10 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import os
 import sys
 import warnings
-
-from cspace.scenario import ScenarioError, clip
 
 COMMANDS = {
     "plan": "planners.cli_plan",
@@ -24,6 +23,27 @@ COMMANDS = {
     "generate": "planners.generate",
     "import": "planners.cli_import",
 }
+# Each command's one-line help, for the listing of ``cspace --help`` (and a bare
+# ``cspace``), which then imports no command module, nor numpy: start-up stays short.
+# tests/test_cli.py checks these are the help strings the modules register.
+HELP = {
+    "plan": "plan a collision-free path for a scenario",
+    "show": "draw the workspace, the C-obstacles and their convex pieces",
+    "bench": "error against run time for OMPL planners vs the exact shortest path",
+    "stability": "run stiff and extreme cases through every layer",
+    "generate": "write a random scenario (random, maze, narrow, disks, office)",
+}
+
+
+def clip(text: str, limit: int) -> str:
+    """:func:`cspace.scenario.clip`, imported when needed (it pulls in numpy).
+
+    >>> clip("abc", 10)
+    'abc'
+    """
+    from cspace.scenario import clip as _clip
+
+    return _clip(text, limit)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -73,8 +93,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name, module in COMMANDS.items():
-        if only is not None and name != only:
-            sub.add_parser(name, help=f"(see cspace {name} --help)", add_help=False)
+        if name != only:  # listed only: its one-line help, its module not imported
+            if importlib.util.find_spec(module) is not None:
+                sub.add_parser(name, help=HELP[name], add_help=False)
             continue
         try:
             mod = importlib.import_module(module)
@@ -94,6 +115,8 @@ def main(argv: list[str] | None = None) -> int:
     first = next((a for a in argv if not a.startswith("-")), None)
     parser = build_parser(first if first in COMMANDS else None)
     args = parser.parse_args(argv)
+    from cspace.scenario import ScenarioError
+
     try:
         with warnings.catch_warnings():
             if not getattr(args, "verbose", False):  # numpy/matplotlib chatter is not for the terminal

@@ -213,6 +213,16 @@ def configure(planner, name: str, iterations: int | None) -> None:
         planner.setNumSamples(int(iterations))
 
 
+def stop_at_first(ss) -> None:
+    """Make an anytime planner stop at its first exact solution: the path-length
+    objective with an infinite cost threshold, which every solution satisfies (OMPL's
+    own stopping rule; without it RRTstar improves until its time limit)."""
+    ob = ompl()[0]
+    objective = ob.PathLengthOptimizationObjective(ss.getSpaceInformation())
+    objective.setCostThreshold(ob.Cost(float("inf")))
+    ss.setOptimizationObjective(objective)
+
+
 def termination(time_limit: float, iterations: int | None = None):
     """Stop at the time limit, or after ``iterations`` evaluations of the condition if given.
 

@@ -56,7 +56,7 @@ def _now() -> float:
 
 def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *,
                 iterations: int | None = None, simplify: bool = True, slices: bool = False,
-                on_progress=None, scenario: str = "") -> list[PlanResult]:
+                on_progress=None, scenario: str = "", until_first: bool = False) -> list[PlanResult]:
     """THE planning routine: one OMPL planner over a state-space adapter, for each query.
 
     ``space`` is an adapter of :mod:`planners.spaces`; ``queries`` is a list of
@@ -70,13 +70,18 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
     so that the time of the first solution (to within one slice) and the best raw
     length along the run are recorded in ``first_solution`` and ``progress``;
     ``on_progress(t, length)`` is called at each recorded point.
+
+    With ``until_first`` (the peer benchmark, ``scripts/bench_planning.py``) an anytime
+    planner stops at its first exact solution, by OMPL's own rule: the path-length
+    objective gets an infinite cost threshold, which any solution satisfies. No slices
+    are needed then: the first solution is the end of the solve.
     """
     key = name.lower()
     out = []
     held = [None]  # the roadmap planners' setup, kept from query to query
     for i, (start, goal) in enumerate(queries):
-        args = (space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify, slices,
-                on_progress, scenario)
+        args = (space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify,
+                slices and not until_first, on_progress, scenario, until_first)
         if tuple(start) == tuple(goal):  # nothing to plan: the one-point path
             out.append(_trivial(space, name, seed, scenario, start, goal))
         elif key == "aorrtc" and space.verify(np.array([start, goal], dtype=np.float64), start, goal)[0]:
@@ -89,13 +94,15 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
 
 
 def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify, slices,
-                on_progress, scenario) -> PlanResult:
-    from .ompl_glue import configure, make_setup, set_query
+                on_progress, scenario, until_first=False) -> PlanResult:
+    from .ompl_glue import configure, make_setup, set_query, stop_at_first
 
     t0 = _now()
     if held[0] is None or key not in ROADMAP:
         held[0] = make_setup(space, name, seed, query=i)
         configure(held[0][0].getPlanner(), name, iterations)
+        if until_first and key in ANYTIME:
+            stop_at_first(held[0][0])
     else:
         held[0][0].getPlanner().clearQuery()  # keep the roadmap, drop the old start and goal
     ss = held[0][0]
@@ -242,7 +249,7 @@ def _guarded(args, limit: float) -> PlanResult:
         return res
     why = f"did not stop at its time limit and was killed after {limit:.3g} s" if res == "timeout" else \
         f"crashed ({res})"
-    return PlanResult(scenario=args[-1], solved=False, exact=False, path=np.zeros((0, space.dim)), length=math.inf,
+    return PlanResult(scenario=args[13], solved=False, exact=False, path=np.zeros((0, space.dim)), length=math.inf,
                       planner=name, seed=seed, timings={"setup": 0.0, "solve": limit, "simplify": 0.0, "verify": 0.0},
                       checks={"states": 0, "motions": 0}, stages=["setup", "solve"], start=tuple(start),
                       goal=tuple(goal), message=f"not solved: {name} {why} (a fault of OMPL's {name}; "

@@ -47,7 +47,10 @@ log-log) against the theory, with the full run's figures (2-core machine, shared
   in each of two directions crossing without being filled in, and two long teeth
   in different directions always sum to a filled parallelogram; no such layout is
   built here. Either way the C-space's own cost follows the pieces, O(nm).
-Usage: python scripts/bench_scaling.py [--quick] [--plot scaling.png] [--out-json rows.json]
+(d) big scenes (scripts/scaling_big.py): 90 601 triangles, a 100 000-vertex star, a
+    10^6-vertex convex obstacle: load and build seconds per stage, slopes per stage.
+
+Usage: python scripts/bench_scaling.py [--quick] [--big | --no-big] [--plot scaling.png] [--out-json rows.json]
 """
 from __future__ import annotations
 
@@ -416,18 +419,30 @@ def main(argv=None) -> int:
     ap.add_argument("--plot", default="scaling.png", help="log-log PNG to write ('' for none)")
     ap.add_argument("--out-json", default=None, help="write the rows and fitted exponents as JSON")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--big", action="store_true", help="only sweep (d), the big scenes")
+    ap.add_argument("--no-big", action="store_true", help="skip sweep (d)")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    rows = run(args.quick, args.seed)
+    import os
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import scaling_big
+
+    rows = [] if args.big else run(args.quick, args.seed)
+    big = [] if args.no_big else scaling_big.sweep(args.quick, log=lambda *a, **k: print(*a, file=sys.stderr, **k))
     print_rows(rows)
     table = fits(rows)
     print_fits(table)
+    big_table = scaling_big.slopes(big, fit_exponent)
+    if big:
+        scaling_big.print_big(big, big_table)
+    rows += big
     if args.plot:
         plot(rows, args.plot)
         print(f"\nplot: {args.plot}")
     if args.out_json:
         with open(args.out_json, "w") as f:
-            json.dump({"rows": rows, "fits": table, "quick": args.quick}, f, indent=1)
+            json.dump({"rows": rows, "fits": table, "big_fits": big_table, "quick": args.quick}, f, indent=1)
     print(f"total {time.perf_counter() - t0:.1f}s")
     return 0
 

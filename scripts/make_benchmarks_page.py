@@ -245,12 +245,75 @@ def render(records: list[dict], missing: list[str], work: str) -> str:
     return "\n".join(lines)
 
 
+def _sections(text: str) -> list[tuple[str, str]]:
+    """The page cut at its ``## `` headings: (name, text) pairs, the preamble named ''."""
+    out, name, buf = [], "", []
+    for line in text.splitlines(keepends=True):
+        if line.startswith("## "):
+            out.append((name, "".join(buf)))
+            name, buf = line[3:].strip(), []
+        buf.append(line)
+    out.append((name, "".join(buf)))
+    return out
+
+
+def splice(old: str, new: str, names: set) -> str:
+    r"""``old`` with the sections ``names`` taken from ``new`` (added before "Not yet run"
+    when the old page lacks them), and ``new``'s commands added to the Reproduce block:
+    what ``--only`` writes, so that the other sections keep their measurements.
+
+    >>> old = "# B\n\n## Reproduce\n\n```sh\nmake\n```\n\n## a\n\nold a\n\n## b\n\nold b\n"
+    >>> new = "# B\n\n## Reproduce\n\n```sh\nmake\npython b\npython c\n```\n\n## b\n\nnew b\n\n## c\n\nnew c\n"
+    >>> print(splice(old, new, {"b", "c"}), end="")
+    # B
+    <BLANKLINE>
+    ## Reproduce
+    <BLANKLINE>
+    ```sh
+    make
+    python b
+    python c
+    ```
+    <BLANKLINE>
+    ## a
+    <BLANKLINE>
+    old a
+    <BLANKLINE>
+    ## b
+    <BLANKLINE>
+    new b
+    <BLANKLINE>
+    ## c
+    <BLANKLINE>
+    new c
+    <BLANKLINE>
+    """
+    fresh = dict(_sections(new))
+    parts = _sections(old)
+    have = {n for n, _ in parts}
+    out = []
+    for name, text in parts:
+        if name == "Reproduce" and "Reproduce" in fresh:
+            lines = text.rstrip("\n").split("\n")
+            end = max(i for i, ln in enumerate(lines) if ln.strip() == "```")
+            known = set(lines)
+            extra = [ln for ln in fresh["Reproduce"].split("\n") if ln.startswith("python ") and ln not in known]
+            text = "\n".join(lines[:end] + extra + lines[end:]) + "\n\n"
+        elif name == "Not yet run":
+            out += [fresh[n] for n in names if n in fresh and n not in have]
+            have |= names
+        out.append(fresh[name] if name in names and name in fresh else text)
+    out += [fresh[n] for n in sorted(names) if n in fresh and n not in have]
+    return "".join(t.rstrip("\n") + "\n\n" for t in out if t.strip())
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"))
     ap.add_argument("--work", help="folder for the runs' outputs (default: a temporary folder)")
     ap.add_argument("--from", dest="source", help="render from the outputs in this folder, without running")
-    ap.add_argument("--only", help="comma-separated bench names to run (e.g. bench_minkowski,cspace_bench)")
+    ap.add_argument("--only", help="comma-separated bench names to run (e.g. bench_minkowski,cspace_bench); "
+                                   "the page's other sections are kept as they are")
     ap.add_argument("--no-planners", action="store_true", help="skip the cspace bench sweep")
     args = ap.parse_args(argv)
     found = {os.path.splitext(os.path.basename(p))[0]: p for p in sorted(glob.glob(os.path.join(ROOT, "scripts", "bench_*.py")))}
@@ -283,6 +346,10 @@ def main(argv: list[str] | None = None) -> int:
             records.append(run_planner_sweep(work))
             print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
     text = render(records, missing, work)
+    if only and not args.source and os.path.exists(args.out):
+        # Only some sections were run: the others keep what the page already shows.
+        with open(args.out) as fh:
+            text = splice(fh.read(), text + "\n", {r["name"] for r in records}).rstrip("\n")
     sys.path.insert(0, ROOT)
     from planners.output import write_text
 

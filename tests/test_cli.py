@@ -197,6 +197,20 @@ def test_version_is_one_line_naming_the_dependencies():
         assert tomllib.load(fh)["project"]["version"] == pkg.__version__ == metadata.version("cspace")
 
 
+def test_the_listing_shows_the_help_each_command_registers():
+    # `cspace --help` lists the commands from planners.cli.HELP without importing them.
+    import argparse
+    import importlib
+
+    from planners.cli import COMMANDS, HELP
+
+    assert set(HELP) == set(COMMANDS)
+    for name, module in COMMANDS.items():
+        sub = argparse.ArgumentParser().add_subparsers()
+        importlib.import_module(module).register(sub)
+        assert sub._choices_actions[0].help == HELP[name], name
+
+
 def test_bare_command_lists_the_commands_and_exits_0():
     from planners.cli import COMMANDS
 

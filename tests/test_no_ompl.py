@@ -55,3 +55,37 @@ def test_with_ompl_nothing_is_noted():
     r = subprocess.run([sys.executable, "-m", "planners.cli", "plan", BASIC], cwd=ROOT, capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 0 and r.stderr == ""
+
+
+def _loaded_after(code: str) -> list[str]:
+    """Heavy optional modules loaded by ``code`` in a fresh interpreter (OMPL not hidden)."""
+    probe = ("import sys\n" + code + "\nprint(' '.join(m for m in ('ompl', 'matplotlib', 'tqdm', 'tomllib', 'numpy') "
+             "if sys.modules.get(m) is not None))")
+    r = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    return r.stdout.split()
+
+
+def test_imports_load_neither_ompl_nor_matplotlib_nor_tqdm():
+    # Start-up (issue 23.6): the packages load their names on first use; OMPL, matplotlib
+    # and tqdm only when a plan, a plot or a progress bar runs, the TOML reader with a file.
+    assert _loaded_after("import cspace, planners") == []
+    assert _loaded_after("import planners.cli") == []
+    used = _loaded_after("import cspace, planners\nfrom cspace import CSpace, SE2CSpace, shortest_path, load_scenario\n"
+                         "from planners import plan, PlanResult\nimport planners.routine, planners.spaces, "
+                         "planners.cli_plan, planners.bench")
+    assert used == ["numpy"]
+    assert _loaded_after(f"from cspace import load_scenario; load_scenario({BASIC!r})") == ["tomllib", "numpy"]
+
+
+def test_help_imports_no_command_module():
+    code = ("import sys; sys.argv = ['cspace', '--help']\nfrom planners.cli import main\n"
+            "import contextlib, io\nwith contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+            "    main()\n"
+            "print(sorted(m for m in sys.modules if m.startswith(('planners.', 'cspace', 'numpy'))))")
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "['planners.cli']"
+    m = subprocess.run([sys.executable, "-m", "planners", "--help"], cwd=ROOT, capture_output=True, text=True,
+                       timeout=60)
+    assert m.returncode == 0 and m.stdout.startswith("usage: cspace") and "plan a collision-free path" in m.stdout

@@ -1,0 +1,360 @@
+"""Planning against peers: the same OMPL planner, three collision checkers, one run.
+
+Each bundled translation scene that has a path (``scenarios/*.toml`` and
+``scenarios/ompl/*.toml``; SE(2) scenes are ``bench_se2.py``'s, and scenes the exact
+planner proves unsolvable are skipped) is planned with OMPL's RRTConnect and RRTstar
+over 10 seeds by
+
+- **ours**: the planning routine of ``cspace plan`` (:func:`planners.routine.run_planner`
+  over :class:`planners.spaces.TranslationSpace`): the C-space's exact point test and
+  its exact segment test as OMPL's motion validator;
+- **shapely**: a state checker that translates the robot to the state
+  (``shapely.transform``) and asks an ``STRtree`` of the obstacles for an intersecting
+  one, with OMPL's default ``DiscreteMotionValidator`` (states 1 % of the space's
+  extent apart);
+- **coal**: coal's convex shapes (our convex pieces of the obstacles and of the robot,
+  as prisms ``coal.Convex``), the obstacles in a ``DynamicAABBTreeCollisionManager``,
+  the robot's pieces moved to the state (``setTranslation``) and collided against
+  it; the same discrete motion checking.
+
+The peers run through the same routine (their adapters only swap the state checker
+and the motion validator, and accept OMPL's path as it is), seeded alike, so the
+planners draw the same samples until the checkers disagree. Anytime planners stop at
+their first solution (``until_first``: OMPL's cost threshold). Runs are interleaved
+(seed-major, the checkers' order rotated per seed). Reported per scene and planner:
+runs solved; the median time to the first solution, wall and CPU (from the call of
+the routine, so setting up OMPL's objects counts; the checker's one-off preparation
+-- our C-space build, the STRtree, coal's shapes -- is the ``prep`` column); the
+median path length; and the returned paths whose swept robot really meets an
+obstacle, judged exactly by our certified segment test (``colliding``) and,
+independently, by shapely (the hull of each convex robot piece at both ends of each
+segment: for a translation that hull *is* the swept piece; ``shapely says``).
+``ours/coal`` is the ratio of the median wall times (target: <= 1.0 where both solve).
+
+Usage: python scripts/bench_planning.py [--quick] [--seeds N] [--time S] [--scenes a,b] [--out-json FILE]
+"""
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import math
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, ROOT)
+
+from cspace.cspace import CSpace, decompose_obstacles, decompose_robot  # noqa: E402
+from cspace.scenario import load_scenario  # noqa: E402
+from planners.routine import run_planner  # noqa: E402
+from planners.spaces import TranslationSpace  # noqa: E402
+
+PLANNERS = ("RRTConnect", "RRTstar")
+CHECKERS = ("ours", "shapely", "coal")  # coal only when installed (pip install -e ".[bench]")
+QUICK_SCENES = ("maze", "office", "env1")
+
+
+# ---------------------------------------------------------------- peers
+
+class PeerSpace(TranslationSpace):
+    """A translation adapter whose states are judged by a peer checker, its motions by
+    OMPL's default discrete validator, and whose paths are accepted as OMPL returns them
+    (the peers have no exact motion test: that is the point of the comparison)."""
+
+    def __init__(self, cspace, checker):
+        super().__init__(cspace, 0)
+        self.checker = checker
+
+    def validity(self):
+        return self.checker
+
+    def motion_validator(self, si):
+        return si.getMotionValidator()  # OMPL's default: the DiscreteMotionValidator
+
+    def verify(self, path, start, goal):
+        ok = len(path) >= 2 and tuple(path[0]) == tuple(map(float, start)) and tuple(path[-1]) == tuple(map(float, goal))
+        return ok, "accepted by the peer's own checks" if ok else "path does not run from start to goal"
+
+    def counts(self):
+        return 0, 0
+
+
+def shapely_checker(sc):
+    """``state -> bool``: the robot translated to the state, an STRtree of the obstacles."""
+    import shapely
+
+    obstacles = [o.to_shapely() for o in sc.obstacles]
+    tree = shapely.STRtree(obstacles)
+    body = shapely.union_all([shapely.Polygon(r.polygon) for r in sc.robot]) if sc.robot else shapely.Point(0, 0)
+    xmin, xmax, ymin, ymax = sc.bounds
+    query, transform, point = tree.query, shapely.transform, shapely.Point
+
+    def is_valid(s) -> bool:
+        x, y = s[0], s[1]
+        if not (xmin <= x <= xmax and ymin <= y <= ymax):
+            return False
+        moved = transform(body, lambda c: c + (x, y)) if sc.robot else point(x, y)
+        return not len(query(moved, predicate="intersects"))
+
+    return is_valid
+
+
+def coal_available() -> bool:
+    """Whether coal (the ``bench`` extra) can be imported."""
+    try:
+        import coal  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _prism(poly: np.ndarray):
+    """A convex polygon as a coal.Convex prism (z in [-1, 1]): coal is 3-D."""
+    import coal
+
+    n = len(poly)
+    pts = coal.StdVec_Vec3s()
+    for z in (-1.0, 1.0):
+        for x, y in poly.tolist():
+            pts.append(np.array([x, y, z]))
+    tris = coal.StdVec_Triangle()
+    for i in range(1, n - 1):
+        tris.append(coal.Triangle(0, i + 1, i))
+        tris.append(coal.Triangle(n, n + i, n + i + 1))
+    for i in range(n):
+        j = (i + 1) % n
+        tris.append(coal.Triangle(i, j, n + j))
+        tris.append(coal.Triangle(i, n + j, n + i))
+    return coal.Convex(pts, tris)
+
+
+def coal_checker(sc):
+    """``state -> bool``: our convex pieces as coal prisms, obstacles in coal's AABB tree."""
+    import coal
+
+    opieces, _owner, _n = decompose_obstacles([o.polygon for o in sc.obstacles], [o.holes for o in sc.obstacles])
+    manager = coal.DynamicAABBTreeCollisionManager()
+    keep = []  # coal's objects hold the geometries by reference
+    for p in opieces:
+        obj = coal.CollisionObject(_prism(p), coal.Transform3s())
+        keep.append(obj)
+        manager.registerObject(obj)
+    manager.setup()
+    if sc.robot:
+        rpieces, _n = decompose_robot([r.polygon for r in sc.robot], sc.robot_kind == "disk")
+        robot = [coal.CollisionObject(_prism(p), coal.Transform3s()) for p in rpieces]
+    else:
+        robot = [coal.CollisionObject(coal.Sphere(0.0), coal.Transform3s())]
+    callback = coal.CollisionCallBackDefault()
+    data = callback.data
+    xmin, xmax, ymin, ymax = sc.bounds
+    collide = manager.collide
+
+    def is_valid(s) -> bool:
+        x, y = s[0], s[1]
+        if not (xmin <= x <= xmax and ymin <= y <= ymax):
+            return False
+        t = np.array([x, y, 0.0])
+        for obj in robot:
+            obj.setTranslation(t)
+            obj.computeAABB()
+            data.result.clear()
+            data.done = False
+            collide(obj, callback)
+            if data.result.isCollision():
+                return False
+        return True
+
+    is_valid.keep = (manager, keep, robot, callback)
+    return is_valid
+
+
+# ---------------------------------------------------------------- judges
+
+def colliding_exact(cs: CSpace, path: np.ndarray) -> bool:
+    """Whether the path's swept robot meets an obstacle: our certified segment test."""
+    return not all(cs.segment_free(tuple(a), tuple(b)) for a, b in zip(path[:-1].tolist(), path[1:].tolist()))
+
+
+def shapely_judge(sc):
+    """``path -> bool``: shapely's independent sweep (hull of each convex robot piece at
+    both ends of each segment, which is the piece's swept region for a translation)."""
+    import shapely
+    from shapely.prepared import prep
+
+    union = shapely.union_all([o.to_shapely() for o in sc.obstacles]) if sc.obstacles else shapely.Polygon()
+    obs = prep(union) if not union.is_empty else None
+    pieces = decompose_robot([r.polygon for r in sc.robot], sc.robot_kind == "disk")[0] if sc.robot else []
+
+    def collides(path: np.ndarray) -> bool:
+        if obs is None:
+            return False
+        for a, b in zip(path[:-1], path[1:]):
+            if not pieces:
+                if obs.intersects(shapely.LineString([a, b]) if (a != b).any() else shapely.Point(a)):
+                    return True
+                continue
+            for p in pieces:
+                if obs.intersects(shapely.MultiPoint(np.vstack([p + a, p + b])).convex_hull):
+                    return True
+        return False
+
+    return collides
+
+
+# ---------------------------------------------------------------- runs
+
+def scenes(names=None) -> list[str]:
+    """The bundled translation scenes (optionally only ``names``, by file stem)."""
+    paths = sorted(glob.glob(os.path.join(ROOT, "scenarios", "*.toml"))) + \
+        sorted(glob.glob(os.path.join(ROOT, "scenarios", "ompl", "*.toml")))
+    out = []
+    for p in paths:
+        stem = os.path.splitext(os.path.basename(p))[0]
+        if names and stem not in names:
+            continue
+        if load_scenario(p).space != "se2":
+            out.append(p)
+    return out
+
+
+def unsolvable(sc, cs) -> bool:
+    """Proven unsolvable by the exact planner (2 s; undecided counts as solvable)."""
+    from cspace.shortest import shortest_path
+
+    return bool(shortest_path(cs.pieces, cs.bounds, sc.start[:2], sc.goal[:2], time_limit=2.0).proven_unsolvable)
+
+
+def one_run(space, planner: str, seed: int, start, goal, time_limit: float) -> dict:
+    """One plan through the routine: the times of the first solution (wall, CPU) from the call."""
+    mark = {}
+    w0, c0 = time.perf_counter(), time.process_time()
+
+    def first(t, length):
+        mark.setdefault("wall", time.perf_counter() - w0)
+        mark.setdefault("cpu", time.process_time() - c0)
+
+    res = run_planner(space, planner, [(start, goal)], time_limit, seed, on_progress=first, until_first=True)[0]
+    found = res.first_solution is not None or bool(res.solved)
+    return {"solved": bool(found and len(res.path) >= 2), "wall": mark.get("wall"), "cpu": mark.get("cpu"),
+            "length": res.length if res.solved else None, "path": res.path if res.solved else None}
+
+
+def _median(xs):
+    xs = [x for x in xs if x is not None]
+    return statistics.median(xs) if xs else None
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help=f"scenes {', '.join(QUICK_SCENES)}, RRTConnect, 3 seeds, 5 s")
+    ap.add_argument("--seeds", type=int, default=None)
+    ap.add_argument("--time", type=float, default=None, help="time limit per run, seconds (default 10)")
+    ap.add_argument("--scenes", default=None, help="comma-separated scene stems")
+    ap.add_argument("--planners", default=None)
+    ap.add_argument("--out-json", default=None)
+    args = ap.parse_args(argv)
+    names = set(args.scenes.split(",")) if args.scenes else (set(QUICK_SCENES) if args.quick else None)
+    seeds = args.seeds or (3 if args.quick else 10)
+    tlim = args.time or (5.0 if args.quick else 10.0)
+    planners = args.planners.split(",") if args.planners else (["RRTConnect"] if args.quick else list(PLANNERS))
+
+    prepared = []
+    for path in scenes(names):
+        sc = load_scenario(path)
+        t = time.perf_counter()
+        cs = CSpace.from_scenario(sc)
+        prep = {"ours": time.perf_counter() - t}
+        if unsolvable(sc, cs):
+            print(f"skip {sc.name}: proven unsolvable", file=sys.stderr)
+            continue
+        t = time.perf_counter()
+        shp = shapely_checker(sc)
+        prep["shapely"] = time.perf_counter() - t
+        spaces = {"ours": TranslationSpace(cs), "shapely": PeerSpace(cs, shp)}
+        if coal_available():
+            t = time.perf_counter()
+            spaces["coal"] = PeerSpace(cs, coal_checker(sc))
+            prep["coal"] = time.perf_counter() - t
+        rel = os.path.relpath(path, os.path.join(ROOT, "scenarios"))
+        prepared.append((os.path.splitext(rel)[0], sc, cs, spaces, prep, shapely_judge(sc)))
+
+    checkers = CHECKERS if coal_available() else CHECKERS[:2]
+    if len(checkers) < 3:
+        print("coal is not installed (pip install -e '.[bench]'): its column is left out", file=sys.stderr)
+    runs: dict = {}
+    for seed in range(seeds):
+        order = checkers[seed % len(checkers):] + checkers[:seed % len(checkers)]
+        for name, sc, cs, spaces, _prep, _judge in prepared:
+            start, goal = (float(sc.start[0]), float(sc.start[1])), (float(sc.goal[0]), float(sc.goal[1]))
+            for planner in planners:
+                for who in order:
+                    runs.setdefault((name, planner, who), []).append(one_run(spaces[who], planner, seed, start, goal, tlim))
+        print(f"seed {seed} done", file=sys.stderr, flush=True)
+
+    rows = []
+    for name, sc, cs, spaces, prep, judge in prepared:
+        for planner in planners:
+            med = {"coal": None}
+            for who in checkers:
+                rs = runs[(name, planner, who)]
+                ok = [r for r in rs if r["solved"]]
+                row = {"scene": name, "planner": planner, "checker": who, "solved": f"{len(ok)}/{len(rs)}",
+                       "first wall ms": _ms(_median([r["wall"] for r in ok])),
+                       "first cpu ms": _ms(_median([r["cpu"] for r in ok])),
+                       "length": _median([r["length"] for r in ok]),
+                       "colliding": sum(colliding_exact(cs, r["path"]) for r in ok),
+                       "shapely says": sum(judge(r["path"]) for r in ok),
+                       "prep ms": _ms(prep[who])}
+                med[who] = row["first wall ms"] if ok else None
+                rows.append(row)
+            ratio = med["ours"] / med["coal"] if med["ours"] and med["coal"] else None
+            for r in rows[-len(checkers):]:
+                r["ours/coal"] = ratio
+    print(f"Time to first solution, {seeds} seeds, {tlim:g} s limit, medians over solved runs; "
+          f"colliding = returned paths whose swept robot meets an obstacle (exact).")
+    print(_table(rows))
+    both = [r for r in rows if r["checker"] == "ours" and r["ours/coal"] is not None]
+    if both:
+        worst = max(both, key=lambda r: r["ours/coal"])
+        losing = [f"{r['scene']}/{r['planner']} {r['ours/coal']:.2f}x" for r in both if r["ours/coal"] > 1.0]
+        print(f"\nours/coal (median wall to first solution): worst {worst['ours/coal']:.2f}x "
+              f"({worst['scene']}, {worst['planner']}); above 1.0x on {len(losing)} of {len(both)}: "
+              f"{', '.join(losing) or 'none'}")
+    total = {w: sum(r["colliding"] for r in rows if r["checker"] == w) for w in checkers}
+    print("colliding paths returned: " + ", ".join(f"{w} {n}" for w, n in total.items()))
+    if args.out_json:
+        with open(args.out_json, "w") as fh:
+            json.dump(rows, fh, indent=1)
+    return 0
+
+
+def _ms(s):
+    return None if s is None else s * 1000.0
+
+
+def _table(rows: list[dict]) -> str:
+    cols = list(rows[0]) if rows else []
+    cells = [[_fmt(r.get(c)) for c in cols] for r in rows]
+    width = [max(len(c), *(len(x[i]) for x in cells)) for i, c in enumerate(cols)]
+    out = ["  ".join(c.ljust(w) for c, w in zip(cols, width))]
+    out += ["  ".join(x.ljust(w) for x, w in zip(row, width)) for row in cells]
+    return "\n".join(out)
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.3g}" if math.isfinite(v) else str(v)
+    return str(v)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
