@@ -333,6 +333,27 @@ static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t na
     return PyLong_FromLong(unknown ? -1 : (tested ? 3 : 1));
 }
 
+/* Is (x, y) a free state? 1 free, 0 not free, -1 undecided. */
+static int point_test(const Grid *g, double x, double y)
+{
+    if (!(isfinite(x) && isfinite(y))) return -1;
+    if (!(g->xmin <= x && x <= g->xmax && g->ymin <= y && y <= g->ymax)) return 0;
+    double fi = floor((x - g->x0) * g->iw), fj = floor((y - g->y0) * g->ih);
+    int64_t i = fi < 0.0 ? 0 : (fi > (double)(g->nx - 1) ? g->nx - 1 : (int64_t)fi);
+    int64_t j = fj < 0.0 ? 0 : (fj > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fj);
+    int64_t c = j * g->nx + i;
+    uint8_t s = g->state[c];
+    if (s == FREE) return 1;
+    if (s == BLOCKED) return 0;
+    int unknown = 0;
+    for (int64_t t = g->starts[c]; t < g->starts[c + 1]; t++) {
+        int r = point_piece(g, g->cand[t], x, y);
+        if (r == 1) return 0;
+        if (r == UNDECIDED) unknown = 1;
+    }
+    return unknown ? -1 : 1;
+}
+
 /* point(grid, x, y) -> 1 free, 0 not free, -1 undecided (non-finite, or a sign the
    filter cannot certify). Outside the closed bounds: not free. The cell is located as
    the build's classification covers it: the margin dwarfs the rounding of the index. */
@@ -345,23 +366,7 @@ static PyObject *py_point(PyObject *self, PyObject *const *args, Py_ssize_t narg
     }
     Grid *g = get_grid(args[0]);
     if (!g || get_doubles(args + 1, 2, q) < 0) return NULL;
-    double x = q[0], y = q[1];
-    if (!(isfinite(x) && isfinite(y))) return PyLong_FromLong(-1);
-    if (!(g->xmin <= x && x <= g->xmax && g->ymin <= y && y <= g->ymax)) return PyLong_FromLong(0);
-    double fi = floor((x - g->x0) * g->iw), fj = floor((y - g->y0) * g->ih);
-    int64_t i = fi < 0.0 ? 0 : (fi > (double)(g->nx - 1) ? g->nx - 1 : (int64_t)fi);
-    int64_t j = fj < 0.0 ? 0 : (fj > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fj);
-    int64_t c = j * g->nx + i;
-    uint8_t s = g->state[c];
-    if (s == FREE) return PyLong_FromLong(1);
-    if (s == BLOCKED) return PyLong_FromLong(0);
-    int unknown = 0;
-    for (int64_t t = g->starts[c]; t < g->starts[c + 1]; t++) {
-        int r = point_piece(g, g->cand[t], x, y);
-        if (r == 1) return PyLong_FromLong(0);
-        if (r == UNDECIDED) unknown = 1;
-    }
-    return PyLong_FromLong(unknown ? -1 : 1);
+    return PyLong_FromLong(point_test(g, q[0], q[1]));
 }
 
 /* orient(ax, ay, bx, by, cx, cy) -> the filter's sign, or 2 when it cannot certify one. */
@@ -376,6 +381,222 @@ static PyObject *py_orient(PyObject *self, PyObject *const *args, Py_ssize_t nar
     return PyLong_FromLong(orient(q[0], q[1], q[2], q[3], q[4], q[5]));
 }
 
+/* ---- SE(2): the float filter of the exact pose test (cspace/se2.py, _pair_filter) ----
+
+   The same IEEE operations in the same order as the Python filter (so the same doubles
+   and the same decisions, each certified there: a side is taken only with |g| above
+   the slab pad times |n|, far above the float error of g). Pairs the filter leaves
+   open, and anything unusual, make the routine answer "undecided": Python then runs
+   its whole exact test, rational sums included. */
+
+typedef struct {
+    int64_t n_obs, n_rob, n, n_entries;
+    double xmin, xmax, ymin, ymax, pad, gx0, gy0, giw, gih;
+    int64_t *o_off;  /* obstacle i: edges and vertices o_off[i] .. o_off[i + 1] - 1 */
+    double *o_edge;  /* per edge: outward normal x, y, offset, |n| */
+    double *o_pt;    /* per vertex: x, y */
+    int64_t *r_off;  /* robot piece j: vertices r_off[j] .. r_off[j + 1] - 1 */
+    double *r_pt;    /* body-frame vertices x, y */
+    double *r_nrm;   /* body-frame normal of the edge ending at each vertex: x, y, |n| */
+    int64_t *starts; /* pair-grid cell c: entries starts[c] .. starts[c + 1] - 1 */
+    int64_t *e_ij;   /* per entry: obstacle i, robot piece j */
+    double *e_box;   /* per entry: the reach box x0, y0, x1, y1 */
+    double *rot;     /* scratch: turned vertices x, y per robot vertex */
+    double *axes;    /* scratch: per robot vertex nx, ny, rx, ry, |n| */
+    uint32_t *stamp; /* per robot piece: the query that last turned it */
+    uint32_t gen;
+} SE2;
+
+static void se2_release(SE2 *h)
+{
+    PyMem_Free(h->o_off);
+    PyMem_Free(h->o_edge);
+    PyMem_Free(h->o_pt);
+    PyMem_Free(h->r_off);
+    PyMem_Free(h->r_pt);
+    PyMem_Free(h->r_nrm);
+    PyMem_Free(h->starts);
+    PyMem_Free(h->e_ij);
+    PyMem_Free(h->e_box);
+    PyMem_Free(h->rot);
+    PyMem_Free(h->axes);
+    PyMem_Free(h->stamp);
+    PyMem_Free(h);
+}
+
+static void se2_free(PyObject *cap)
+{
+    SE2 *h = (SE2 *)PyCapsule_GetPointer(cap, "cspace._fast.SE2");
+    if (h) se2_release(h);
+}
+
+/* se2(o_off, o_edge, o_pt, r_off, r_pt, r_nrm, starts, e_ij, e_box, n, n_obs, n_rob,
+       n_entries, xmin, xmax, ymin, ymax, pad, gx0, gy0, giw, gih) -> capsule (copies). */
+static PyObject *py_se2(PyObject *self, PyObject *args)
+{
+    PyObject *a[9];
+    Py_ssize_t n, n_obs, n_rob, n_ent;
+    double v[9];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOnnnnddddddddd", &a[0], &a[1], &a[2], &a[3], &a[4], &a[5], &a[6], &a[7],
+                          &a[8], &n, &n_obs, &n_rob, &n_ent, &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
+                          &v[7], &v[8]))
+        return NULL;
+    SE2 *h = PyMem_Calloc(1, sizeof(SE2));
+    if (!h) return PyErr_NoMemory();
+    h->n = n, h->n_obs = n_obs, h->n_rob = n_rob, h->n_entries = n_ent;
+    h->xmin = v[0], h->xmax = v[1], h->ymin = v[2], h->ymax = v[3], h->pad = v[4];
+    h->gx0 = v[5], h->gy0 = v[6], h->giw = v[7], h->gih = v[8];
+    if (n < 1 || n_obs < 0 || n_rob < 1 || n_ent < 0) {
+        PyErr_SetString(PyExc_ValueError, "_fast.se2: bad sizes");
+        goto fail;
+    }
+    if (!(h->o_off = copy_buffer(a[0], 8, n_obs + 1, "o_off"))) goto fail;
+    if (!(h->r_off = copy_buffer(a[3], 8, n_rob + 1, "r_off"))) goto fail;
+    int64_t no = h->o_off[n_obs], nr = h->r_off[n_rob];
+    for (int64_t i = 0; i < n_obs; i++)
+        if (h->o_off[i + 1] <= h->o_off[i]) goto bad;
+    for (int64_t j = 0; j < n_rob; j++)
+        if (h->r_off[j + 1] <= h->r_off[j]) goto bad;
+    if (!(h->o_edge = copy_buffer(a[1], 32, no, "o_edge"))) goto fail;
+    if (!(h->o_pt = copy_buffer(a[2], 16, no, "o_pt"))) goto fail;
+    if (!(h->r_pt = copy_buffer(a[4], 16, nr, "r_pt"))) goto fail;
+    if (!(h->r_nrm = copy_buffer(a[5], 24, nr, "r_nrm"))) goto fail;
+    if (!(h->starts = copy_buffer(a[6], 8, n * n + 1, "starts"))) goto fail;
+    if (!(h->e_ij = copy_buffer(a[7], 16, n_ent, "e_ij"))) goto fail;
+    if (!(h->e_box = copy_buffer(a[8], 32, n_ent, "e_box"))) goto fail;
+    for (int64_t c = 0; c < n * n; c++)
+        if (h->starts[c] < 0 || h->starts[c] > h->starts[c + 1] || h->starts[c + 1] > n_ent) goto bad;
+    for (int64_t t = 0; t < n_ent; t++)
+        if (h->e_ij[2 * t] < 0 || h->e_ij[2 * t] >= n_obs || h->e_ij[2 * t + 1] < 0 || h->e_ij[2 * t + 1] >= n_rob)
+            goto bad;
+    h->rot = PyMem_Malloc(16 * (size_t)nr);
+    h->axes = PyMem_Malloc(40 * (size_t)nr);
+    h->stamp = PyMem_Calloc((size_t)n_rob, sizeof(uint32_t));
+    if (!h->rot || !h->axes || !h->stamp) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    PyObject *cap = PyCapsule_New(h, "cspace._fast.SE2", se2_free);
+    if (cap) return cap;
+    goto fail;
+bad:
+    PyErr_SetString(PyExc_ValueError, "_fast.se2: inconsistent arrays");
+fail:
+    se2_release(h);
+    return NULL;
+}
+
+/* _pair_filter of cspace/se2.py: +1 outside, -1 inside, 0 unsure (same operations). */
+static int pair_filter(const SE2 *h, int64_t i, int64_t j, double x, double y, double margin)
+{
+    int inside = 1;
+    int64_t o0 = h->o_off[i], o1 = h->o_off[i + 1], r0 = h->r_off[j], r1 = h->r_off[j + 1];
+    for (int64_t e = o0; e < o1; e++) { /* O's normals */
+        const double *E = h->o_edge + 4 * e;
+        double nx = E[0], ny = E[1], off = E[2], ln = E[3];
+        double lo = HUGE_VAL;
+        for (int64_t t = r0; t < r1; t++) {
+            double vv = nx * h->rot[2 * t] + ny * h->rot[2 * t + 1];
+            if (vv < lo) lo = vv;
+        }
+        double g = nx * x + ny * y - off + lo;
+        double m = margin * ln;
+        if (g > m) return 1;
+        if (g >= -m) inside = 0;
+    }
+    for (int64_t t = r0; t < r1; t++) { /* -R''s normals */
+        const double *A = h->axes + 5 * t;
+        double nx = A[0], ny = A[1], rx = A[2], ry = A[3], ln = A[4];
+        double hi = -HUGE_VAL;
+        for (int64_t e = o0; e < o1; e++) {
+            double vv = nx * h->o_pt[2 * e] + ny * h->o_pt[2 * e + 1];
+            if (vv > hi) hi = vv;
+        }
+        double g = nx * x + ny * y - hi + (nx * rx + ny * ry);
+        double m = margin * ln;
+        if (g > m) return 1;
+        if (g >= -m) inside = 0;
+    }
+    return inside ? -1 : 0;
+}
+
+static int se2_filter(SE2 *h, double x, double y, double c, double sn);
+
+/* se2_pose(handle, x, y, c, s) -> 1 free, 0 not free, -1 undecided: the filter stage of
+   SE2CSpace._exact at the angle whose math.cos and math.sin are c and s (computed by
+   the caller, so the turned robot is the Python path's to the last bit). */
+static PyObject *py_se2_pose(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    double q[4];
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "se2_pose(handle, x, y, c, s)");
+        return NULL;
+    }
+    SE2 *h = (SE2 *)PyCapsule_GetPointer(args[0], "cspace._fast.SE2");
+    if (!h || get_doubles(args + 1, 4, q) < 0) return NULL;
+    return PyLong_FromLong(se2_filter(h, q[0], q[1], q[2], q[3]));
+}
+
+/* se2_slow(slab grid, handle, x, y, c, s) -> the slow path of SE2CSpace.pose_test in
+   one call: 1 free in the slab's C-space (free at every angle of the slab), else the
+   filter stage of the exact test: 2 free, 0 not free; -1 undecided (Python decides). */
+static PyObject *py_se2_slow(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    double q[4];
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "se2_slow(grid, handle, x, y, c, s)");
+        return NULL;
+    }
+    Grid *g = get_grid(args[0]);
+    if (!g) return NULL;
+    SE2 *h = (SE2 *)PyCapsule_GetPointer(args[1], "cspace._fast.SE2");
+    if (!h || get_doubles(args + 2, 4, q) < 0) return NULL;
+    if (point_test(g, q[0], q[1]) == 1) return PyLong_FromLong(1);
+    int r = se2_filter(h, q[0], q[1], q[2], q[3]);
+    return PyLong_FromLong(r == 1 ? 2 : r);
+}
+
+/* The filter stage of the exact pose test: 1 free, 0 not free, -1 undecided. */
+static int se2_filter(SE2 *h, double x, double y, double c, double sn)
+{
+    if (!(isfinite(x) && isfinite(y) && isfinite(c) && isfinite(sn))) return -1;
+    if (!(h->xmin <= x && x <= h->xmax && h->ymin <= y && y <= h->ymax)) return 0;
+    if (++h->gen == 0) {
+        memset(h->stamp, 0, (size_t)h->n_rob * sizeof(uint32_t));
+        h->gen = 1;
+    }
+    double fi = floor((x - h->gx0) * h->giw), fj = floor((y - h->gy0) * h->gih);
+    int64_t ci = fi < 0.0 ? 0 : (fi > (double)(h->n - 1) ? h->n - 1 : (int64_t)fi);
+    int64_t cj = fj < 0.0 ? 0 : (fj > (double)(h->n - 1) ? h->n - 1 : (int64_t)fj);
+    int64_t cell = cj * h->n + ci;
+    int unknown = 0;
+    for (int64_t t = h->starts[cell]; t < h->starts[cell + 1]; t++) {
+        const double *B = h->e_box + 4 * t;
+        if (x < B[0] || x > B[2] || y < B[1] || y > B[3]) continue; /* beyond this pair's reach */
+        int64_t i = h->e_ij[2 * t], j = h->e_ij[2 * t + 1];
+        if (h->stamp[j] != h->gen) { /* turn robot piece j: rotate() in scalars */
+            h->stamp[j] = h->gen;
+            for (int64_t u = h->r_off[j]; u < h->r_off[j + 1]; u++) {
+                double vx = h->r_pt[2 * u], vy = h->r_pt[2 * u + 1];
+                double rx = vx * c - vy * sn + 0.0, ry = vx * sn + vy * c + 0.0;
+                const double *N = h->r_nrm + 3 * u;
+                double *A = h->axes + 5 * u;
+                h->rot[2 * u] = rx;
+                h->rot[2 * u + 1] = ry;
+                A[0] = -(N[0] * c - N[1] * sn);
+                A[1] = -(N[0] * sn + N[1] * c);
+                A[2] = rx;
+                A[3] = ry;
+                A[4] = N[2];
+            }
+        }
+        int side = pair_filter(h, i, j, x, y, h->pad);
+        if (side < 0) return 0; /* certainly inside a sum */
+        if (side == 0) unknown = 1;
+    }
+    return unknown ? -1 : 1;
+}
+
 static PyMethodDef methods[] = {
     {"grid", py_grid, METH_VARARGS, "Copy a grid index and its packed pieces; returns a handle."},
     {"segment", (PyCFunction)(void (*)(void))py_segment, METH_FASTCALL,
@@ -384,6 +605,11 @@ static PyMethodDef methods[] = {
      "point(grid, x, y): 1 free, 0 not free, -1 undecided."},
     {"orient", (PyCFunction)(void (*)(void))py_orient, METH_FASTCALL,
      "orient(ax, ay, bx, by, cx, cy): the float filter's sign of orient2d, 2 if undecided."},
+    {"se2", py_se2, METH_VARARGS, "Copy the SE(2) pose filter's data; returns a handle."},
+    {"se2_pose", (PyCFunction)(void (*)(void))py_se2_pose, METH_FASTCALL,
+     "se2_pose(handle, x, y, c, s): 1 free, 0 not free, -1 undecided (the exact test's float filter)."},
+    {"se2_slow", (PyCFunction)(void (*)(void))py_se2_slow, METH_FASTCALL,
+     "se2_slow(grid, handle, x, y, c, s): 1 free in the slab, 2 free, 0 not free, -1 undecided."},
     {NULL, NULL, 0, NULL},
 };
 

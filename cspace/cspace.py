@@ -369,6 +369,8 @@ class CSpace:
         rows = [flat[r * nx:(r + 1) * nx] + border for r in range(ny)] + [border * (nx + 1)]
         exact = self._is_free_exact
         mixed = self._mixed_cell_test()
+        if self._fast is not None:  # compiled: certified answers only, else the Python narrow phase
+            mixed = self._mixed_cell_fast(mixed)
         xmin, xmax, ymin, ymax = self.bounds
         count = int if tick is None else tick  # int() is a C-level no-op: no branch per query
         floor = math.floor  # on floats about 3x cheaper than int() (a type call); equal for i >= 0
@@ -456,6 +458,20 @@ class CSpace:
                 else:
                     return False  # on or left of every edge: in this closed piece
             return True
+
+        return free_in_cell
+
+    def _mixed_cell_fast(self, pure):
+        """``(cell, x, y) -> bool``: :meth:`_mixed_cell_test` through the compiled point
+        test (the same exact answer when it decides; ``pure`` when it cannot)."""
+        handle, point, checks = self._fast, fastpath._fast.point, self.checks
+
+        def free_in_cell(cell: int, x: float, y: float) -> bool:
+            r = point(handle, x, y)  # 1 free, 0 not, -1 undecided
+            if r < 0:
+                return pure(cell, x, y)
+            checks["exact_points"] += 1
+            return r == 1
 
         return free_in_cell
 

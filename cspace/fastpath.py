@@ -12,6 +12,7 @@ The C routines decide only what Shewchuk's stage-A float filter certifies and an
 """
 from __future__ import annotations
 
+import contextlib
 import os
 
 import numpy as np
@@ -51,3 +52,58 @@ def grid_handle(index, packed, bounds):
         np.ascontiguousarray(xy, dtype=np.float64),
         index.nx, index.ny, index.x0, index.y0, index.inv_w, index.inv_h, index.cw, index.ch, index.margin,
         *map(float, bounds))
+
+
+def se2_handle(cs):
+    """A handle on the pose filter's data of a :class:`cspace.se2.SE2CSpace` (its obstacle
+    edges and vertices, body-frame robot pieces and normals, and pair grid) for the
+    compiled filter stage of its exact pose test, or None on the pure path (or without
+    robot pieces).
+
+    >>> import numpy as np
+    >>> from cspace.se2 import SE2CSpace
+    >>> cs = SE2CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])],
+    ...                [np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])], slabs=8)
+    >>> h = se2_handle(cs)
+    >>> h is None or (_fast.se2_pose(h, 5.0, 5.0, 1.0, 0.0), _fast.se2_pose(h, 1.0, 1.0, 1.0, 0.0)) == (0, 1)
+    True
+    """
+    if _fast is None or not cs.robot_pieces:
+        return None
+    o_off = np.concatenate([[0], np.cumsum([len(p) for p in cs.obstacle_lists])]).astype(np.int64)
+    r_off = np.concatenate([[0], np.cumsum([len(p) for p in cs._robot_lists])]).astype(np.int64)
+    o_edge = np.array([e for edges in cs._obstacle_edges for e in edges], dtype=np.float64).reshape(-1, 4)
+    o_pt = np.array([v for pts in cs.obstacle_lists for v in pts], dtype=np.float64).reshape(-1, 2)
+    r_pt = np.array([v for pts in cs._robot_lists for v in pts], dtype=np.float64).reshape(-1, 2)
+    r_nrm = np.array([v for nrm in cs._robot_normals for v in nrm], dtype=np.float64).reshape(-1, 3)
+    cells = cs._pg_cells
+    starts = np.concatenate([[0], np.cumsum([len(c) for c in cells])]).astype(np.int64)
+    entries = [e for c in cells for e in c]
+    e_ij = np.array([(e[0], e[1]) for e in entries], dtype=np.int64).reshape(-1, 2)
+    e_box = np.array([e[5:9] for e in entries], dtype=np.float64).reshape(-1, 4)
+    xmin, xmax, ymin, ymax = cs.bounds
+    return _fast.se2(o_off, np.ascontiguousarray(o_edge), np.ascontiguousarray(o_pt), r_off,
+                     np.ascontiguousarray(r_pt), np.ascontiguousarray(r_nrm), starts, np.ascontiguousarray(e_ij),
+                     np.ascontiguousarray(e_box), cs._pg_n, len(cs.obstacle_lists), len(cs._robot_lists),
+                     len(entries), xmin, xmax, ymin, ymax, cs.pad, cs._pg_x0, cs._pg_y0, cs._pg_iw, cs._pg_ih)
+
+
+@contextlib.contextmanager
+def disabled():
+    """Within the block, C-spaces are built on the pure path (no compiled handle): the
+    oracle of the tests and the pure column of the benches. Objects keep the path they
+    were built with (an SE(2) C-space's slabs: build them inside the block).
+
+    >>> from cspace import fastpath
+    >>> with fastpath.disabled():
+    ...     inside = fastpath._fast
+    >>> inside is None
+    True
+    """
+    global _fast
+    saved = _fast
+    _fast = None
+    try:
+        yield
+    finally:
+        _fast = saved

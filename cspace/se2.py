@@ -28,6 +28,7 @@ import time
 
 import numpy as np
 
+from . import fastpath
 from .broadphase import GridIndex
 from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
 from .minkowski import minkowski_sum, reflect
@@ -101,6 +102,8 @@ class SE2CSpace(SE2Motions):
         self._robot_lists = [p.tolist() for p in self.robot_pieces]
         self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
         self._pair_grid()
+        self._fast = fastpath.se2_handle(self)  # the compiled filter stage (None: pure path)
+        self._fast_pose = None if self._fast is None else fastpath._fast.se2_pose
         self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
                        "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
         self._states = itertools.count()
@@ -193,6 +196,18 @@ class SE2CSpace(SE2Motions):
                 return True  # free in the slab: free at every angle of it
             return exact(x, y, th, k)
 
+        if self._fast is not None and outer._fast is not None:
+            pure_slow, both, checks = slow, fastpath._fast.se2_slow, self.checks
+            handles, cos, sin = (outer._fast, self._fast), math.cos, math.sin
+
+            def slow(x: float, y: float, th: float) -> bool:  # noqa: F811  (the same test, compiled)
+                r = both(*handles, x, y, cos(th), sin(th))  # 1 free in the slab, 2 free, 0 not, -1 undecided
+                if r < 0:
+                    return pure_slow(x, y, th)
+                if r != 1:
+                    checks["exact_states"] += 1  # decided by the exact test's filter stage
+                return r != 0
+
         return rows, g.inv_w, g.x0 * g.inv_w, g.inv_h, g.y0 * g.inv_h, slow
 
     def _slab_index(self, th: float) -> int:
@@ -277,6 +292,10 @@ class SE2CSpace(SE2Motions):
         if not self.in_bounds(x, y):
             return False
         c, sn = math.cos(th), math.sin(th)
+        if self._fast is not None:  # compiled: the same filter, certified answers only
+            r = self._fast_pose(self._fast, x, y, c, sn)
+            if r >= 0:
+                return r == 1
         rotated: dict = {}
         margin = self.pad
         for i, j, o_edges, o_pts, r_normals, bx0, by0, bx1, by1 in self._cell_pairs(k, x, y):

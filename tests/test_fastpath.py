@@ -118,3 +118,72 @@ def test_cspace_pure_forces_the_pure_path():
     out = subprocess.run([sys.executable, "-c", "import cspace.fastpath as f; print(f.ENABLED)"],
                          env=env, capture_output=True, text=True, cwd=ROOT, check=True)
     assert out.stdout.strip() == "False"
+
+
+# ---------------------------------------------------------------- SE(2)
+
+def _se2_pair(seed: int):
+    """The same integer SE(2) scene twice: compiled, and pure (every slab built pure)."""
+    from cspace import SE2CSpace
+
+    rng = np.random.default_rng(100 + seed)
+    obstacles = []
+    for _ in range(int(rng.integers(1, 6))):
+        x, y = rng.integers(0, 10, 2)
+        w, h = rng.integers(1, 4, 2)
+        obstacles.append(np.array([[x, y], [x + w, y], [x + w, y + h], [x, y + h]], dtype=float))
+    robot = [np.array([[-2., -0.5], [2, -0.5], [2, 0.5], [-2, 0.5]])] if seed % 2 else \
+        [np.array([[0., 0], [2, 0], [2, 1]]), np.array([[0., 0], [2, 1], [0, 2]])]
+    fast = SE2CSpace((0, 12, 0, 12), obstacles, robot, slabs=8)
+    with fastpath.disabled():
+        pure = SE2CSpace((0, 12, 0, 12), obstacles, robot, slabs=8)
+        for k in range(pure.slabs):
+            pure.slab(k)
+    return fast, pure
+
+
+_SE2 = {}
+
+
+def se2_pair(seed: int):
+    if seed not in _SE2:
+        _SE2[seed] = _se2_pair(seed)
+    return _SE2[seed]
+
+
+angle = st.one_of(st.sampled_from([0.0, -np.pi, np.pi / 2, -np.pi / 2, 1.0]), st.floats(-np.pi, np.pi - 1e-9))
+
+
+@needs_c
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 3), coord, coord, angle)
+def test_se2_pose_matches_pure(seed, x, y, th):
+    fast, pure = se2_pair(seed)
+    assert fast._fast is not None and pure._fast is None
+    assert fast.is_free((x, y, th)) == pure.is_free((x, y, th))
+
+
+@needs_c
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 3), coord, coord, angle, coord, coord, angle)
+def test_se2_motion_matches_pure(seed, x0, y0, a0, x1, y1, a1):
+    fast, pure = se2_pair(seed)
+    assert fast.motion_free((x0, y0, a0), (x1, y1, a1)) == pure.motion_free((x0, y0, a0), (x1, y1, a1))
+
+
+@needs_c
+def test_se2_bundled_scene_matches_pure():
+    """A float SE(2) scene (the bundled car maze, 8 slabs): 3000 random poses."""
+    from cspace import SE2CSpace, load_scenario
+
+    sc = load_scenario(os.path.join(ROOT, "scenarios", "se2", "car_maze.toml"))
+    fast = SE2CSpace.from_scenario(sc, slabs=8)
+    with fastpath.disabled():
+        pure = SE2CSpace.from_scenario(sc, slabs=8)
+        for k in range(pure.slabs):
+            pure.slab(k)
+    xmin, xmax, ymin, ymax = sc.bounds
+    rng = np.random.default_rng(2)
+    f, g = fast.pose_test(), pure.pose_test()
+    for x, y, th in rng.uniform((xmin, ymin, -np.pi), (xmax, ymax, np.pi), (3000, 3)).tolist():
+        assert f(x, y, th) == g(x, y, th), (x, y, th)
