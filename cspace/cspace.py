@@ -558,10 +558,8 @@ class CSpace:
         # Motions mostly fail at their far end (an RRT extension into an obstacle).
         if not (self._point_uncounted(bx, by) and self._point_uncounted(ax, ay)):
             return False
-        hits = self.packed.segment_hits_many
-        a2, b2 = (ax, ay), (bx, by)
-        found = self.coarse.segment_candidates(
-            ax, ay, bx, by, on_blocker=lambda k: bool(hits(np.array([k]), a2, b2)[0]))
+        one = self.packed.segment_hits_xy
+        found = self.coarse.segment_candidates(ax, ay, bx, by, on_blocker=lambda k: one(k, ax, ay, bx, by))
         if found is None:
             self.checks["exact_segments"] += 1
             return False
@@ -569,8 +567,11 @@ class CSpace:
         if not cands:
             return True  # blockers, if any, were each tested (and missed) as they were found
         self.checks["exact_segments"] += 1
-        cands -= blockers
-        return not (cands and hits(np.fromiter(cands, np.int64, len(cands)), a2, b2).any())
+        cands -= blockers  # each candidate tested once: scalars for a few, numpy for many
+        if len(cands) <= 8:
+            return not any(one(k, ax, ay, bx, by) for k in sorted(cands))
+        hits = self.packed.segment_hits_many
+        return not hits(np.fromiter(cands, np.int64, len(cands)), (ax, ay), (bx, by)).any()
 
     def _segments_free(self, s) -> np.ndarray:
         """:meth:`segment_free` of an (N, 2, 2) batch, each segment by the exact scalar test."""
