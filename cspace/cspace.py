@@ -172,7 +172,7 @@ class CSpace:
         self.is_free_xy = self.point_test(self._points.__next__)
         self._is_free_q = self.is_free_xy.by_state  # the same test, on one indexable (x, y)
         self._point_uncounted = self.point_test(None)
-        self._segment = self._segment_pure if self._fast is None else self._segment_fast()
+        self._segment = fastpath.segment_test(self._fast, self._segment_pure, self.checks)
 
     # -- construction --------------------------------------------------------------
 
@@ -370,7 +370,7 @@ class CSpace:
         exact = self._is_free_exact
         mixed = self._mixed_cell_test()
         if self._fast is not None:  # compiled: certified answers only, else the Python narrow phase
-            mixed = self._mixed_cell_fast(mixed)
+            mixed = fastpath.mixed_cell_test(self._fast, mixed, self.checks)
         xmin, xmax, ymin, ymax = self.bounds
         count = int if tick is None else tick  # int() is a C-level no-op: no branch per query
         floor = math.floor  # on floats about 3x cheaper than int() (a type call); equal for i >= 0
@@ -461,20 +461,6 @@ class CSpace:
 
         return free_in_cell
 
-    def _mixed_cell_fast(self, pure):
-        """``(cell, x, y) -> bool``: :meth:`_mixed_cell_test` through the compiled point
-        test (the same exact answer when it decides; ``pure`` when it cannot)."""
-        handle, point, checks = self._fast, fastpath._fast.point, self.checks
-
-        def free_in_cell(cell: int, x: float, y: float) -> bool:
-            r = point(handle, x, y)  # 1 free, 0 not, -1 undecided
-            if r < 0:
-                return pure(cell, x, y)
-            checks["exact_points"] += 1
-            return r == 1
-
-        return free_in_cell
-
     def point_count(self) -> int:
         """Point queries answered so far."""
         n = self._points.__reduce__()[1][0]
@@ -531,22 +517,6 @@ class CSpace:
         (True, False)
         """
         return self._segment
-
-    def _segment_fast(self):
-        """The segment test: the compiled routine's certified answer when it has one,
-        else :meth:`_segment_pure` (exact)."""
-        handle, seg, pure, checks = self._fast, fastpath._fast.segment, self._segment_pure, self.checks
-
-        def segment(ax: float, ay: float, bx: float, by: float) -> bool:
-            r = seg(handle, ax, ay, bx, by)  # 1 or 3 free, 0 not, -1 undecided or out of bounds
-            if r < 0:
-                return pure(ax, ay, bx, by)
-            checks["segments"] += 1
-            if r != 1:
-                checks["exact_segments"] += 1  # the narrow phase ran
-            return r != 0
-
-        return segment
 
     def _segment_pure(self, ax: float, ay: float, bx: float, by: float) -> bool:
         """The exact segment test on four floats (the pure path, and the oracle)."""

@@ -13,6 +13,7 @@ The C routines decide only what Shewchuk's stage-A float filter certifies and an
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 
 import numpy as np
@@ -52,6 +53,75 @@ def grid_handle(index, packed, bounds):
         np.ascontiguousarray(xy, dtype=np.float64),
         index.nx, index.ny, index.x0, index.y0, index.inv_w, index.inv_h, index.cw, index.ch, index.margin,
         *map(float, bounds))
+
+
+def segment_test(handle, pure, checks: dict):
+    """The C-space's ``(ax, ay, bx, by) -> bool`` segment test: the compiled routine's
+    certified answer when it has one, else ``pure`` (exact); ``pure`` itself on the pure
+    path (``handle`` None). Counted in ``checks`` as the pure test counts.
+
+    >>> segment_test(None, max, {}) is max
+    True
+    """
+    if handle is None:
+        return pure
+    seg = _fast.segment
+
+    def segment(ax: float, ay: float, bx: float, by: float) -> bool:
+        r = seg(handle, ax, ay, bx, by)  # 1 or 3 free, 0 not, -1 undecided or out of bounds
+        if r < 0:
+            return pure(ax, ay, bx, by)
+        checks["segments"] += 1
+        if r != 1:
+            checks["exact_segments"] += 1  # the narrow phase ran
+        return r != 0
+
+    return segment
+
+
+def mixed_cell_test(handle, pure, checks: dict):
+    """``(cell, x, y) -> bool``, the point test of a MIXED cell: the compiled test's
+    certified answer when it has one, else ``pure`` (the Python narrow phase).
+
+    >>> mixed_cell_test(None, max, {}) is max
+    True
+    """
+    if handle is None:
+        return pure
+    point = _fast.point
+
+    def free_in_cell(cell: int, x: float, y: float) -> bool:
+        r = point(handle, x, y)  # 1 free, 0 not, -1 undecided
+        if r < 0:
+            return pure(cell, x, y)
+        checks["exact_points"] += 1
+        return r == 1
+
+    return free_in_cell
+
+
+def se2_slow_test(slab_handle, handle, pure, checks: dict):
+    """``(x, y, th) -> bool``, the slow path of an SE(2) slab's pose test (free in the
+    slab's C-space, else the exact test) in one compiled call; ``pure`` when it cannot
+    decide. ``math.cos``/``math.sin`` are taken here, so the C filter turns the robot by
+    the same doubles as the Python one.
+
+    >>> se2_slow_test(None, None, max, {}) is max
+    True
+    """
+    if handle is None or slab_handle is None:
+        return pure
+    both, cos, sin = _fast.se2_slow, math.cos, math.sin
+
+    def slow(x: float, y: float, th: float) -> bool:
+        r = both(slab_handle, handle, x, y, cos(th), sin(th))  # 1 free in the slab, 2 free, 0 not, -1 undecided
+        if r < 0:
+            return pure(x, y, th)
+        if r != 1:
+            checks["exact_states"] += 1  # decided by the exact test's filter stage
+        return r != 0
+
+    return slow
 
 
 def se2_handle(cs):

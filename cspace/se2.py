@@ -196,18 +196,7 @@ class SE2CSpace(SE2Motions):
                 return True  # free in the slab: free at every angle of it
             return exact(x, y, th, k)
 
-        if self._fast is not None and outer._fast is not None:
-            pure_slow, both, checks = slow, fastpath._fast.se2_slow, self.checks
-            handles, cos, sin = (outer._fast, self._fast), math.cos, math.sin
-
-            def slow(x: float, y: float, th: float) -> bool:  # noqa: F811  (the same test, compiled)
-                r = both(*handles, x, y, cos(th), sin(th))  # 1 free in the slab, 2 free, 0 not, -1 undecided
-                if r < 0:
-                    return pure_slow(x, y, th)
-                if r != 1:
-                    checks["exact_states"] += 1  # decided by the exact test's filter stage
-                return r != 0
-
+        slow = fastpath.se2_slow_test(outer._fast, self._fast, slow, self.checks)  # compiled, if built
         return rows, g.inv_w, g.x0 * g.inv_w, g.inv_h, g.y0 * g.inv_h, slow
 
     def _slab_index(self, th: float) -> int:
