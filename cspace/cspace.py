@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import fastpath
 from .broadphase import BLOCKED, FREE, GridIndex
 from .pieces import PieceSet
 from .inputs import query_points
@@ -174,12 +175,15 @@ class CSpace:
                        else GridIndex(self.pieces, self.bounds, cells=max(cells // 16, 64)))
         self.stages.append(Stage("index", True, time.perf_counter() - t,
                                  {**self.index.stats(), "segment_grid": [self.coarse.nx, self.coarse.ny]}))
+        # The compiled fast path's copy of the grid and pieces (None on the pure path).
+        self._fast = fastpath.grid_handle(self.index, self.packed, self.bounds)
         self.checks = {"points": 0, "segments": 0, "exact_points": 0, "exact_segments": 0}
         self._points = itertools.count()
         self._batch_points = 0  # points answered by is_free on arrays
         self.is_free_xy = self.point_test(self._points.__next__)
         self._is_free_q = self.is_free_xy.by_state  # the same test, on one indexable (x, y)
         self._point_uncounted = self.point_test(None)
+        self._segment = fastpath.segment_test(self._fast, self._segment_pure, self.checks)
 
     # -- construction --------------------------------------------------------------
 
@@ -370,6 +374,8 @@ class CSpace:
         rows = idx.state_rows()
         exact = self._is_free_exact
         mixed = self._mixed_cell_test()
+        if self._fast is not None:  # compiled: certified answers only, else the Python narrow phase
+            mixed = fastpath.mixed_cell_test(self._fast, mixed, self.checks)
         xmin, xmax, ymin, ymax = self.bounds
         count = int if tick is None else tick  # int() is a C-level no-op: no branch per query
         floor = math.floor  # on floats about 3x cheaper than int() (a type call); equal for i >= 0
@@ -503,18 +509,32 @@ class CSpace:
             return self._segments_free(np.stack([np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)], 1))
         if len(a) != 2 or len(b) != 2:
             query_points([a, b], 2, "segment_free")  # raises: (x, y, theta) or a wrong length
+        return self._segment(ax, ay, bx, by)
+
+    def segment_test(self):
+        """A fast ``(ax, ay, bx, by) -> bool`` closed-segment test on four floats: the motion
+        validator's hot path, the same answers as :meth:`segment_free` (counted alike).
+
+        >>> import numpy as np
+        >>> cs = CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])])
+        >>> f = cs.segment_test()
+        >>> f(1.0, 1.0, 9.0, 1.0), f(1.0, 5.0, 9.0, 5.0)
+        (True, False)
+        """
+        return self._segment
+
+    def _segment_pure(self, ax: float, ay: float, bx: float, by: float) -> bool:
+        """The exact segment test on four floats (the pure path, and the oracle)."""
         self.checks["segments"] += 1
         if not (self.in_bounds(ax, ay) and self.in_bounds(bx, by)):
             if not (ax - ax == 0.0 and ay - ay == 0.0 and bx - bx == 0.0 and by - by == 0.0):
-                query_points([a, b], 2, "segment_free")  # raises: NaN or inf
+                query_points([(ax, ay), (bx, by)], 2, "segment_free")  # raises: NaN or inf
             return False  # the bounds box is convex: both ends inside => whole segment inside
         # Motions mostly fail at their far end (an RRT extension into an obstacle).
         if not (self._point_uncounted(bx, by) and self._point_uncounted(ax, ay)):
             return False
-        hits = self.packed.segment_hits_many
-        a2, b2 = (ax, ay), (bx, by)
-        found = self.coarse.segment_candidates(
-            ax, ay, bx, by, on_blocker=lambda k: bool(hits(np.array([k]), a2, b2)[0]))
+        one = self.packed.segment_hits_xy
+        found = self.coarse.segment_candidates(ax, ay, bx, by, on_blocker=lambda k: one(k, ax, ay, bx, by))
         if found is None:
             self.checks["exact_segments"] += 1
             return False
@@ -522,8 +542,11 @@ class CSpace:
         if not cands:
             return True  # blockers, if any, were each tested (and missed) as they were found
         self.checks["exact_segments"] += 1
-        cands -= blockers
-        return not (cands and hits(np.fromiter(cands, np.int64, len(cands)), a2, b2).any())
+        cands -= blockers  # each candidate tested once: scalars for a few, numpy for many
+        if len(cands) <= 8:
+            return not any(one(k, ax, ay, bx, by) for k in sorted(cands))
+        hits = self.packed.segment_hits_many
+        return not hits(np.fromiter(cands, np.int64, len(cands)), (ax, ay), (bx, by)).any()
 
     def _segments_free(self, s) -> np.ndarray:
         """:meth:`segment_free` of an (N, 2, 2) batch, each segment by the exact scalar test."""

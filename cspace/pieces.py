@@ -56,6 +56,31 @@ class PieceSet:
             px, py = qx, qy
         return True
 
+    def segment_hits_xy(self, k: int, ax: float, ay: float, bx: float, by: float) -> bool:
+        """Does closed segment a-b meet closed piece k? Exact, in scalars: the same
+        separating axes as :meth:`segment_hits_many`, cheaper for a few pieces (no numpy
+        call overhead), stopping at the first separating axis.
+
+        >>> PieceSet([np.array([[0., 0], [2, 0], [2, 2], [0, 2]])]).segment_hits_xy(0, 3.0, 0.0, 2.0, 2.0)
+        True
+        """
+        pts = self._lists[k]
+        px, py = pts[-1]
+        for qx, qy in pts:  # an edge with both ends strictly outside it
+            if orient2d_xy(px, py, qx, qy, ax, ay) < 0 and orient2d_xy(px, py, qx, qy, bx, by) < 0:
+                return False
+            px, py = qx, qy
+        if ax == bx and ay == by:
+            return True  # a point: the piece's edges are the only axes
+        left = right = True  # the segment's line with every vertex strictly on one side
+        for qx, qy in pts:
+            s = orient2d_xy(ax, ay, bx, by, qx, qy)
+            left = left and s > 0
+            right = right and s < 0
+            if not (left or right):
+                return True
+        return False
+
     def segment_hits(self, k: int, a, b) -> bool:
         """Does closed segment a-b meet closed piece k? Exact."""
         return bool(self.segment_hits_many(np.array([k]), a, b)[0])

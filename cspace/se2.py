@@ -29,6 +29,7 @@ import time
 
 import numpy as np
 
+from . import fastpath
 from .broadphase import GridIndex
 from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
 from .minkowski import minkowski_sum, reflect
@@ -103,6 +104,8 @@ class SE2CSpace(SE2Motions, CarMotions):
         self._robot_lists = [p.tolist() for p in self.robot_pieces]
         self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
         self._pair_grid()
+        self._fast = fastpath.se2_handle(self)  # the compiled filter stage (None: pure path)
+        self._fast_pose = None if self._fast is None else fastpath._fast.se2_pose
         self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
                        "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0,
                        "curves": 0, "arcs": 0, "arc_sweeps": 0}
@@ -196,6 +199,7 @@ class SE2CSpace(SE2Motions, CarMotions):
                 return True  # free in the slab: free at every angle of it
             return exact(x, y, th, k)
 
+        slow = fastpath.se2_slow_test(outer._fast, self._fast, slow, self.checks)  # compiled, if built
         return rows, g.inv_w, g.x0 * g.inv_w, g.inv_h, g.y0 * g.inv_h, slow
 
     def _slab_index(self, th: float) -> int:
@@ -280,6 +284,10 @@ class SE2CSpace(SE2Motions, CarMotions):
         if not self.in_bounds(x, y):
             return False
         c, sn = math.cos(th), math.sin(th)
+        if self._fast is not None:  # compiled: the same filter, certified answers only
+            r = self._fast_pose(self._fast, x, y, c, sn)
+            if r >= 0:
+                return r == 1
         rotated: dict = {}
         margin = self.pad
         for i, j, o_edges, o_pts, r_normals, bx0, by0, bx1, by1 in self._cell_pairs(k, x, y):

@@ -187,6 +187,7 @@ def _validator_class():
             def __init__(self, si, cspace, k: int = 0):
                 super().__init__(si)
                 self.segment_free = cspace.segment_free
+                self.segment = cspace.segment_test()  # four floats: no tuples per motion
                 self.k = k
 
             def checkMotion(self, s1, s2, *rest):
@@ -195,7 +196,7 @@ def _validator_class():
                     ok = self.segment_free((math.ldexp(s1[0], k), math.ldexp(s1[1], k)),
                                            (math.ldexp(s2[0], k), math.ldexp(s2[1], k)))
                 else:
-                    ok = self.segment_free((s1[0], s1[1]), (s2[0], s2[1]))
+                    ok = self.segment(s1[0], s1[1], s2[0], s2[1])
                 if rest and not ok:  # the (s1, s2, lastValid) form: report no progress
                     with contextlib.suppress(Exception):
                         rest[0].second = 0.0

@@ -1,0 +1,189 @@
+"""The compiled fast path (cspace/_fast.c) against the pure-Python path, its oracle.
+
+Every answer the C routines give must be the exact one: on random and degenerate
+queries (integer scenes, segments through vertices and along edges, zero-length
+segments, points on boundaries) the compiled segment and point tests, where they
+decide, agree with the pure path, and the public segment test agrees everywhere.
+Skipped when the extension is not built (or CSPACE_PURE=1): then there is one path.
+"""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cspace import CSpace, fastpath
+from cspace.predicates import orient2d_exact
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+needs_c = pytest.mark.skipif(not fastpath.ENABLED, reason="compiled fast path not built (or CSPACE_PURE=1)")
+
+
+def _integer_scene(seed: int) -> CSpace:
+    """Integer boxes and triangles with an integer robot: every C-obstacle vertex is an
+    integer, so queries on integers touch edges and vertices exactly."""
+    rng = np.random.default_rng(seed)
+    obstacles = []
+    for _ in range(int(rng.integers(1, 7))):
+        x, y = rng.integers(0, 10, 2)
+        w, h = rng.integers(1, 4, 2)
+        if rng.random() < 0.5:
+            obstacles.append(np.array([[x, y], [x + w, y], [x + w, y + h], [x, y + h]], dtype=float))
+        else:
+            obstacles.append(np.array([[x, y], [x + w, y], [x, y + h]], dtype=float))
+    robot = [np.array([[0., 0], [1, 0], [0, 1]])] if seed % 2 else None
+    return CSpace((0, 12, 0, 12), obstacles, robot, grid_cells=int(rng.choice([16, 64, 1024])))
+
+
+_SCENES = {}
+
+
+def scene(seed: int) -> CSpace:
+    if seed not in _SCENES:
+        _SCENES[seed] = _integer_scene(seed)
+    return _SCENES[seed]
+
+
+coord = st.one_of(st.integers(-1, 13).map(float), st.integers(-2, 26).map(lambda v: v / 2.0),
+                  st.floats(-0.5, 12.5, allow_nan=False))
+
+
+@needs_c
+@settings(max_examples=400, deadline=None)
+@given(st.integers(0, 11), coord, coord, coord, coord)
+def test_segment_matches_pure(seed, ax, ay, bx, by):
+    cs = scene(seed)
+    want = cs._segment_pure(ax, ay, bx, by)
+    r = fastpath._fast.segment(cs._fast, ax, ay, bx, by)
+    if r >= 0:
+        assert (r != 0) == want
+    assert cs.segment_test()(ax, ay, bx, by) == want
+    assert cs.segment_free((ax, ay), (bx, by)) == want
+
+
+@needs_c
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 11), coord, coord)
+def test_point_matches_pure(seed, x, y):
+    cs = scene(seed)
+    want = cs._is_free_exact(x, y)
+    r = fastpath._fast.point(cs._fast, x, y)
+    if r >= 0:
+        assert (r == 1) == want
+    r = fastpath._fast.segment(cs._fast, x, y, x, y)  # a segment of length zero
+    if r >= 0:
+        assert (r != 0) == want
+
+
+@needs_c
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.one_of(st.integers(-4, 4).map(float), st.floats(-1e3, 1e3, allow_nan=False),
+                          st.sampled_from([1e-300, -1e-300, 1e300, 0.1, 0.3, 2.0**-60])), min_size=6, max_size=6))
+def test_orient_filter_certified(v):
+    s = fastpath._fast.orient(*v)
+    if s != 2:
+        assert s == orient2d_exact(*v)
+
+
+@needs_c
+def test_random_polygons_motions_match():
+    """Float scene (the bundled random_polygons): 3000 random motions, short and long."""
+    cs = CSpace.from_scenario(os.path.join(ROOT, "scenarios", "random_polygons.toml"))
+    xmin, xmax, ymin, ymax = cs.bounds
+    rng = np.random.default_rng(1)
+    fast = cs.segment_test()
+    for _ in range(3000):
+        a = rng.uniform((xmin, ymin), (xmax, ymax))
+        b = a + rng.normal(size=2) * (xmax - xmin) * rng.choice([0.01, 0.1, 0.5])
+        b = np.clip(b, (xmin, ymin), (xmax, ymax))
+        args = (float(a[0]), float(a[1]), float(b[0]), float(b[1]))
+        assert fast(*args) == cs._segment_pure(*args), args
+
+
+@needs_c
+def test_nonfinite_and_out_of_bounds_go_to_python():
+    cs = scene(0)
+    assert fastpath._fast.segment(cs._fast, float("nan"), 1.0, 2.0, 2.0) == -1
+    assert fastpath._fast.segment(cs._fast, -1.0, 1.0, 2.0, 2.0) == -1
+    with pytest.raises(ValueError):
+        cs.segment_free((float("nan"), 1.0), (2.0, 2.0))
+    assert cs.segment_free((-1.0, 1.0), (2.0, 2.0)) is False
+
+
+def test_cspace_pure_forces_the_pure_path():
+    env = dict(os.environ, CSPACE_PURE="1")
+    out = subprocess.run([sys.executable, "-c", "import cspace.fastpath as f; print(f.ENABLED)"],
+                         env=env, capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.strip() == "False"
+
+
+# ---------------------------------------------------------------- SE(2)
+
+def _se2_pair(seed: int):
+    """The same integer SE(2) scene twice: compiled, and pure (every slab built pure)."""
+    from cspace import SE2CSpace
+
+    rng = np.random.default_rng(100 + seed)
+    obstacles = []
+    for _ in range(int(rng.integers(1, 6))):
+        x, y = rng.integers(0, 10, 2)
+        w, h = rng.integers(1, 4, 2)
+        obstacles.append(np.array([[x, y], [x + w, y], [x + w, y + h], [x, y + h]], dtype=float))
+    robot = [np.array([[-2., -0.5], [2, -0.5], [2, 0.5], [-2, 0.5]])] if seed % 2 else \
+        [np.array([[0., 0], [2, 0], [2, 1]]), np.array([[0., 0], [2, 1], [0, 2]])]
+    fast = SE2CSpace((0, 12, 0, 12), obstacles, robot, slabs=8)
+    with fastpath.disabled():
+        pure = SE2CSpace((0, 12, 0, 12), obstacles, robot, slabs=8)
+        for k in range(pure.slabs):
+            pure.slab(k)
+    return fast, pure
+
+
+_SE2 = {}
+
+
+def se2_pair(seed: int):
+    if seed not in _SE2:
+        _SE2[seed] = _se2_pair(seed)
+    return _SE2[seed]
+
+
+angle = st.one_of(st.sampled_from([0.0, -np.pi, np.pi / 2, -np.pi / 2, 1.0]), st.floats(-np.pi, np.pi - 1e-9))
+
+
+@needs_c
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 3), coord, coord, angle)
+def test_se2_pose_matches_pure(seed, x, y, th):
+    fast, pure = se2_pair(seed)
+    assert fast._fast is not None and pure._fast is None
+    assert fast.is_free((x, y, th)) == pure.is_free((x, y, th))
+
+
+@needs_c
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 3), coord, coord, angle, coord, coord, angle)
+def test_se2_motion_matches_pure(seed, x0, y0, a0, x1, y1, a1):
+    fast, pure = se2_pair(seed)
+    assert fast.motion_free((x0, y0, a0), (x1, y1, a1)) == pure.motion_free((x0, y0, a0), (x1, y1, a1))
+
+
+@needs_c
+def test_se2_bundled_scene_matches_pure():
+    """A float SE(2) scene (the bundled car maze, 8 slabs): 3000 random poses."""
+    from cspace import SE2CSpace, load_scenario
+
+    sc = load_scenario(os.path.join(ROOT, "scenarios", "se2", "car_maze.toml"))
+    fast = SE2CSpace.from_scenario(sc, slabs=8)
+    with fastpath.disabled():
+        pure = SE2CSpace.from_scenario(sc, slabs=8)
+        for k in range(pure.slabs):
+            pure.slab(k)
+    xmin, xmax, ymin, ymax = sc.bounds
+    rng = np.random.default_rng(2)
+    f, g = fast.pose_test(), pure.pose_test()
+    for x, y, th in rng.uniform((xmin, ymin, -np.pi), (xmax, ymax, np.pi), (3000, 3)).tolist():
+        assert f(x, y, th) == g(x, y, th), (x, y, th)
