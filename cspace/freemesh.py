@@ -33,18 +33,33 @@ class MeshError(ValueError):
     """GEOS's triangulation failed an exact check (the caller falls back)."""
 
 
-def _clean_ring(c: np.ndarray, shared: set) -> np.ndarray:
-    """Ring ``c`` (no closing repeat) without its flat vertices (exactly collinear with
-    both neighbours and between them) that no other ring touches."""
-    a, b = np.roll(c, 1, axis=0), np.roll(c, -1, axis=0)
-    turn = orient2d_cols(a[:, 0], a[:, 1], c[:, 0], c[:, 1], b[:, 0], b[:, 1])
-    # Between its neighbours: the steps a -> c and c -> b point the same way (signs of
-    # float differences are exact).
-    ahead = (np.sign(c - a) == np.sign(b - c)).all(axis=1)
-    flat = (turn == 0) & ahead
-    if flat.any() and shared:
-        flat &= np.array([tuple(v) not in shared for v in c.tolist()])
-    return c[~flat]
+def ring_turns(region) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """All ring vertices of a polygon at once: ``(C, prev, nxt, turn, ring)``: the
+    vertices (shell, then holes; no closing repeats), each one's ring neighbours as
+    indices into C, the exact turn prev -> v -> next (+1 left, -1 right, 0 straight)
+    and the ring index.
+
+    >>> C, prev, nxt, turn, ring = ring_turns(__import__("shapely").box(0, 0, 1, 1))
+    >>> len(C), turn.tolist()
+    (4, [1, 1, 1, 1])
+    """
+    import shapely
+
+    xy, idx = shapely.get_coordinates(shapely.get_rings(region), return_index=True)
+    sizes = np.bincount(idx)
+    ends = np.cumsum(sizes)
+    keep = np.ones(len(xy), dtype=bool)
+    keep[ends - 1] = False  # the closing repeats
+    C = xy[keep]
+    ring = idx[keep]
+    n = sizes - 1
+    first = np.repeat(ends - sizes - np.arange(len(sizes)), n)  # each ring's first index in C
+    pos = np.arange(len(C)) - first
+    nn = np.repeat(n, n)
+    prev = first + (pos - 1) % nn
+    nxt = first + (pos + 1) % nn
+    turn = orient2d_cols(C[prev, 0], C[prev, 1], C[:, 0], C[:, 1], C[nxt, 0], C[nxt, 1])
+    return C, prev, nxt, turn, ring
 
 
 class FreeMesh:
@@ -63,39 +78,52 @@ class FreeMesh:
     def __init__(self, region):
         import shapely
 
-        rings = [region.exterior] + list(region.interiors)
-        raw = [np.asarray(r.coords)[:-1, :2] for r in rings]
-        seen: dict = {}
-        for c in raw:
-            for v in c.tolist():
-                seen[tuple(v)] = seen.get(tuple(v), 0) + 1
-        shared = {v for v, n in seen.items() if n > 1}
-        clean = [_clean_ring(c, shared) for c in raw]
-        if any(len(c) < 3 for c in clean):
+        C, prev, nxt, turn, ring = ring_turns(region)
+        # Flat: collinear with both neighbours and between them (the steps prev -> v and
+        # v -> next point the same way; signs of float differences are exact), and no
+        # other ring touches it.
+        flat = (turn == 0) & (np.sign(C - C[prev]) == np.sign(C[nxt] - C)).all(axis=1)
+        if flat.any():
+            order = np.lexsort((C[:, 1], C[:, 0]))
+            dup = np.zeros(len(C), dtype=bool)
+            same = (C[order[1:]] == C[order[:-1]]).all(axis=1)
+            dup[order[1:][same]] = True
+            dup[order[:-1][same]] = True
+            flat &= ~dup
+        C, ring = C[~flat], ring[~flat]
+        sizes = np.bincount(ring, minlength=int(ring.max()) + 1)
+        if (sizes < 3).any():
             raise MeshError("a ring of F has fewer than 3 corners")
-        self.rings = clean
-        poly = shapely.Polygon(np.vstack([clean[0], clean[0][:1]]),
-                               [np.vstack([c, c[:1]]) for c in clean[1:]])
+        starts = np.cumsum(sizes) - sizes
+        nxt = np.arange(len(C)) + 1
+        nxt[starts + sizes - 1] = starts  # each ring closes on itself
+        if flat.any():
+            clean = np.split(C, starts[1:])
+            poly = shapely.Polygon(np.vstack([clean[0], clean[0][:1]]), [np.vstack([c, c[:1]]) for c in clean[1:]])
+        else:
+            poly = region
         tris = shapely.get_parts(shapely.constrained_delaunay_triangles(poly))
         coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3]
         ident: dict = {}
-        for c in clean:
-            for v in c.tolist():
-                ident.setdefault(tuple(v), len(ident))
-        nv = len(ident)
+        for v in map(tuple, C.tolist()):
+            ident.setdefault(v, len(ident))  # a point where rings touch gets one id
+        vid = np.array([ident[v] for v in map(tuple, C.tolist())], dtype=np.int64)
         try:
             tv = np.array([ident[v] for v in map(tuple, coords.reshape(-1, 2).tolist())], dtype=np.int64).reshape(-1, 3)
         except KeyError:
             raise MeshError("the triangulation added a vertex") from None
-        xy = np.empty((nv, 2))
-        xy[list(ident.values())] = list(ident.keys())
+        xy = np.empty((len(ident), 2))
+        xy[vid] = C
         self.x, self.y = xy[:, 0].tolist(), xy[:, 1].tolist()
         # Integer coordinates up to 2^25: every orientation determinant is exact in floats.
         self.small_int = bool((xy == np.floor(xy)).all() and (np.abs(xy) <= 2.0**25).all())
         self.xy = xy
-        self._check_and_link(tv, clean, ident, float(poly.area))
+        self.id = ident
+        self._check_and_link(tv, vid * len(xy) + vid[nxt], float(poly.area))
 
-    def _check_and_link(self, tv: np.ndarray, rings: list, ident: dict, area: float) -> None:
+    def _check_and_link(self, tv: np.ndarray, ring_key: np.ndarray, area: float) -> None:
+        """The exact checks (see the module notes), then the neighbour tables.
+        ``ring_key``: F's ring edges a -> b as ``id(a) * nv + id(b)``."""
         xy = self.xy
         P = xy[tv]
         s = orient2d_cols(P[:, 0, 0], P[:, 0, 1], P[:, 1, 0], P[:, 1, 1], P[:, 2, 0], P[:, 2, 1])
@@ -118,9 +146,6 @@ class FreeMesh:
         nbr = np.where(has, order[pos] // 3, -1)
         # Local index of the far vertex in the neighbour: the edge slot of the twin.
         nbk = np.where(has, order[pos] % 3, -1)
-        ring_key = np.concatenate([np.array([ident[tuple(v)] for v in c.tolist()], dtype=np.int64) * nv
-                                   + np.array([ident[tuple(v)] for v in np.roll(c, -1, axis=0).tolist()],
-                                              dtype=np.int64) for c in rings])
         bound = np.sort(key[~has])
         if len(bound) != len(ring_key) or (bound != np.sort(ring_key)).any():
             raise MeshError("the triangles' boundary is not F's boundary")
@@ -134,12 +159,22 @@ class FreeMesh:
         self.nbr = nbr.tolist()
         self.nbk = nbk.tolist()
         self.ntri = T
-        # The triangles around each vertex (all fans of a point where rings touch).
-        fan: list = [[] for _ in range(nv)]
-        for t3, v in enumerate(self.tri):
-            fan[v].append(t3)
-        self.fan = fan  # entries 3t + k: triangle t, the vertex at local index k
-        self.id = ident
+        # The triangles around each vertex (all fans of a point where rings touch), as
+        # entries 3t + k: triangle t, the vertex at local index k.
+        flat_tv = tv.ravel()
+        by_vertex = np.argsort(flat_tv, kind="stable")
+        cuts = np.searchsorted(flat_tv[by_vertex], np.arange(nv + 1))
+        self._fan_order, self._fan_cuts = by_vertex.tolist(), cuts.tolist()
+
+    def fan(self, v: int) -> list[int]:
+        """Entries 3t + k of the triangles around vertex v (k: v's local index in t).
+
+        >>> import shapely
+        >>> m = FreeMesh(shapely.Polygon([(0, 0), (2, 0), (2, 2), (0, 2)]))
+        >>> sorted(len(m.fan(v)) for v in range(4))
+        [1, 1, 2, 2]
+        """
+        return self._fan_order[self._fan_cuts[v]:self._fan_cuts[v + 1]]
 
     def locate(self, px: float, py: float) -> list[int]:
         """Triangles whose closure holds (px, py), exactly (empty when outside F).

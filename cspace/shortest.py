@@ -219,6 +219,14 @@ def _scene(pieces: list, bounds: tuple) -> _Scene:
     return _LAST[0][1]
 
 
+def clear_cache() -> None:
+    """Forget the last scene's F and mesh (benchmarks time the preparation with it).
+
+    >>> clear_cache()
+    """
+    _LAST.clear()
+
+
 def _point(p, what: str) -> tuple[float, float]:
     """(x, y) as two finite floats, else ValueError (NaN and inf never reach the search)."""
     from .polygon import as_point
@@ -236,21 +244,13 @@ def _reflex_vertices(region) -> tuple[list, list]:
     a -> v -> b means F's interior angle at v exceeds pi: an obstacle corner the
     shortest path can wrap around. The neighbours are kept for the tangency test.
     """
-    from .predicates import orient2d_cols
+    from .freemesh import ring_turns
 
-    nodes: list = []
-    nbrs: list = []
-    rings = [region.exterior] + list(region.interiors)
-    for ring in rings:
-        c = np.asarray(ring.coords)[:-1, :2]
-        if len(c) < 3:
-            continue
-        a, b = np.roll(c, 1, axis=0), np.roll(c, -1, axis=0)
-        turn = orient2d_cols(a[:, 0], a[:, 1], c[:, 0], c[:, 1], b[:, 0], b[:, 1])
-        # Exterior rings of F are CCW and holes CW (orient_polygons), so F is on the left.
-        for k in np.flatnonzero(turn < 0):
-            nodes.append((float(c[k, 0]), float(c[k, 1])))
-            nbrs.append((a[k], b[k]))
+    C, prev, nxt, turn, _ = ring_turns(region)
+    # Exterior rings of F are CCW and holes CW (orient_polygons), so F is on the left.
+    k = np.flatnonzero(turn < 0)
+    nodes = [tuple(v) for v in C[k].tolist()]
+    nbrs = list(zip(map(tuple, C[prev[k]].tolist()), map(tuple, C[nxt[k]].tolist())))
     return nodes, nbrs
 
 

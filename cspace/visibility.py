@@ -213,7 +213,7 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
     says why a search ended early.
     """
     n = len(pts)
-    P = [(float(x), float(y)) for x, y in pts]
+    P = [tuple(v) for v in pts.tolist()]
     gx, gy = P[1]
     h = [math.hypot(x - gx, y - gy) for x, y in P]
     at: dict = {}  # mesh vertex -> nodes there (a point where rings touch has several)
@@ -254,7 +254,7 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
             starts, wedges = [3 * t for t in start_tris], None
         else:
             (ax, ay), (bx, by) = nbrs[v - 2]
-            starts, wedges = mesh.fan[mesh.id[P[v]]], tangent_wedges(vx, vy, float(ax), float(ay), float(bx), float(by))
+            starts, wedges = mesh.fan(mesh.id[P[v]]), tangent_wedges(vx, vy, float(ax), float(ay), float(bx), float(by))
         seen, goal_seen, visited = visible_from(mesh, vx, vy, starts, wedges, is_node, P[1], goal_tris)
         counts["triangles_visited"] += visited
         cand = [w for q in seen for w in at[q] if not closed[w]]
