@@ -62,6 +62,31 @@ def ring_turns(region) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, 
     return C, prev, nxt, turn, ring
 
 
+def _triangulate(poly) -> np.ndarray:
+    """GEOS's constrained triangulation as (T, 3, 2) corners. GEOS's ear clipper can fail
+    on a valid polygon with many holes ("Unable to find a convex corner") depending on
+    where its rings start: the same polygon is then retried normalised, then with every
+    ring started one vertex later (deterministic; the result is checked exactly anyway)."""
+    import shapely
+
+    def rotated(p):
+        def r(c):
+            c = np.asarray(c.coords)[:-1]
+            c = np.roll(c, -1, axis=0)
+            return np.vstack([c, c[:1]])
+        return shapely.Polygon(r(p.exterior), [r(h) for h in p.interiors])
+
+    err = None
+    for attempt in (lambda: poly, lambda: shapely.normalize(poly), lambda: rotated(poly)):
+        try:
+            tris = shapely.get_parts(shapely.constrained_delaunay_triangles(attempt()))
+        except shapely.errors.GEOSException as exc:
+            err = exc
+            continue
+        return shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3]
+    raise MeshError(f"GEOS could not triangulate F ({err})")
+
+
 class FreeMesh:
     """An exactly verified triangulation of the free polygon ``region`` (shapely).
 
@@ -90,6 +115,10 @@ class FreeMesh:
             dup[order[1:][same]] = True
             dup[order[:-1][same]] = True
             flat &= ~dup
+        # Integer coordinates up to 2^25 on every ring (the dropped flat vertices too: they
+        # are the corners' ring neighbours in the tangency tests): every orientation
+        # determinant of them is exact in floats.
+        self.small_int = bool((C == np.floor(C)).all() and (np.abs(C) <= 2.0**25).all())
         C, ring = C[~flat], ring[~flat]
         sizes = np.bincount(ring, minlength=int(ring.max()) + 1)
         if (sizes < 3).any():
@@ -102,8 +131,7 @@ class FreeMesh:
             poly = shapely.Polygon(np.vstack([clean[0], clean[0][:1]]), [np.vstack([c, c[:1]]) for c in clean[1:]])
         else:
             poly = region
-        tris = shapely.get_parts(shapely.constrained_delaunay_triangles(poly))
-        coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3]
+        coords = _triangulate(poly)
         ident: dict = {}
         for v in map(tuple, C.tolist()):
             ident.setdefault(v, len(ident))  # a point where rings touch gets one id
@@ -115,8 +143,6 @@ class FreeMesh:
         xy = np.empty((len(ident), 2))
         xy[vid] = C
         self.x, self.y = xy[:, 0].tolist(), xy[:, 1].tolist()
-        # Integer coordinates up to 2^25: every orientation determinant is exact in floats.
-        self.small_int = bool((xy == np.floor(xy)).all() and (np.abs(xy) <= 2.0**25).all())
         self.xy = xy
         self.id = ident
         self._check_and_link(tv, vid * len(xy) + vid[nxt], float(poly.area))

@@ -56,7 +56,13 @@ def _orient(px: float, py: float, ax: float, ay: float, bx: float, by: float) ->
     return orient2d_xy(px, py, ax, ay, bx, by)
 
 
-def _meet(px, py, c1, c2):
+def _orient_int(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> int:
+    """orient(P, A, B) when every coordinate is an integer of magnitude <= 2^25: exact in floats."""
+    d = (ax - px) * (by - py) - (ay - py) * (bx - px)
+    return (d > 0) - (d < 0)
+
+
+def _meet(px, py, c1, c2, o=_orient):
     """The intersection of two closed cones at P (each under pi), or None when empty.
 
     A cone is ``(rx, ry, rs, lx, ly, ls)``: its right side along rs·(R − P), its left
@@ -64,28 +70,27 @@ def _meet(px, py, c1, c2):
     one cone that lies in the other; likewise the left.
     """
     r = None
-    if _dir_in(px, py, c1[0], c1[1], c1[2], c2):
+    if _dir_in(px, py, c1[0], c1[1], c1[2], c2, o):
         r = c1[:3]
-    elif _dir_in(px, py, c2[0], c2[1], c2[2], c1):
+    elif _dir_in(px, py, c2[0], c2[1], c2[2], c1, o):
         r = c2[:3]
     if r is None:
         return None
-    if _dir_in(px, py, c1[3], c1[4], c1[5], c2):
+    if _dir_in(px, py, c1[3], c1[4], c1[5], c2, o):
         return r + c1[3:]
-    if _dir_in(px, py, c2[3], c2[4], c2[5], c1):
+    if _dir_in(px, py, c2[3], c2[4], c2[5], c1, o):
         return r + c2[3:]
     return None
 
 
-def _dir_in(px, py, x, y, s, c) -> bool:
+def _dir_in(px, py, x, y, s, c, o=_orient) -> bool:
     """Is the direction s·((x, y) − P) in the closed cone c?"""
-    return (s * c[2] * _orient(px, py, c[0], c[1], x, y) >= 0
-            and s * c[5] * _orient(px, py, x, y, c[3], c[4]) >= 0)
+    return s * c[2] * o(px, py, c[0], c[1], x, y) >= 0 and s * c[5] * o(px, py, x, y, c[3], c[4]) >= 0
 
 
-def _width(px, py, c) -> int:
+def _width(px, py, c, o=_orient) -> int:
     """Sign of the cone's opening (0: a single ray)."""
-    return c[2] * c[5] * _orient(px, py, c[0], c[1], c[3], c[4])
+    return c[2] * c[5] * o(px, py, c[0], c[1], c[3], c[4])
 
 
 def visible_from(mesh, px: float, py: float, starts: list, wedges: list | None,
@@ -105,7 +110,8 @@ def visible_from(mesh, px: float, py: float, starts: list, wedges: list | None,
     [(0.0, 0.0), (0.0, 4.0), (1.0, 1.0), (1.0, 3.0)]
     """
     X, Y, tri, nbr, nbk = mesh.x, mesh.y, mesh.tri, mesh.nbr, mesh.nbk
-    o = _orient
+    exact = mesh.small_int and _small_int(px, py)
+    o = _orient_int if exact else _orient  # (for the goal, which may be off the integers: _orient)
     seen: set = set()
     goal_seen = False
     gx, gy = goal if goal is not None else (0.0, 0.0)
@@ -118,23 +124,23 @@ def visible_from(mesh, px: float, py: float, starts: list, wedges: list | None,
         if (X[tri[e]], Y[tri[e]]) == (px, py):
             windows = [k]  # P is the vertex k: the one window is the opposite edge
         else:  # inside t or on an edge of it: every edge P is not on
-            windows = [j for j, (u, w) in enumerate(((v1, v2), (v2, v0), (v0, v1))) if o(X[u], Y[u], X[w], Y[w], px, py) > 0]
+            windows = [j for j, (u, w) in enumerate(((v1, v2), (v2, v0), (v0, v1))) if o(px, py, X[u], Y[u], X[w], Y[w]) > 0]
         visited += 1
         for j in windows:
             u, w = tri[b + (j + 1) % 3], tri[b + (j + 2) % 3]
             cone = (X[u], Y[u], 1, X[w], Y[w], 1)  # from P, u is on the right, w on the left
             for wedge in (wedges or (None,)):
-                c = cone if wedge is None else _meet(px, py, cone, wedge)
+                c = cone if wedge is None else _meet(px, py, cone, wedge, o)
                 if c is None:
                     continue
                 for q in (u, w):
-                    if is_node[q] and q not in seen and _pt_in(px, py, X[q], Y[q], c):
+                    if is_node[q] and q not in seen and _pt_in(px, py, X[q], Y[q], c, o):
                         seen.add(q)
-                if goal is not None and t in goal_tris and not goal_seen and _pt_in(px, py, gx, gy, c):
+                if goal is not None and t in goal_tris and not goal_seen and _pt_in(px, py, gx, gy, c, _orient):
                     goal_seen = True
-                if nbr[b + j] >= 0 and _width(px, py, c) > 0:
+                if nbr[b + j] >= 0 and _width(px, py, c, o) > 0:
                     stack.append((nbr[b + j], nbk[b + j]) + c)
-    err, tiny, exact = CCW_ERRBOUND_A, _TINY, mesh.small_int and _small_int(px, py)
+    err, tiny = CCW_ERRBOUND_A, _TINY
     while stack:
         t, k, rx, ry, rs, lx, ly, ls = stack.pop()
         visited += 1
@@ -169,7 +175,7 @@ def visible_from(mesh, px: float, py: float, starts: list, wedges: list | None,
         if zr >= 0 and zl >= 0 and is_node[z]:
             seen.add(z)
         if goal is not None and t in goal_tris and not goal_seen:
-            if rs * o(px, py, rx, ry, gx, gy) >= 0 and ls * o(px, py, gx, gy, lx, ly) >= 0:
+            if rs * _orient(px, py, rx, ry, gx, gy) >= 0 and ls * _orient(px, py, gx, gy, lx, ly) >= 0:
                 goal_seen = True
         # The window entered is the edge opposite z, u (left) -> w (right) as seen from P;
         # (w, z) is the edge opposite u (slot k+1), (z, u) the edge opposite w (slot k+2).
@@ -188,9 +194,9 @@ def visible_from(mesh, px: float, py: float, starts: list, wedges: list | None,
     return list(seen), goal_seen, visited
 
 
-def _pt_in(px, py, qx, qy, c) -> bool:
+def _pt_in(px, py, qx, qy, c, o=_orient) -> bool:
     """Is the point Q in the closed cone c at P?"""
-    return c[2] * _orient(px, py, c[0], c[1], qx, qy) >= 0 and c[5] * _orient(px, py, qx, qy, c[3], c[4]) >= 0
+    return c[2] * o(px, py, c[0], c[1], qx, qy) >= 0 and c[5] * o(px, py, qx, qy, c[3], c[4]) >= 0
 
 
 def tangent_wedges(vx: float, vy: float, ax: float, ay: float, bx: float, by: float) -> list:
@@ -254,7 +260,8 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
             starts, wedges = [3 * t for t in start_tris], None
         else:
             (ax, ay), (bx, by) = nbrs[v - 2]
-            starts, wedges = mesh.fan(mesh.id[P[v]]), tangent_wedges(vx, vy, float(ax), float(ay), float(bx), float(by))
+            starts, wedges = mesh.fan(mesh.id[P[v]]), tangent_wedges(vx, vy, ax, ay, bx, by)
+        o = _orient_int if mesh.small_int and _small_int(vx, vy) else _orient
         seen, goal_seen, visited = visible_from(mesh, vx, vy, starts, wedges, is_node, P[1], goal_tris)
         counts["triangles_visited"] += visited
         cand = [w for q in seen for w in at[q] if not closed[w]]
@@ -264,7 +271,7 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
             wx, wy = P[w]
             if w >= 2:  # tangent at the far end too: w's ring neighbours weakly on one side
                 (ax, ay), (bx, by) = nbrs[w - 2]
-                if _orient(vx, vy, wx, wy, float(ax), float(ay)) * _orient(vx, vy, wx, wy, float(bx), float(by)) < 0:
+                if o(vx, vy, wx, wy, ax, ay) * o(vx, vy, wx, wy, bx, by) < 0:
                     continue
             gw = gv + math.hypot(wx - vx, wy - vy)
             counts["edges_found"] += 1

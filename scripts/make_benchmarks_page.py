@@ -27,7 +27,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # Scripts the page expects; others found in scripts/ are run too.
-EXPECTED = ("bench_minkowski", "bench_gjk", "bench_scaling", "bench_cspace", "bench_direct")
+EXPECTED = ("bench_minkowski", "bench_gjk", "bench_scaling", "bench_cspace", "bench_direct", "bench_shortest")
 # Small arguments for scripts without a --quick mode (their defaults take minutes).
 QUICK_ARGS = {
     "bench_minkowski": ["--sizes", "8,64,1024"],
@@ -245,6 +245,62 @@ def render(records: list[dict], missing: list[str], work: str) -> str:
     return "\n".join(lines)
 
 
+def splice(old: str, new: str, names: list[str]) -> str:
+    r"""The page ``old`` with the sections ``names`` taken from the page ``new`` (replaced
+    in place, or added before "Not yet run"), their commands added to the Reproduce block
+    and their names dropped from "Not yet run"; every other section is kept as it was.
+
+    >>> old = "# B\n\n```sh\nrun all\n```\n\n## a\n\nA1\n\n## Not yet run\n\n- `scripts/b.py`: x\n"
+    >>> new = "# B\n\n```sh\nrun all\npython scripts/b.py\n```\n\n## b\n\nB2\n"
+    >>> print(splice(old, new, ["b"]))
+    # B
+    <BLANKLINE>
+    ```sh
+    run all
+    python scripts/b.py
+    ```
+    <BLANKLINE>
+    ## a
+    <BLANKLINE>
+    A1
+    <BLANKLINE>
+    ## b
+    <BLANKLINE>
+    B2
+    <BLANKLINE>
+    """
+    def sections(text: str) -> list[str]:
+        parts = text.split("\n## ")
+        return [parts[0]] + ["## " + p for p in parts[1:]]
+
+    old_s, new_s = sections(old.rstrip("\n") + "\n"), sections(new.rstrip("\n") + "\n")
+    head = old_s[0]
+    for n in names:
+        sec = next((x for x in new_s[1:] if x.split("\n", 1)[0] == f"## {n}"), None)
+        if sec is None:
+            continue
+        sec = sec.rstrip("\n") + "\n\n"
+        cmd = next((ln for ln in new_s[0].splitlines() if f"{n}.py" in ln), None)
+        if cmd and cmd not in head:
+            head = head.replace("\n```\n", f"\n{cmd}\n```\n", 1)
+        at = next((i for i, x in enumerate(old_s) if x.split("\n", 1)[0] == f"## {n}"), None)
+        if at is not None:
+            old_s[at] = sec
+        else:
+            tail = next((i for i, x in enumerate(old_s) if x.startswith("## Not yet run")), len(old_s))
+            old_s.insert(tail, sec)
+    old_s[0] = head
+    out = []
+    for x in old_s:
+        if x.startswith("## Not yet run"):
+            kept = [ln for ln in x.splitlines() if not any(f"scripts/{n}.py" in ln for n in names)]
+            if not any(ln.startswith("- ") for ln in kept):
+                continue
+            x = "\n".join(kept) + "\n"
+        out.append(x if x.endswith("\n") else x + "\n")
+    return "\n".join(o.rstrip("\n") + "\n" for o in out).rstrip("\n") + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks.md"))
@@ -252,6 +308,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--from", dest="source", help="render from the outputs in this folder, without running")
     ap.add_argument("--only", help="comma-separated bench names to run (e.g. bench_minkowski,cspace_bench)")
     ap.add_argument("--no-planners", action="store_true", help="skip the cspace bench sweep")
+    ap.add_argument("--splice", action="store_true",
+                    help="with --only: replace only those sections of the existing page, keep the others")
     args = ap.parse_args(argv)
     found = {os.path.splitext(os.path.basename(p))[0]: p for p in sorted(glob.glob(os.path.join(ROOT, "scripts", "bench_*.py")))}
     order = [n for n in EXPECTED if n in found] + [n for n in found if n not in EXPECTED]
@@ -283,6 +341,9 @@ def main(argv: list[str] | None = None) -> int:
             records.append(run_planner_sweep(work))
             print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
     text = render(records, missing, work)
+    if args.splice and only and os.path.exists(args.out):
+        with open(args.out) as fh:
+            text = splice(fh.read(), text, [r["name"] for r in records])
     sys.path.insert(0, ROOT)
     from planners.output import write_text
 

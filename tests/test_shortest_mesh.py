@@ -141,3 +141,30 @@ def test_zero_area_pieces_use_the_lazy_search():
         shortest_path([dot], (0, 10, 0, 10), (0, 5), (9, 5), method="mesh")
     with pytest.raises(ValueError, match="method"):
         shortest_path([dot], (0, 10, 0, 10), (0, 5), (9, 5), method="fast")
+
+
+def test_geos_triangulation_errors_are_retried_then_fall_back(monkeypatch):
+    # GEOS's ear clipper fails on some valid polygons depending on where the rings start:
+    # the mesh retries other starts; when every try fails, the lazy search answers.
+    sq = np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]])
+    real = shapely.constrained_delaunay_triangles
+    calls = []
+
+    def flaky(poly):
+        calls.append(1)
+        if len(calls) == 1:
+            raise shapely.errors.GEOSException("IllegalStateException: Unable to find a convex corner")
+        return real(poly)
+
+    monkeypatch.setattr(shapely, "constrained_delaunay_triangles", flaky)
+    sp = shortest_path([sq], (0, 10, 0, 13), (1, 5), (9, 5))
+    assert sp.stats["method"] == "mesh" and len(calls) == 2
+    assert sp.length == pytest.approx(2 + 2 * math.hypot(3, 1))
+
+    def broken(poly):
+        raise shapely.errors.GEOSException("IllegalStateException: Unable to find a convex corner")
+
+    monkeypatch.setattr(shapely, "constrained_delaunay_triangles", broken)
+    sp = shortest_path([sq], (0, 10, 0, 14), (1, 5), (9, 5))
+    assert sp.stats["method"] == "lazy" and "GEOS could not triangulate" in sp.stats["mesh_error"]
+    assert sp.length == pytest.approx(2 + 2 * math.hypot(3, 1))
