@@ -210,6 +210,27 @@ def tangent_wedges(vx: float, vy: float, ax: float, ay: float, bx: float, by: fl
     return [(bx, by, 1, ax, ay, -1), (bx, by, -1, ax, ay, 1)]
 
 
+def taut(vx, vy, px, py, ax, ay, bx, by, wedges: list, o=_orient) -> list:
+    """The tangent wedges at corner v cut to the closed half-plane, beside the line from
+    the parent p through v, that holds the obstacle's corner: a path p -> v -> w that
+    turns away from the corner is shortened by cutting it, so v -> w is on no shortest
+    path to w (whichever optimal parent v has: the argument only uses that p -> v is
+    tangent at v). Straight on (w on the line) is kept.
+
+    >>> # corner of the square [0, 1]^2 at v = (0, 1), reached from p = (-1, 2): only the
+    >>> # down-left wedge wraps the square; the up-right one turns away from it
+    >>> taut(0.0, 1.0, -1.0, 2.0, 0.0, 0.0, 1.0, 1.0, tangent_wedges(0.0, 1.0, 0.0, 0.0, 1.0, 1.0))
+    [(1.0, 1.0, -1, 0.0, 0.0, 1)]
+    """
+    side = o(px, py, vx, vy, ax, ay) or o(px, py, vx, vy, bx, by)  # the corner's side of line p -> v
+    if side == 0:
+        return wedges
+    # Directions d with side * cross(v - p, d) >= 0, a cone of angle pi at v: its right
+    # side along side * (v - p) = -side * (p - v), its left side along side * (p - v).
+    half = (px, py, -side, px, py, side)
+    return [c for c in (_meet(vx, vy, w, half, o) for w in wedges) if c is not None]
+
+
 def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
                on_progress: Callable[[int, int, float], None] | None = None, every: int = 64) -> tuple:
     """A* from node 0 (start) to node 1 (goal) over nodes ``pts`` (then the reflex
@@ -256,12 +277,14 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
         if v == 1:
             break
         vx, vy = P[v]
+        o = _orient_int if mesh.small_int and _small_int(vx, vy) else _orient
         if v == 0:
             starts, wedges = [3 * t for t in start_tris], None
         else:
             (ax, ay), (bx, by) = nbrs[v - 2]
             starts, wedges = mesh.fan(mesh.id[P[v]]), tangent_wedges(vx, vy, ax, ay, bx, by)
-        o = _orient_int if mesh.small_int and _small_int(vx, vy) else _orient
+            px, py = P[parent[v]]
+            wedges = taut(vx, vy, px, py, ax, ay, bx, by, wedges, o)
         seen, goal_seen, visited = visible_from(mesh, vx, vy, starts, wedges, is_node, P[1], goal_tris)
         counts["triangles_visited"] += visited
         cand = [w for q in seen for w in at[q] if not closed[w]]
