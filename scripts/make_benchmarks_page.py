@@ -274,13 +274,16 @@ def splice(old: str, new: str, names: list[str]) -> str:
         return [parts[0]] + ["## " + p for p in parts[1:]]
 
     old_s, new_s = sections(old.rstrip("\n") + "\n"), sections(new.rstrip("\n") + "\n")
-    head = old_s[0]
+    # The commands live in the "Reproduce" section (or, in a page without one, the head).
+    rep = next((i for i, x in enumerate(old_s) if x.startswith("## Reproduce")), 0)
+    head = old_s[rep]
+    new_cmds = "\n".join(x for x in new_s if x.startswith("## Reproduce")) or new_s[0]
     for n in names:
         sec = next((x for x in new_s[1:] if x.split("\n", 1)[0] == f"## {n}"), None)
         if sec is None:
             continue
         sec = sec.rstrip("\n") + "\n\n"
-        cmd = next((ln for ln in new_s[0].splitlines() if f"{n}.py" in ln), None)
+        cmd = next((ln for ln in new_cmds.splitlines() if f"{n}.py" in ln), None)
         if cmd and cmd not in head:
             head = head.replace("\n```\n", f"\n{cmd}\n```\n", 1)
         at = next((i for i, x in enumerate(old_s) if x.split("\n", 1)[0] == f"## {n}"), None)
@@ -289,7 +292,7 @@ def splice(old: str, new: str, names: list[str]) -> str:
         else:
             tail = next((i for i, x in enumerate(old_s) if x.startswith("## Not yet run")), len(old_s))
             old_s.insert(tail, sec)
-    old_s[0] = head
+    old_s[rep] = head
     out = []
     for x in old_s:
         if x.startswith("## Not yet run"):
