@@ -1,4 +1,4 @@
-"""Exact shortest paths for a translating robot: a lazy A* over the reduced visibility graph.
+"""Exact shortest paths for a translating robot: A* over the reduced visibility graph.
 
 The free C-space is F = B − int(∪ C_i): the bounds B minus the interior of the union
 of the C-obstacle pieces. The shortest start–goal path in the closure of F is a
@@ -8,17 +8,17 @@ touches the obstacle at both ends without entering it (Lozano-Pérez & Wesley 19
 Latombe, ch. 4). So the graph has the reflex vertices plus start and goal as nodes
 and the bitangent segments as edges.
 
-Search is lazy A* (Euclidean heuristic, consistent): an edge is only tested for
-visibility when it is popped from the open list, so most of the O(V²) candidate edges
-are never tested. A visibility test is one prepared ``covers`` of F by the segment
-(GEOS, robust predicates), O(log n + k).
-
-Cost: building F is a polygon union, O(N log N) for N piece vertices plus the
-output; the search pushes O(V · V_closed) candidates and tests one segment per pop,
-each test O(log n + k). Scenes with hundreds of reflex vertices, or thousands in open
-space (OMPL's circles), take milliseconds; a maze of thousands of reflex vertices
-where the straight-line heuristic misleads (OMPL's env2: 4647) takes minutes, so a
-``time_limit`` bounds the search and says so when it stops.
+Search (:func:`cspace.visibility.mesh_astar`): A* with the Euclidean heuristic over
+that graph, where a node's edges are computed only when it is settled, by exact
+triangular expansion in a verified constrained triangulation of F
+(:mod:`cspace.freemesh`), inside the node's two tangent wedges. The visibility
+region of a corner in a maze is a few triangles, so OMPL's env2 (4647 reflex
+corners) takes about a second, not minutes. Zero-area pieces (outside F's area) or
+a triangulation that fails its exact checks use the older lazy search
+(:mod:`cspace.shortest_lazy`: every bitangent candidate pushed, each tested with
+GEOS's ``covers`` when popped), which gives the same lengths. ``time_limit`` bounds
+either search and says so when it stops. Queries on the same pieces and bounds
+share F, its corners and its mesh (a one-scene cache keyed by content).
 
 Tolerance: F's vertices come from GEOS's union, whose new vertices (edge crossings
 of overlapping pieces) are rounded to doubles; the length is exact for that F,
@@ -27,7 +27,7 @@ in the same polygon of F, so an unsolvable query is *proven* unsolvable.
 """
 from __future__ import annotations
 
-import heapq
+import gc
 import math
 import time
 from dataclasses import dataclass, field
@@ -78,7 +78,8 @@ def _orient(geom):
 
 
 def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = None,
-                  on_progress: Callable[[int, int, float], None] | None = None) -> ShortestPath:
+                  on_progress: Callable[[int, int, float], None] | None = None,
+                  method: str = "auto") -> ShortestPath:
     """The shortest path from start to goal through the free C-space.
 
     ``time_limit`` (seconds) bounds the search: past it the result is unsolved with
@@ -97,17 +98,33 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
     >>> calls[-1][:2], round(calls[-1][2], 12)  # all 4 nodes settled; the bound reached the length
     ((4, 4), 3.828427124746)
     """
+    if method not in ("auto", "mesh", "lazy"):
+        raise ValueError(f"shortest_path: method: expected 'auto', 'mesh' or 'lazy', got {method!r}")
+
+    # The search makes many small tuples and no cycles: the cyclic collector, which would
+    # rescan them over and over (~15 % of the time), is paused while it runs.
+    paused = gc.isenabled()
+    gc.disable()
+    try:
+        return _shortest(pieces, bounds, start, goal, time_limit, on_progress, method)
+    finally:
+        if paused:
+            gc.enable()
+
+
+def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method) -> ShortestPath:
     import shapely
 
     from .pathcheck import Degenerate, path_violations, split_pieces
     from .polygon import as_array
+    from .shortest_lazy import _lazy_astar
 
     t0 = time.perf_counter()
     pieces = [as_array(p, copy=False, nonempty=True) for p in pieces]  # the one input gate: finite (N, 2) reals
     s, g = _point(start, "start"), _point(goal, "goal")
     bounds = tuple(_point(bounds[:2], "bounds")) + tuple(_point(bounds[2:], "bounds"))
-    F = free_space(pieces, bounds)
-    parts = [p for p in shapely.get_parts(F) if p.geom_type == "Polygon" and not p.is_empty]
+    scene = _scene(pieces, bounds)
+    parts = scene.parts
     ps, pg = shapely.Point(s), shapely.Point(g)
     comp_s = next((k for k, p in enumerate(parts) if p.covers(ps)), None)
     comp_g = next((k for k, p in enumerate(parts) if p.covers(pg)), None)
@@ -123,10 +140,9 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
         stats["time"] = time.perf_counter() - t0
         return ShortestPath(False, np.zeros((0, 2)), math.inf, True, stats)
     region = parts[comp_s]
-    shapely.prepare(region)
     if s == g:
         return ShortestPath(True, np.array([s]), 0.0, False, {**stats, "time": time.perf_counter() - t0})
-    nodes, tangent_dirs = _reflex_vertices(region)
+    nodes, tangent_dirs = scene.reflex(comp_s)
     if deg is not None:  # the free tips of zero-area pieces: the path may bend around them
         stats["counts"]["degenerate_pieces"] = len(degenerate)
         for tip in deg.wraps:
@@ -134,7 +150,23 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
             tangent_dirs.append((np.array(tip), np.array(tip)))  # any direction is tangent
     pts = np.array([s, g] + nodes, dtype=np.float64).reshape(-1, 2)
     deadline = None if time_limit is None else t0 + float(time_limit)
-    path, length, counts = _lazy_astar(pts, tangent_dirs, region, deadline, on_progress, deg)
+    path = None
+    if method != "lazy" and deg is None:  # zero-area pieces are outside F's mesh: the lazy search
+        from .freemesh import MeshError
+        from .visibility import mesh_astar
+
+        try:
+            mesh = scene.mesh(comp_s)
+        except MeshError as exc:  # GEOS's triangulation failed an exact check
+            stats["mesh_error"] = str(exc)
+        else:
+            path, length, counts = mesh_astar(mesh, pts, tangent_dirs, deadline, on_progress, PROGRESS_EVERY)
+            stats["method"] = "mesh"
+    if "method" not in stats:
+        if method == "mesh":
+            raise ValueError(f"shortest_path: no mesh search here ({stats.get('mesh_error', 'zero-area pieces')})")
+        path, length, counts = _lazy_astar(pts, tangent_dirs, region, deadline, on_progress, deg, PROGRESS_EVERY)
+        stats["method"] = "lazy"
     stats["counts"].update(counts, nodes=len(pts))
     stats["time"] = time.perf_counter() - t0
     if path is None:  # a connected region has a path, unless zero-area pieces cut it
@@ -146,6 +178,65 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
         stats["reason"] = f"the path failed the exact check against the pieces (edge {bad[0][0]}, piece {bad[0][1]})"
         return ShortestPath(False, np.zeros((0, 2)), math.inf, False, stats)
     return ShortestPath(True, pts[path], length, False, stats)
+
+
+class _Scene:
+    """F's components for one set of pieces and bounds, with each component's reflex
+    corners and mesh made on first use (queries on one C-space share them)."""
+
+    def __init__(self, pieces: list, bounds: tuple):
+        import shapely
+
+        F = free_space(pieces, bounds)
+        self.parts = [p for p in shapely.get_parts(F) if p.geom_type == "Polygon" and not p.is_empty]
+        for p in self.parts:
+            shapely.prepare(p)
+        self._reflex: dict = {}
+        self._mesh: dict = {}
+
+    def reflex(self, k: int) -> tuple[list, list]:
+        if k not in self._reflex:
+            self._reflex[k] = _reflex_vertices(self.parts[k])
+        nodes, nbrs = self._reflex[k]
+        return list(nodes), list(nbrs)  # callers append the tips of zero-area pieces
+
+    def mesh(self, k: int):
+        from .freemesh import FreeMesh, MeshError
+
+        if k not in self._mesh:
+            try:
+                self._mesh[k] = FreeMesh(self.parts[k])
+            except MeshError as exc:
+                self._mesh[k] = exc
+        if isinstance(self._mesh[k], MeshError):
+            raise self._mesh[k]
+        return self._mesh[k]
+
+
+_LAST: list = []  # [(key, _Scene)]: the last scene searched
+
+
+def _scene(pieces: list, bounds: tuple) -> _Scene:
+    """The :class:`_Scene` of these pieces and bounds, reused when the last call had the same
+    ones (compared by content: a digest of every coordinate and piece size)."""
+    import hashlib
+
+    h = hashlib.blake2b(np.asarray(bounds, dtype=np.float64).tobytes(), digest_size=20)
+    h.update(np.array([len(p) for p in pieces], dtype=np.int64).tobytes())
+    for p in pieces:
+        h.update(np.ascontiguousarray(p, dtype=np.float64).tobytes())
+    key = h.digest()
+    if not _LAST or _LAST[0][0] != key:
+        _LAST[:] = [(key, _Scene(pieces, bounds))]
+    return _LAST[0][1]
+
+
+def clear_cache() -> None:
+    """Forget the last scene's F and mesh (benchmarks time the preparation with it).
+
+    >>> clear_cache()
+    """
+    _LAST.clear()
 
 
 def _point(p, what: str) -> tuple[float, float]:
@@ -165,118 +256,16 @@ def _reflex_vertices(region) -> tuple[list, list]:
     a -> v -> b means F's interior angle at v exceeds pi: an obstacle corner the
     shortest path can wrap around. The neighbours are kept for the tangency test.
     """
-    from .predicates import orient2d_cols
+    from .freemesh import ring_turns
 
-    nodes: list = []
-    nbrs: list = []
-    rings = [region.exterior] + list(region.interiors)
-    for ring in rings:
-        c = np.asarray(ring.coords)[:-1, :2]
-        if len(c) < 3:
-            continue
-        a, b = np.roll(c, 1, axis=0), np.roll(c, -1, axis=0)
-        turn = orient2d_cols(a[:, 0], a[:, 1], c[:, 0], c[:, 1], b[:, 0], b[:, 1])
-        # Exterior rings of F are CCW and holes CW (orient_polygons), so F is on the left.
-        for k in np.flatnonzero(turn < 0):
-            nodes.append((float(c[k, 0]), float(c[k, 1])))
-            nbrs.append((a[k], b[k]))
+    C, prev, nxt, turn, _ = ring_turns(region)
+    # Exterior rings of F are CCW and holes CW (orient_polygons), so F is on the left.
+    k = np.flatnonzero(turn < 0)
+    nodes = [tuple(v) for v in C[k].tolist()]
+    nbrs = list(zip(map(tuple, C[prev[k]].tolist()), map(tuple, C[nxt[k]].tolist())))
     return nodes, nbrs
 
 
 PROGRESS_EVERY = 64  # settled nodes between two progress reports
 
 
-def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None,
-                on_progress: Callable[[int, int, float], None] | None = None, deg=None) -> tuple:
-    """A* from node 0 to node 1 over bitangent candidate edges, each checked when popped."""
-    import shapely
-
-    n = len(pts)
-    goal = pts[1]
-    h = np.hypot(pts[:, 0] - goal[0], pts[:, 1] - goal[1])
-    closed = np.zeros(n, dtype=bool)
-    g_best = np.full(n, np.inf)
-    parent = np.full(n, -1)
-    g_best[0] = 0.0
-    heap = [(h[0], 0.0, 0, -1)]
-    tested = pushed = 0
-    # Neighbour vectors of each reflex vertex, for the tangency filter.
-    na = np.array([x[0] for x in nbrs]).reshape(-1, 2)
-    nb = np.array([x[1] for x in nbrs]).reshape(-1, 2)
-    stopped = None
-    settled = 0
-    bound = float(h[0])
-    while heap:
-        if deadline is not None and time.perf_counter() > deadline:
-            stopped = "time limit"
-            break
-        f, gv, v, par = heapq.heappop(heap)
-        if closed[v]:
-            continue
-        if par >= 0:
-            tested += 1
-            seg = shapely.LineString([pts[par], pts[v]])
-            if not region.covers(seg) or (deg is not None and deg.blocks(pts[par], pts[v])):
-                continue
-        closed[v] = True
-        g_best[v] = gv
-        parent[v] = par
-        settled += 1
-        bound = f
-        if on_progress is not None and settled % PROGRESS_EVERY == 0:
-            on_progress(settled, n, bound)
-        if v == 1:
-            break
-        cand = np.flatnonzero(~closed)
-        if len(cand) == 0:
-            continue
-        d = np.hypot(pts[cand, 0] - pts[v, 0], pts[cand, 1] - pts[v, 1])
-        keep = _tangent_mask(pts, v, cand, na, nb)
-        # Every candidate is pushed unverified: a tentative cost must not shadow a
-        # costlier but visible edge to the same node, so no pruning before the test.
-        gw = gv + d[keep]
-        for fw, gw_, w in zip((gw + h[cand[keep]]).tolist(), gw.tolist(), cand[keep].tolist()):
-            heapq.heappush(heap, (fw, gw_, w, v))
-        pushed += int(keep.sum())
-    if on_progress is not None:
-        on_progress(settled, n, bound)
-    counts = {"edges_tested": tested, "edges_pushed": pushed}
-    if stopped:
-        counts["stopped"] = stopped
-    if not closed[1]:
-        return None, math.inf, counts
-    path = [1]
-    while path[-1] != 0:
-        path.append(int(parent[path[-1]]))
-    return path[::-1], float(g_best[1]), counts
-
-
-def _tangent_mask(pts: np.ndarray, v: int, cand: np.ndarray, na: np.ndarray, nb: np.ndarray) -> np.ndarray:
-    """Candidate edges v-w that can lie on a shortest path: tangent at both reflex ends.
-
-    At a reflex vertex r with ring neighbours a and b, the line through r and the
-    other end must not separate a from b (the path would cut into the obstacle's
-    corner instead of wrapping it). The test is in floats with a tolerance that only
-    ever keeps more edges than needed (never drops a tangent one).
-    """
-    keep = np.ones(len(cand), dtype=bool)
-    p = pts[v]
-    q = pts[cand]
-    # Tangency at the far end w (reflex nodes are 2..n-1).
-    far = cand >= 2
-    if far.any():
-        w = cand[far] - 2
-        keep[far] &= _not_separated(q[far], p, na[w], nb[w])
-    if v >= 2:
-        keep &= _not_separated(np.broadcast_to(p, q.shape), q, na[v - 2][None, :], nb[v - 2][None, :])
-    return keep
-
-
-def _not_separated(r: np.ndarray, other: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Whether a and b lie (weakly) on one side of the line through r and ``other``."""
-    dx, dy = other[..., 0] - r[..., 0], other[..., 1] - r[..., 1]
-    sa = dx * (a[..., 1] - r[..., 1]) - dy * (a[..., 0] - r[..., 0])
-    sb = dx * (b[..., 1] - r[..., 1]) - dy * (b[..., 0] - r[..., 0])
-    scale = (np.abs(dx) + np.abs(dy)) * (np.abs(a - r).sum(-1) + np.abs(b - r).sum(-1)) + 1e-300
-    tol = 1e-9 * scale
-    return ~(((sa > tol) & (sb < -tol)) | ((sa < -tol) & (sb > tol)))

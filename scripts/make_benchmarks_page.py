@@ -27,7 +27,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # Scripts the page expects; others found in scripts/ are run too.
-EXPECTED = ("bench_minkowski", "bench_gjk", "bench_scaling", "bench_cspace", "bench_direct")
+EXPECTED = ("bench_minkowski", "bench_gjk", "bench_scaling", "bench_cspace", "bench_direct", "bench_shortest")
 # Small arguments for scripts without a --quick mode (their defaults take minutes).
 QUICK_ARGS = {
     "bench_minkowski": ["--sizes", "8,64,1024"],
