@@ -32,6 +32,7 @@ HELP = {
     "bench": "error against run time for OMPL planners vs the exact shortest path",
     "stability": "run stiff and extreme cases through every layer",
     "generate": "write a random scenario (random, maze, narrow, disks, office)",
+    "import": "convert a ROS map (.yaml) or an OMPL.app problem (.cfg) to a scenario",
 }
 
 
