@@ -42,7 +42,7 @@ from .slab import wrap_angle
 
 
 
-def _toml():
+def toml_reader():
     """The TOML reader, imported when a file is read (not by ``import cspace``)."""
     try:  # Python >= 3.11
         import tomllib
@@ -217,7 +217,7 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
         text = raw.decode("utf-8-sig")  # a byte-order mark is allowed and skipped
     except UnicodeDecodeError as exc:
         raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
-    tomllib = _toml()
+    tomllib = toml_reader()
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

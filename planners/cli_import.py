@@ -87,8 +87,9 @@ def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
 
 def read_robot(path: str) -> dict:
     """The ``[robot]`` table of a TOML file (a robot file, or any scenario)."""
-    from cspace.scenario import read_input, tomllib
+    from cspace.scenario import read_input, toml_reader
 
+    tomllib = toml_reader()
     raw = read_input(path)
     try:
         data = tomllib.loads(raw.decode("utf-8-sig"))
