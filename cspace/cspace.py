@@ -628,7 +628,9 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
     if (sizes >= 3).all():
         rings = shapely.linearrings(np.concatenate(pieces), indices=np.repeat(np.arange(n), sizes))
         firsts = shapely.points(np.array([p[0] for p in pieces]))
-        ps, qs = shapely.STRtree(shapely.polygons(rings)).query(firsts, predicate="intersects")
+        # The pieces are the (prepared) query geometries, the points the tree: a piece of
+        # 10^5 vertices is indexed once, not walked once per point near it.
+        qs, ps = shapely.STRtree(firsts).query(shapely.polygons(rings), predicate="intersects")
     else:
         boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
         qs, ps = shapely.STRtree(boxes).query(boxes, predicate="covers")
