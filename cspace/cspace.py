@@ -133,6 +133,7 @@ class CSpace:
         robot_is_disk: bool = False,
         grid_cells: int | None = None,
         normalized: bool = False,
+        margin: list[np.ndarray] | None = None,
     ):
         # Obstacles and robot parts: (N, 2) arrays in either orientation or shapely Polygons /
         # MultiPolygons (cspace.inputs); ``normalized`` says they are already the loader's
@@ -148,7 +149,10 @@ class CSpace:
 
             obstacles, holes, owner = obstacle_shapes(obstacles, obstacle_holes)
             robot = robot_parts(robot)
-        _check_range(self.bounds, obstacles + robot)
+        # Safety margin (cspace.margin): convex operands summed with every robot piece in the
+        # same merge as the obstacle piece; none (the default) is the plain C-space, same code.
+        self.margin = [np.asarray(m, dtype=np.float64) for m in (margin or [])]
+        _check_range(self.bounds, obstacles + robot + self.margin)
         self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes, owner)
         self.robot_pieces = self._decompose_robot(robot, robot_is_disk)
         raw, raw_owner = self._sum()
@@ -194,6 +198,7 @@ class CSpace:
             robot_is_disk=sc.robot_kind == "disk",
             grid_cells=grid_cells,
             normalized=True,
+            margin=sc.margins(),
         )
         cs.scenario = sc
         if not isinstance(scenario, Scenario):
@@ -223,24 +228,37 @@ class CSpace:
 
     def _sum(self):
         t = time.perf_counter()
+        if not self.robot_pieces and self.margin:  # a point robot with a margin: O ⊕ −M
+            return self._sum_with([[]])
         if not self.robot_pieces:
             self.stages.append(Stage("minkowski", False, 0.0, {"pieces": len(self.obstacle_pieces)},
                                      "point robot: C-obstacles are the obstacles"))
             n = len(self.obstacle_pieces)
             self._raw_pairs = [(i, -1) for i in range(n)]
             return list(self.obstacle_pieces), self.obstacle_of
+        from .minkowski import reflect
+
+        return self._sum_with([[reflect(r)] for r in self.robot_pieces], t)
+
+    def _sum_with(self, neg: list, t: float | None = None):
+        """obstacle piece ⊕ −robot piece (⊕ −margin operands): one k-way merge per pair.
+        ``neg`` holds, per robot piece, its reflected operands ([] for a point robot)."""
         from .minkowski import minkowski_sum, reflect
 
-        neg = [reflect(r) for r in self.robot_pieces]
+        t = time.perf_counter() if t is None else t
+        extra = [reflect(m) for m in self.margin]
+        ops = [r + extra for r in neg]
         out, owner, pairs = [], [], []
         for i, (p, o) in enumerate(zip(self.obstacle_pieces, self.obstacle_of)):
-            for j, r in enumerate(neg):
-                out.append(minkowski_sum(p, r))
+            for j, r in enumerate(ops):
+                out.append(minkowski_sum(p, *r))
                 owner.append(o)
-                pairs.append((i, j))
+                pairs.append((i, j if self.robot_pieces else -1))
         self._raw_pairs = pairs
-        self.stages.append(Stage("minkowski", True, time.perf_counter() - t,
-                                 {"pairs": len(out), "robot_pieces": len(neg)}))
+        counts = {"pairs": len(out), "robot_pieces": len(self.robot_pieces)}
+        if self.margin:
+            counts["margin_vertices"] = [len(m) for m in self.margin]
+        self.stages.append(Stage("minkowski", True, time.perf_counter() - t, counts))
         return out, np.array(owner, dtype=np.int64)
 
     def _prune(self, pieces, owner):

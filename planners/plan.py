@@ -45,6 +45,19 @@ class PlanResult:
     # solve) and [time, best raw length] pairs along the run (the bench's anytime curve).
     first_solution: float | None = None
     progress: list = field(default_factory=list)
+    # Clearance (filled by plan() on solved paths; cspace.clearance): the smallest distance
+    # between the ROBOT (not inflated) swept along the path and any obstacle, the reference
+    # pose where it occurs, the obstacle's closest point, "exact" (translation) or "lower"
+    # (SE(2): a certified lower bound); ``touches``: the path touches an obstacle (distance 0,
+    # as the exact planner's optimum does at its bends without a clearance); ``clearance``:
+    # the margin D the plan was asked to keep; ``objective``: what the planner optimised.
+    min_clearance: float | None = None
+    min_clearance_at: tuple | None = None
+    min_clearance_obstacle: tuple | None = None
+    min_clearance_bound: str | None = None
+    touches: bool = False
+    clearance: float = 0.0
+    objective: str = "length"
     # The objects behind the result, for plots and further queries (not serialised).
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
@@ -70,12 +83,24 @@ class PlanResult:
             "checks": self.checks,
             "stages": self.stages,
             "message": self.message,
+            "clearance": self.clearance,
+            "objective": self.objective,
+            "min_clearance": _finite(self.min_clearance),
+            "min_clearance_at": list(self.min_clearance_at) if self.min_clearance_at else None,
+            "min_clearance_obstacle": list(self.min_clearance_obstacle) if self.min_clearance_obstacle else None,
+            "min_clearance_bound": self.min_clearance_bound,
+            "touches": self.touches,
         }
         if nested and self.cspace_report is not None:
             d["cspace"] = self.cspace_report
         if nested and self.queries is not None:
             d["queries"] = [q.as_dict(nested=False) for q in self.queries]
         return d
+
+
+def _finite(x):
+    """A float for JSON: None for None, "inf" for no obstacle at all (JSON has no infinity)."""
+    return None if x is None else (float(x) if math.isfinite(x) else "inf")
 
 
 def path_length(path: np.ndarray) -> float:
@@ -140,7 +165,7 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
 def plan(scenario, planner: str | None = None, time: float | None = None, seed: int | None = None,
          *, simplify: bool = True, iterations: int | None = None, cspace: CSpace | None = None,
          all_queries: bool = False, slices: bool = False, on_progress=None, space: str | None = None,
-         slabs: int | None = None) -> PlanResult:
+         slabs: int | None = None, clearance: float | None = None, objective: str = "length") -> PlanResult:
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
@@ -159,12 +184,26 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     interpolation. There is no exact planner in SE(2); ``planner="exact"`` there
     answers only when the inscribed-disk rule proves the scene unsolvable.
 
+    ``clearance=D`` (over the file's ``clearance``) inflates the robot by a polygon
+    containing the disk of radius D (:mod:`cspace.margin`): every path then keeps the
+    robot at least D from every obstacle (``exact``: the shortest such path). Each solved
+    result carries ``min_clearance`` (exact in translation, a certified lower bound in
+    SE(2)), where it occurs, and ``touches``. ``objective`` is ``length`` (default),
+    ``clearance`` or ``balanced`` (:mod:`planners.objectives`).
+
     >>> import os
     >>> res = plan(os.path.join(os.path.dirname(__file__), "..", "scenarios", "basic.toml"), seed=3)
     >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
     (True, [1.0, 1.0], [9.0, 9.0])
     """
     sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space)
+    sc = _with_clearance(sc, clearance)
+    try:
+        from .objectives import check_objective
+
+        objective = check_objective(objective, name)
+    except ValueError as exc:
+        raise ScenarioError("plan()", "objective", str(exc)) from None
     se2 = sc.space == "se2"
     if slabs is not None and not se2:
         raise ScenarioError("plan()", "slabs", 'applies to space = "se2" only')
@@ -189,7 +228,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         for pt, fld in zip(pair, ("start", "goal")):
             if not adapter.is_free(pt):
                 label = fld if i == 0 else f"queries[{i - 1}].{fld}"
-                raise ScenarioError(src, label, f"{pt} is not a free state of the C-space")
+                why = (f" with clearance {sc.clearance:g} (the robot there is closer than that to an obstacle)"
+                       if sc.clearance > 0 else " with the margin" if sc.margin is not None else "")
+                raise ScenarioError(src, label, f"{pt} is not a free state of the C-space{why}")
         poses.append(pair)
     if name == "exact" and se2:
         from .exact import exact_se2
@@ -203,10 +244,12 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         from .routine import run_planner
 
         results = run_planner(adapter, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
-                              slices=slices, on_progress=on_progress, scenario=sc.name)
+                              slices=slices, on_progress=on_progress, scenario=sc.name, objective=objective)
         if se2:
             _explain_se2_failures(sc, queries, results)
     for r in results:
+        r.clearance, r.objective = sc.clearance, objective
+        _measure_clearance(r, adapter)
         r.timings = {"load": load_s, "cspace": build_s, **r.timings}
         r.stages = _stage_names(report) + r.stages
         r.cspace_report = report
@@ -222,6 +265,33 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
 
 def _now() -> float:
     return time.perf_counter()
+
+
+def _with_clearance(sc: Scenario, clearance) -> Scenario:
+    """The scenario with the margin D of ``plan(clearance=D)`` (the file's when None)."""
+    if clearance is None:
+        return sc
+    if isinstance(clearance, bool) or not isinstance(clearance, (int, float)) or not math.isfinite(clearance) \
+            or clearance < 0:
+        raise ScenarioError("plan()", "clearance", f"must be a finite distance >= 0, got {clearance!r}")
+    if float(clearance) == sc.clearance:
+        return sc
+    import dataclasses
+
+    return dataclasses.replace(sc, clearance=float(clearance))
+
+
+def _measure_clearance(r: PlanResult, adapter) -> None:
+    """Fill a solved result's min_clearance (timed as ``clearance``) and ``touches``."""
+    if not r.solved or not len(r.path):
+        return
+    t = _now()
+    c = adapter.path_clearance(r.path)
+    r.timings["clearance"] = _now() - t
+    r.min_clearance, r.min_clearance_bound = float(c.distance), c.bound
+    r.min_clearance_at = tuple(c.where) or None
+    r.min_clearance_obstacle = tuple(c.obstacle_point) or None
+    r.touches = c.distance == 0.0 and c.bound == "exact"
 
 
 def _stage_names(report: dict) -> list[str]:

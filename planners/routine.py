@@ -56,7 +56,7 @@ def _now() -> float:
 
 def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *,
                 iterations: int | None = None, simplify: bool = True, slices: bool = False,
-                on_progress=None, scenario: str = "") -> list[PlanResult]:
+                on_progress=None, scenario: str = "", objective: str = "length") -> list[PlanResult]:
     """THE planning routine: one OMPL planner over a state-space adapter, for each query.
 
     ``space`` is an adapter of :mod:`planners.spaces`; ``queries`` is a list of
@@ -70,13 +70,17 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
     so that the time of the first solution (to within one slice) and the best raw
     length along the run are recorded in ``first_solution`` and ``progress``;
     ``on_progress(t, length)`` is called at each recorded point.
+
+    ``objective`` (:mod:`planners.objectives`): ``length`` (OMPL's default, nothing set),
+    ``clearance`` (maximise the minimum clearance) or ``balanced``; it matters to the
+    optimising planners (RRTstar, PRMstar, BITstar, ...).
     """
     key = name.lower()
     out = []
     held = [None]  # the roadmap planners' setup, kept from query to query
     for i, (start, goal) in enumerate(queries):
         args = (space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify, slices,
-                on_progress, scenario)
+                on_progress, objective, scenario)
         if tuple(start) == tuple(goal):  # nothing to plan: the one-point path
             out.append(_trivial(space, name, seed, scenario, start, goal))
         elif key == "aorrtc" and space.verify(np.array([start, goal], dtype=np.float64), start, goal)[0]:
@@ -89,13 +93,19 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
 
 
 def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify, slices,
-                on_progress, scenario) -> PlanResult:
+                on_progress, objective, scenario) -> PlanResult:
     from .ompl_glue import configure, make_setup, set_query
 
     t0 = _now()
     if held[0] is None or key not in ROADMAP:
         held[0] = make_setup(space, name, seed, query=i)
         configure(held[0][0].getPlanner(), name, iterations)
+        if objective != "length":
+            from .objectives import make_objective
+
+            obj = make_objective(objective, held[0][0].getSpaceInformation(), space)
+            held[0][0].setOptimizationObjective(obj)
+            held[0] = (*held[0], obj)  # OMPL holds the objective by reference: keep it alive
     else:
         held[0][0].getPlanner().clearQuery()  # keep the roadmap, drop the old start and goal
     ss = held[0][0]
@@ -109,6 +119,8 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
     found = ss.haveExactSolutionPath()
     raw = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
     t2 = _now()
+    # OMPL's simplifier shortens paths, trading clearance away: kept for the length objective only.
+    simplify = simplify and objective == "length"
     if found and simplify:
         ss.simplifySolution()
     simp_s = _now() - t2 if found and simplify else 0.0
