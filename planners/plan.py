@@ -218,6 +218,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         build_s = _now() - t0
     else:
         build_s = 0.0
+        _check_margin(sc, cspace)
     report = cspace.report()
     adapter = _adapter(sc, cspace)
     queries = sc.all_queries() if all_queries else sc.all_queries()[:1]
@@ -279,6 +280,15 @@ def _with_clearance(sc: Scenario, clearance) -> Scenario:
     import dataclasses
 
     return dataclasses.replace(sc, clearance=float(clearance))
+
+
+def _check_margin(sc: Scenario, cspace) -> None:
+    """A C-space passed in must have been built with the margin the plan asks for."""
+    want, have = sc.margins(), getattr(cspace, "margin", [])
+    if len(want) != len(have) or not all(np.array_equal(a, b) for a, b in zip(want, have)):
+        raise ScenarioError("plan()", "cspace", f"was built with another margin than clearance {sc.clearance:g}"
+                                                f"{' and [margin]' if sc.margin is not None else ''}: build it from "
+                                                f"the same scenario and clearance, or pass none")
 
 
 def _measure_clearance(r: PlanResult, adapter) -> None:

@@ -153,18 +153,19 @@ class TranslationSpace:
     def clearance_functions(self):
         """``(state -> clearance, (state, state) -> clearance)`` on OMPL states, in the
         C-space's units: the distance from the reference point (from the segment, for a
-        motion: exact, GJK on the segment's hull) to the nearest C-obstacle piece, that is
-        how far the robot (inflated by the margin, if any) is from touching an obstacle."""
-        from cspace.clearance import Nearest
+        motion) to the nearest C-obstacle edge, that is, for a free state or motion, how far
+        the robot (inflated by the margin, if any) is from touching an obstacle (floats, all
+        edges at once: :class:`cspace.clearance.EdgeDistance`)."""
+        from cspace.clearance import EdgeDistance
 
-        near, k = Nearest(self.cspace.pieces), -self.k
+        ed, k = EdgeDistance(self.cspace.pieces), -self.k
+        point, segment = ed.point, ed.segment
 
         def state(s) -> float:
-            return near.distance(np.array([[math.ldexp(s[0], k), math.ldexp(s[1], k)]]))
+            return point(math.ldexp(s[0], k), math.ldexp(s[1], k))
 
         def motion(s1, s2) -> float:
-            return near.distance(np.array([[math.ldexp(s1[0], k), math.ldexp(s1[1], k)],
-                                           [math.ldexp(s2[0], k), math.ldexp(s2[1], k)]]))
+            return segment(math.ldexp(s1[0], k), math.ldexp(s1[1], k), math.ldexp(s2[0], k), math.ldexp(s2[1], k))
 
         return state, motion
 

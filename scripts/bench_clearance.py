@@ -1,7 +1,8 @@
 """Clearance (issue 21): what a safety margin costs, and what measuring min_clearance costs.
 
 1. Build: the C-space of each bundled translation scene built without and with a margin
-   (clearance D = ``--fraction`` x the bounds' extent, the scene's disk_tolerance), builds
+   (clearance D = ``--fraction`` x the bounds' extent, the scene's disk_tolerance; a scene
+   with its own ``clearance`` keeps it), builds
    interleaved, medians over ``--reps``; the ratio is the margin's cost (target <= 1.5x).
    With ``--tolerance T`` the margin's polygon is built with disk_tolerance T instead.
 2. Plan: each scene planned with its own planner (and with ``exact``) with the margin;
@@ -83,7 +84,9 @@ def main():
     print(f"{'scene':<22} {'D':>7} {'plain ms':>9} {'margin ms':>9} {'ratio':>6}  "
           f"{'share (own planner)':>20} {'share (exact)':>14}")
     for sc in scenes(args.scenarios):
-        inflated = margin_of(sc, args.fraction, args.tolerance)
+        # A scene with its own clearance (clearance.toml) is measured with it, against none.
+        inflated = sc if sc.clearance > 0 and not args.tolerance else margin_of(sc, args.fraction, args.tolerance)
+        sc = dataclasses.replace(sc, clearance=0.0, margin=None)
         a, b = build_ratio(sc, inflated, args.reps)
         own = plan_share(inflated, None, args.reps)
         ex = plan_share(inflated, "exact", max(1, args.reps // 2))

@@ -360,7 +360,7 @@ def test_clearance_objective_runs_and_is_recorded():
 
     f = os.path.join(SCENARIOS, "basic.toml")
     for objective in ("clearance", "balanced"):
-        res = plan(f, planner="RRTstar", time=0.3, seed=1, objective=objective, iterations=400)
+        res = plan(f, planner="RRTstar", time=30.0, seed=1, objective=objective, iterations=250)
         assert res.solved and res.objective == objective
         assert res.min_clearance > 0.0
 
@@ -370,3 +370,18 @@ def test_csv_of_se2_path_has_theta():
 
     text = path_csv(np.array([[1.0, 2.0, 0.5]]), 3)
     assert text.splitlines() == ["x,y,theta", "1.0,2.0,0.5"]
+
+
+def test_edge_distance_matches_shapely():
+    """The objectives' clearance of a state or a motion: distance to the nearest C-obstacle edge."""
+    from cspace.clearance import EdgeDistance
+
+    rng = np.random.default_rng(0)
+    pieces = [np.array([[4., 4], [6, 4], [6, 6], [4, 6]]), np.array([[1., 7], [3, 7], [2, 9]])]
+    ed = EdgeDistance(pieces)
+    edges = shapely.union_all([shapely.Polygon(p).boundary for p in pieces])
+    for _ in range(300):
+        a, b = rng.uniform(0, 10, 2), rng.uniform(0, 10, 2)
+        assert ed.segment(*a, *b) == pytest.approx(shapely.LineString([a, b]).distance(edges), abs=1e-12)
+        assert ed.point(*a) == pytest.approx(shapely.Point(a).distance(edges), abs=1e-12)
+    assert EdgeDistance([]).segment(0, 0, 1, 1) == math.inf
