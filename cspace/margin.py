@@ -51,6 +51,25 @@ def margin_shapes(clearance: float = 0.0, polygon=None, disk_tolerance: float = 
     return out
 
 
+def inflated_pieces(robot_pieces: list, margin: list) -> list[np.ndarray]:
+    """Each convex robot piece summed with the margin operands in one merge (the margin alone
+    for a point robot); the pieces themselves without a margin.
+
+    >>> sq = np.array([[-1., -1], [1, -1], [1, 1], [-1, 1]])
+    >>> inflated_pieces([sq], [sq])[0].tolist()
+    [[-2.0, -2.0], [2.0, -2.0], [2.0, 2.0], [-2.0, 2.0]]
+    >>> len(inflated_pieces([], [sq])[0]), inflated_pieces([sq], [])[0] is sq
+    (4, True)
+    """
+    if not margin:
+        return list(robot_pieces)
+    from .minkowski import minkowski_sum
+
+    if robot_pieces:
+        return [minkowski_sum(p, *margin) for p in robot_pieces]
+    return [minkowski_sum(*margin) if len(margin) > 1 else np.asarray(margin[0], dtype=np.float64)]
+
+
 def margin_error(clearance: float, disk_tolerance: float = DEFAULT_RELATIVE_ERROR) -> float:
     """How much more than ``clearance`` a path may be kept away: the disk polygon's error.
 

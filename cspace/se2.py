@@ -68,12 +68,11 @@ class SE2CSpace(SE2Motions):
         # merge, so it turns with the robot (a disk margin is the same at every angle, up to
         # its polygon, which the slab hulls cover); a point robot becomes the margin itself.
         self.margin = [np.asarray(m, dtype=np.float64) for m in (margin or [])]
+        self.body_pieces = self.robot_pieces  # the robot itself, for clearance measures
         if self.margin:
-            self.body_pieces = self.robot_pieces  # the robot itself, for clearance measures
-            self.robot_pieces = ([minkowski_sum(p, *self.margin) for p in self.robot_pieces] if self.robot_pieces
-                                 else [minkowski_sum(*self.margin) if len(self.margin) > 1 else self.margin[0]])
-        else:
-            self.body_pieces = self.robot_pieces
+            from .margin import inflated_pieces
+
+            self.robot_pieces = inflated_pieces(self.robot_pieces, self.margin)
         self.grid_cells = grid_cells
         xmin, xmax, ymin, ymax = self.bounds
         self.extent = max(xmax - xmin, ymax - ymin)

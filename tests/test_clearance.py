@@ -385,3 +385,22 @@ def test_edge_distance_matches_shapely():
         assert ed.segment(*a, *b) == pytest.approx(shapely.LineString([a, b]).distance(edges), abs=1e-12)
         assert ed.point(*a) == pytest.approx(shapely.Point(a).distance(edges), abs=1e-12)
     assert EdgeDistance([]).segment(0, 0, 1, 1) == math.inf
+
+
+def test_plot_marks_the_closest_approach():
+    import os
+
+    from conftest import SCENARIOS
+    from planners.plan import plan
+    from planners.plot import figure_result
+
+    res = plan(os.path.join(SCENARIOS, "clearance.toml"))
+    fig = figure_result(res)
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert f"closest approach (clearance {res.min_clearance:.3g})" in labels
+    assert "robot with its safety margin 0.3" in labels
+    notes = [t.get_text() for t in fig.axes[0].texts]
+    assert any(n.startswith("clearance = 0.3") for n in notes)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
