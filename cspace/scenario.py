@@ -21,7 +21,8 @@ Schema (all lengths in one unit, angles in radians)::
     [goal]     x, y, theta (optional; must equal the start's unless space = "se2")
     [planner]  name, time, seed        # optional defaults
     [[queries]] start = [x, y], goal = [x, y]   # optional extra queries ([x, y, theta] in SE(2))
-    space = "translation" | "se2"      # optional: "se2" lets the robot rotate (theta is free;
+    space = "translation" | "se2" | "dubins" | "reeds-shepp"
+                                       # optional: "se2" lets the robot rotate (theta is free;
                                        # pose angles are taken into [-pi, pi), as OMPL's SO(2))
     slabs = K                          # optional, SE(2) only: angle slabs of the sliced C-space
 """
@@ -144,10 +145,17 @@ class Scenario:
     path: str | None = None
     robot_kind: str = "point"  # "point", "polygon", "parts" or "disk"
     disk_tolerance: float = DEFAULT_RELATIVE_ERROR
-    space: str = "translation"  # or "se2"
+    space: str = "translation"  # or "se2", "dubins", "reeds-shepp"
     slabs: int | None = None  # SE(2): angle slabs of the sliced C-space (None: derived)
     clearance: float = 0.0  # safety margin D: paths keep the robot at least D from obstacles
     margin: np.ndarray | None = None  # anisotropic convex margin (at theta in translation; body frame in SE(2))
+    turning_radius: float | None = None  # car-like spaces: the minimum turning radius
+
+    @property
+    def rotates(self) -> bool:
+        """Whether poses carry an angle: SE(2) and the car-like spaces (a car is a rotating robot
+        whose motions are Dubins or Reeds–Shepp curves)."""
+        return self.space in ROTATING_SPACES
 
     def margins(self) -> list[np.ndarray]:
         """The margin operands the robot is inflated by (:func:`cspace.margin.margin_shapes`);
@@ -158,8 +166,8 @@ class Scenario:
 
     @property
     def dim(self) -> int:
-        """Numbers in a state: 2 for translation, 3 for SE(2)."""
-        return 3 if self.space == "se2" else 2
+        """Numbers in a state: 2 for translation, 3 for SE(2) and the car-like spaces."""
+        return 3 if self.rotates else 2
 
     @property
     def is_point_robot(self) -> bool:
@@ -185,9 +193,10 @@ class Scenario:
 # Loading
 
 
-def load_scenario(path, space: str | None = None) -> Scenario:
-    """Read and validate a TOML scenario file; ``space`` (``"translation"`` or ``"se2"``)
-    overrides the file's ``space`` (``--space`` on the command line).
+def load_scenario(path, space: str | None = None, turning_radius: float | None = None) -> Scenario:
+    """Read and validate a TOML scenario file; ``space`` (``"translation"``, ``"se2"``,
+    ``"dubins"`` or ``"reeds-shepp"``) overrides the file's ``space`` (``--space`` on the
+    command line), ``turning_radius`` its ``turning_radius`` (``--turning-radius``).
 
     >>> import tempfile, os
     >>> d = tempfile.mkdtemp(); f = os.path.join(d, "s.toml")
@@ -212,7 +221,7 @@ def load_scenario(path, space: str | None = None) -> Scenario:
         raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
     except RecursionError:
         raise ScenarioError(path, "toml", "invalid TOML (arrays or tables nested too deeply)") from None
-    return scenario_from_dict(data, path, space=space)
+    return scenario_from_dict(data, path, space=space, turning_radius=turning_radius)
 
 
 def check_input(path) -> os.stat_result:
@@ -269,7 +278,7 @@ MIN_EXTENT = 2.0**-400
 
 # The keys a scenario may have at its top level (a new section adds its key here).
 TOP_LEVEL_KEYS = frozenset({"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal",
-                            "planner", "queries", "space", "slabs",
+                            "planner", "queries", "space", "slabs", "turning_radius",
                             "clearance", "margin"})
 # The forms of a robot table and of a shape (obstacle or robot part), by their keys: keys of two
 # different forms in one table exclude each other.
@@ -291,9 +300,10 @@ def unknown_field_message(key: str, allowed) -> str:
     return f"unknown field (expected one of: {', '.join(sorted(allowed))})"
 
 
-def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None = None) -> Scenario:
+def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None = None,
+                       turning_radius: float | None = None) -> Scenario:
     """Validate a parsed scenario (the TOML document as a dict) into a :class:`Scenario`.
-    ``space``, if given, overrides the document's ``space``."""
+    ``space`` and ``turning_radius``, if given, override the document's."""
     v = _Validator(path)
     v.no_extra(data, "", TOP_LEVEL_KEYS)
     name = data.get("name", os.path.splitext(os.path.basename(path))[0])
@@ -322,14 +332,28 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
     space = space or data.get("space", "translation")
     if space not in SPACES:
         raise v.err("space", f"must be one of {', '.join(repr(s) for s in SPACES)}, got {_short(space)}")
+    se2 = space in ROTATING_SPACES
     slabs = data.get("slabs")
     if slabs is not None:
-        if space != "se2":
-            raise v.err("slabs", 'applies to space = "se2" only')
+        if not se2:
+            raise v.err("slabs", 'applies to a rotating robot only (space = "se2", "dubins" or "reeds-shepp")')
         if isinstance(slabs, bool) or not isinstance(slabs, int) or not 4 <= slabs <= MAX_SLABS:
             raise v.err("slabs", f"must be an integer from 4 to {MAX_SLABS} (a slab spans at most a quarter "
                                  f"turn), got {_short(slabs)}")
-    se2 = space == "se2"
+    radius = data.get("turning_radius")
+    if turning_radius is not None:
+        if space not in CAR_SPACES:
+            raise ScenarioError("--turning-radius", "turning_radius", 'applies to space = "dubins" or "reeds-shepp" only')
+        if isinstance(turning_radius, bool) or not isinstance(turning_radius, (int, float)) \
+                or not 0.0 < float(turning_radius) < math.inf:
+            raise ScenarioError("--turning-radius", "turning_radius", f"must be a positive number, got {_short(turning_radius)}")
+        radius = float(turning_radius)
+    if space in CAR_SPACES:
+        if radius is None:
+            raise v.err("turning_radius", f'is required for space = "{space}" (the car\'s minimum turning radius)')
+        radius = v.number(radius, "turning_radius", positive=True)
+    elif radius is not None:
+        raise v.err("turning_radius", 'applies to space = "dubins" or "reeds-shepp" only')
 
     start_t = v.table(data, "start", required=True)
     goal_t = v.table(data, "goal", required=True)
@@ -357,7 +381,7 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
         name=name, bounds=bounds, robot=robot, obstacles=obstacles, start=start, goal=goal,
         theta=theta, planner=planner, queries=queries, expect=expect, path=path,
         robot_kind=kind, disk_tolerance=tol, space=space, slabs=slabs,
-        clearance=clearance, margin=margin,
+        turning_radius=radius, clearance=clearance, margin=margin,
     )
     probe = CollisionProbe(sc)
     labelled = [(start, "start"), (goal, "goal")]
@@ -369,7 +393,9 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
 
 
 # The state spaces a scenario can ask for, and the largest number of angle slabs.
-SPACES = ("translation", "se2")
+SPACES = ("translation", "se2", "dubins", "reeds-shepp")
+ROTATING_SPACES = ("se2", "dubins", "reeds-shepp")
+CAR_SPACES = ("dubins", "reeds-shepp")
 MAX_SLABS = 4096
 
 

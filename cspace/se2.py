@@ -18,7 +18,8 @@ angle of the slab), and is a plain translational :class:`CSpace` of those hulls:
 piece turned by :func:`rotate_piece`, translated by (x, y). Slabs are built lazily, on
 first use, and cached. Everything is deterministic.
 
-Motions (OMPL's SE(2) interpolation, certified) are :mod:`cspace.se2_motion`.
+Motions (OMPL's SE(2) interpolation, certified) are :mod:`cspace.se2_motion`; a car's
+curves (straight segments and turning arcs) are :mod:`cspace.car_motion`.
 """
 from __future__ import annotations
 
@@ -33,6 +34,7 @@ from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
 from .minkowski import minkowski_sum, reflect
 from .polygon import point_in_convex
 from .scenario import Scenario, load_scenario
+from .car_motion import CarMotions
 from .se2_motion import SE2Motions, interpolate  # noqa: F401  (interpolate: part of this module's API)
 from .slab import (ANGLE_SLACK, TWO_PI, _edges, _typical_gap, default_slabs, robot_radius, rotate_piece,
                    slab_hull, slab_inner, slab_of, slab_pad, slab_range, wrap_angle)
@@ -43,7 +45,7 @@ from .slab import (ANGLE_SLACK, TWO_PI, _edges, _typical_gap, default_slabs, rob
 SLAB_GRID_CELLS = 1 << 12
 
 
-class SE2CSpace(SE2Motions):
+class SE2CSpace(SE2Motions, CarMotions):
     """C-space of a rotating polygonal robot: K lazily built angle slabs plus exact tests.
 
     >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
@@ -111,7 +113,8 @@ class SE2CSpace(SE2Motions):
         self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
         self._pair_grid()
         self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
-                       "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0}
+                       "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0,
+                       "curves": 0, "arcs": 0, "arc_sweeps": 0}
         self._states = itertools.count()
         self._pose = self.pose_test(self._states.__next__)
         self.setup_seconds = time.perf_counter() - t0

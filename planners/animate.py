@@ -75,11 +75,19 @@ def animate_path(res, out: str, frames: int = 80, fps: int = 20, scenario=None) 
         raise ValueError("animate_path needs the scenario (pass scenario=...)")
     if not res.solved or not len(res.path):
         raise ValueError("animate_path needs a solved plan")
-    poses = poses_along(res.path, frames)
+    if sc.turning_radius is not None:  # a car: along its curves, not the chords
+        from .space_car import dense_curve
+
+        xmin, xmax, ymin, ymax = sc.bounds
+        dense, _ = dense_curve(res.path, sc.space, sc.turning_radius, step=max(xmax - xmin, ymax - ymin) / 1000)
+        poses = dense[np.linspace(0, len(dense) - 1, frames).round().astype(int)]
+    else:
+        poses = poses_along(res.path, frames)
     w, h = sc.bounds[1] - sc.bounds[0], sc.bounds[3] - sc.bounds[2]
     fig, ax = plt.subplots(figsize=(6, 6 * h / w + 0.5))
     draw_scene(ax, sc, None)
-    ax.plot(res.path[:, 0], res.path[:, 1], "-", color="#1f5fbf", linewidth=0.8, alpha=0.4)
+    trace = poses if sc.turning_radius is not None else res.path
+    ax.plot(trace[:, 0], trace[:, 1], "-", color="#1f5fbf", linewidth=0.8, alpha=0.4)
     _frame(ax, sc.bounds)
     ax.set_xlabel("x")
     ax.set_ylabel("y")

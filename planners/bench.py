@@ -205,7 +205,7 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
         if any(o["file"] == full for o in out):
             raise InputError(f, "scenario", "given twice")
         sc = load_scenario(f, space=space)
-        if sc.space == "se2":
+        if sc.rotates:  # SE(2) or a car: the inscribed disk gives a lower bound on the length
             from .se2_bounds import disk_bound
 
             cs = _build_cspace(sc, slabs)
@@ -214,7 +214,7 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
             db = disk_bound(sc, sc.all_queries()[0])
             bound = db.lower_bound if math.isfinite(db.lower_bound) else None
             out.append({"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
-                        "space": "se2", "slabs": cs.slabs})
+                        "space": sc.space, "slabs": cs.slabs})
             note = f"lower bound {bound:.6g} ({db.message})" if bound else db.message
         else:
             res = plan(sc, planner="exact")

@@ -9,7 +9,8 @@ from .output import PLOT_FORMATS, check_distinct, check_output, write_json
 
 def register(sub) -> None:
     p = sub.add_parser("plan", help="plan a collision-free path for a scenario",
-                       description="Plan a path for a translating (or, with --space se2, rotating) robot; "
+                       description="Plan a path for a translating robot, a rotating one (--space se2) or a car "
+                                   "(--space dubins / reeds-shepp); "
                                    "exit 0 solved, 1 not solved, 2 bad input.")
     p.add_argument("scenario", help="scenario TOML file")
     p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, else RRTConnect")
@@ -19,6 +20,8 @@ def register(sub) -> None:
     p.add_argument("--all-queries", action="store_true", help="plan every [[queries]] entry on one C-space")
     p.add_argument("--no-simplify", action="store_true", help="keep the planner's raw path")
     add_space_options(p)
+    p.add_argument("--turning-radius", type=number, help="a car's minimum turning radius (space dubins or "
+                                                         "reeds-shepp); default: the scenario's")
     p.add_argument("--plot", help="save a picture of the path (.png, .svg or .pdf)")
     p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
     p.add_argument("--json", help="write the result as JSON")
@@ -34,9 +37,10 @@ def register(sub) -> None:
 
 def add_space_options(p) -> None:
     """``--space`` and ``--slabs`` (plan, show and bench share them)."""
-    p.add_argument("--space", choices=("translation", "se2"),
-                   help="state space: translation (the robot keeps its angle) or se2 (it also rotates); "
-                        "default: the scenario's, else translation")
+    p.add_argument("--space", choices=("translation", "se2", "dubins", "reeds-shepp"),
+                   help="state space: translation (the robot keeps its angle), se2 (it also rotates), "
+                        "dubins or reeds-shepp (a car: forward only, or forward and reverse, along arcs "
+                        "of a minimum turning radius); default: the scenario's, else translation")
     p.add_argument("--slabs", type=integer, help="SE(2): angle slabs of the sliced C-space (default: derived "
                                                  "from the robot and the scene)")
 
@@ -108,7 +112,8 @@ def run(args) -> int:
     try:
         res = plan(src, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
                    simplify=not args.no_simplify, all_queries=args.all_queries,
-                   space=args.space, slabs=args.slabs, clearance=args.clearance, objective=args.objective)
+                   space=args.space, slabs=args.slabs, turning_radius=args.turning_radius,
+                   clearance=args.clearance, objective=args.objective)
     except ScenarioError as exc:
         if exc.file == "plan()" and exc.field == "objective":  # the file's planner takes no objective
             raise InputError(src, "--objective", exc.message) from None

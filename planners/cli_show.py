@@ -40,7 +40,7 @@ def run(args) -> int:
         import dataclasses
 
         sc = dataclasses.replace(sc, clearance=float(args.clearance))
-    if sc.space == "se2":
+    if sc.rotates:
         return _show_se2(sc, args, fmt)
     cs = CSpace.from_scenario(sc)
     rep = cs.report()

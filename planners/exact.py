@@ -82,7 +82,7 @@ def exact_se2(sc, query, source: str, time_limit: float | None = None) -> PlanRe
 
     db = disk_bound(sc, query, time_limit=time_limit if time_limit is not None else 10.0)
     if not db.proven_unsolvable:
-        raise ScenarioError(source, "planner", "there is no exact planner for a rotating robot (space = \"se2\"); "
+        raise ScenarioError(source, "planner", f"there is no exact planner for a rotating robot (space = \"{sc.space}\"); "
                             "the inscribed-disk rule did not prove the scene unsolvable either: use a sampling "
                             "planner such as RRTConnect")
     return PlanResult(

@@ -58,6 +58,9 @@ class PlanResult:
     touches: bool = False
     clearance: float = 0.0
     objective: str = "length"
+    # A car's path: per motion its start and end poses and its segments (type, length,
+    # direction), see planners.space_car.CarSpace.curves; None for other spaces.
+    curves: list | None = None
     # The objects behind the result, for plots and further queries (not serialised).
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
@@ -91,6 +94,8 @@ class PlanResult:
             "min_clearance_bound": self.min_clearance_bound,
             "touches": self.touches,
         }
+        if self.curves is not None:
+            d["curves"] = self.curves
         if nested and self.cspace_report is not None:
             d["cspace"] = self.cspace_report
         if nested and self.queries is not None:
@@ -124,18 +129,21 @@ SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit
 DEFAULT_TIME_SE2 = 10.0  # seconds, when neither the call nor the file gives a time (translation: 1)
 
 
-def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
+def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None, turning_radius=None):
     """Scenario object plus the effective planner, time and seed (arguments over file defaults)."""
     from .ompl_glue import planner_name
 
     t0 = time.perf_counter()
     if isinstance(scenario, Scenario):
         sc = scenario
+        if turning_radius is not None and turning_radius != sc.turning_radius:
+            raise ScenarioError("plan()", "turning_radius", "the scenario was loaded with turning_radius "
+                                f"{sc.turning_radius!r}; pass its path to plan with another")
         if space is not None and space != sc.space:
             raise ScenarioError("plan()", "space", f"the scenario was loaded as {sc.space!r}; load it with "
                                                    f"load_scenario(path, space={space!r}) or pass its path")
     else:
-        sc = load_scenario(os.fspath(scenario), space=space)
+        sc = load_scenario(os.fspath(scenario), space=space, turning_radius=turning_radius)
     load_s = time.perf_counter() - t0
     src = sc.path or "<scenario>"
     opts = sc.planner
@@ -148,7 +156,7 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
     else:
         name = planner_name(opts.get("name"), src, "planner.name")
     # SE(2) builds its angle slabs lazily, inside the planner's time: a longer default.
-    t = time_limit if time_limit is not None else opts.get("time", DEFAULT_TIME_SE2 if sc.space == "se2" else 1.0)
+    t = time_limit if time_limit is not None else opts.get("time", DEFAULT_TIME_SE2 if sc.rotates else 1.0)
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
         raise ScenarioError(*where(time_limit, "time"), f"must be a positive number of seconds, got {t!r}")
     if t > MAX_TIME:
@@ -165,7 +173,8 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None):
 def plan(scenario, planner: str | None = None, time: float | None = None, seed: int | None = None,
          *, simplify: bool = True, iterations: int | None = None, cspace: CSpace | None = None,
          all_queries: bool = False, slices: bool = False, on_progress=None, space: str | None = None,
-         slabs: int | None = None, clearance: float | None = None, objective: str = "length") -> PlanResult:
+         slabs: int | None = None, turning_radius: float | None = None, clearance: float | None = None,
+         objective: str = "length") -> PlanResult:
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
@@ -184,6 +193,11 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     interpolation. There is no exact planner in SE(2); ``planner="exact"`` there
     answers only when the inscribed-disk rule proves the scene unsolvable.
 
+    ``space="dubins"`` or ``"reeds-shepp"`` (with ``turning_radius``, or the file's
+    ``turning_radius``) plans a car: the same poses and C-space, but every motion is the
+    shortest Dubins (forward only) or Reeds–Shepp (forward and reverse) curve, certified
+    segment by segment; ``PlanResult.curves`` holds each motion's segments.
+
     ``clearance=D`` (over the file's ``clearance``) inflates the robot by a polygon
     containing the disk of radius D (:mod:`cspace.margin`): every path then keeps the
     robot at least D from every obstacle (``exact``: the shortest such path). Each solved
@@ -196,7 +210,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
     (True, [1.0, 1.0], [9.0, 9.0])
     """
-    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space)
+    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space, turning_radius)
     sc = _with_clearance(sc, clearance)
     try:
         from .objectives import check_objective
@@ -204,9 +218,10 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         objective = check_objective(objective, name)
     except ValueError as exc:
         raise ScenarioError("plan()", "objective", str(exc)) from None
-    se2 = sc.space == "se2"
+    se2 = sc.rotates  # SE(2) or a car: poses (x, y, theta) over the sliced C-space
     if slabs is not None and not se2:
-        raise ScenarioError("plan()", "slabs", 'applies to space = "se2" only')
+        raise ScenarioError("plan()", "slabs", 'applies to a rotating robot only (space = "se2", "dubins" or '
+                                               '"reeds-shepp")')
     if name != "exact":
         from .ompl_glue import ompl
 
@@ -221,6 +236,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         _check_margin(sc, cspace)
     report = cspace.report()
     adapter = _adapter(sc, cspace)
+    if objective != "length" and not hasattr(adapter, "clearance_functions"):
+        raise ScenarioError("plan()", "objective", f"{objective} is not available for space {sc.space!r} "
+                                                   "(translation and se2 only)")
     queries = sc.all_queries() if all_queries else sc.all_queries()[:1]
     src = sc.path or "<scenario>"
     poses = []
@@ -248,6 +266,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
                               slices=slices, on_progress=on_progress, scenario=sc.name, objective=objective)
         if se2:
             _explain_se2_failures(sc, queries, results)
+        if hasattr(adapter, "curves"):
+            for r in results:
+                r.curves = adapter.curves(r.path) if r.solved else []
     for r in results:
         r.clearance, r.objective = sc.clearance, objective
         _measure_clearance(r, adapter)
@@ -293,10 +314,11 @@ def _check_margin(sc: Scenario, cspace) -> None:
 
 def _measure_clearance(r: PlanResult, adapter) -> None:
     """Fill a solved result's min_clearance (timed as ``clearance``) and ``touches``."""
-    if not r.solved or not len(r.path):
+    measure = getattr(adapter, "path_clearance", None)  # a car's curves: not measured (yet)
+    if not r.solved or not len(r.path) or measure is None:
         return
     t = _now()
-    c = adapter.path_clearance(r.path)
+    c = measure(r.path)
     r.timings["clearance"] = _now() - t
     r.min_clearance, r.min_clearance_bound = float(c.distance), c.bound
     r.min_clearance_at = tuple(c.where) or None
@@ -313,7 +335,7 @@ def _stage_names(report: dict) -> list[str]:
 
 def _build_cspace(sc: Scenario, slabs: int | None = None):
     """The C-space a scenario's state space needs: translation, or sliced SE(2)."""
-    if sc.space == "se2":
+    if sc.rotates:
         from cspace.se2 import SE2CSpace
 
         return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)
@@ -322,6 +344,10 @@ def _build_cspace(sc: Scenario, slabs: int | None = None):
 
 def _adapter(sc: Scenario, cspace):
     """The state-space adapter of :mod:`planners.spaces` for the scenario's space."""
+    if sc.turning_radius is not None:
+        from .space_car import CarSpace
+
+        return CarSpace(cspace, sc.space, sc.turning_radius)
     if sc.space == "se2":
         from .space_se2 import SE2Space
 

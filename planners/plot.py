@@ -20,6 +20,7 @@ OBSTACLE = "#3b3b3b"
 COBSTACLE = "#f2b8a0"
 PIECE_EDGE = "#c97c5d"
 PATH = "#1f5fbf"
+REVERSE = "#e07b00"  # orange, dashed: a car driving backwards
 ROBOT = "#2a9d4b"
 GOAL = "#c0392b"
 FAILED = "#d6007a"  # magenta: apart from the goal's red and the path's blue
@@ -84,6 +85,7 @@ LEGEND = {
     "query_goal": ("query goal", lambda point: _robot_proxy(point, GOAL)),
     "along": ("robot along the path", lambda point: _robot_proxy(point, PATH, fill=False, alpha=0.4)),
     "path": ("path", lambda point: _line(color=PATH, lw=1.4)),
+    "reverse": ("path driven in reverse", lambda point: _line(color=REVERSE, lw=1.6, ls="--")),
     "failed": ("no path found (start to goal)",
                lambda point: _line(color=FAILED, lw=2.0, ls="--", marker="x", ms=8, mew=2.0)),
     "gap": ("narrowest gap (zoomed)", lambda point: _line(color=GAP, lw=1.5, marker="|", ms=6)),
@@ -118,7 +120,9 @@ def legend_handles(keys, point_robot: bool = False, labels: dict | None = None) 
 
 def add_legend(ax, handles: list, ncol: int = 3) -> None:
     """The legend below the axis, outside the scene, so that it never hides a path."""
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=ncol,
+    # Anchored a fixed distance (in font sizes) below the axis: clear of the tick labels and
+    # the x label whatever the scene's aspect.
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.0, ncol=ncol,
               fontsize=8, frameon=False, handlelength=2.2, columnspacing=1.2)
 
 
@@ -222,9 +226,11 @@ def _draw_queries(ax, sc, results: list, poses: int) -> list[str]:
     """Paths, robots at start and goal, failed queries; returns the legend keys drawn."""
     single = len(results) == 1
     keys: list[str] = []
-    se2 = sc.space == "se2"
+    se2 = sc.rotates
     for i, r in enumerate(results):
-        if r.solved and len(r.path) and se2:
+        if r.solved and len(r.path) and sc.turning_radius is not None:
+            keys += _draw_car_path(ax, sc, r.path, 3 * poses + 2 if single else 0)
+        elif r.solved and len(r.path) and se2:
             # A rotating robot: its footprint at poses spaced along the path, moved as
             # the planner's motions move it (OMPL's SE(2) interpolation), so it is seen to turn.
             from .animate import poses_along
@@ -248,8 +254,33 @@ def _draw_queries(ax, sc, results: list, poses: int) -> list[str]:
         draw_robot(ax, sc, *r.start[:3], color=ROBOT, alpha=0.6)
         draw_robot(ax, sc, *r.goal[:3], color=GOAL, alpha=0.6)
     keys += ["start", "goal"] if single else ["query_start", "query_goal"]
-    order = ["start", "goal", "query_start", "query_goal", "along", "path", "failed"]
+    order = ["start", "goal", "query_start", "query_goal", "along", "path", "reverse", "failed"]
     return [k for k in order if k in keys]
+
+
+def _draw_car_path(ax, sc, path: np.ndarray, count: int) -> list[str]:
+    """A car's path drawn along its curves (forward solid, reverse dashed), with its
+    footprint at ``count`` poses spaced along them; returns the legend keys drawn."""
+    from .space_car import dense_curve
+
+    xmin, xmax, ymin, ymax = sc.bounds
+    poses, rev = dense_curve(path, sc.space, sc.turning_radius, step=max(xmax - xmin, ymax - ymin) / 400)
+    keys = []
+    if count and len(poses) > 2:
+        for q in poses[np.linspace(0, len(poses) - 1, count).round().astype(int)[1:-1]]:
+            draw_robot(ax, sc, q[0], q[1], q[2], color=PATH, alpha=0.35, fill=False)
+        keys.append("along")
+    # Runs of poses in one gear, each drawn as one line (joined to the next run's first pose).
+    cuts = [0] + [i for i in range(1, len(rev)) if rev[i] != rev[i - 1]] + [len(rev)]
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        seg = poses[a:min(b + 1, len(poses))]
+        if rev[a]:
+            ax.plot(seg[:, 0], seg[:, 1], "--", color=REVERSE, linewidth=1.6)
+            keys.append("reverse")
+        else:
+            ax.plot(seg[:, 0], seg[:, 1], "-", color=PATH, linewidth=1.4)
+            keys.append("path")
+    return keys
 
 
 def _frame(ax, bounds) -> None:
@@ -327,7 +358,7 @@ def figure_result(res, scenario=None, cspace=None, poses: int = 4):
         raise ValueError("plot_result needs the scenario (pass scenario=...)")
     # In SE(2) the C-obstacles depend on the angle: the picture shows the workspace and
     # the robot's footprint along the path (cspace show --space se2 --theta draws a slab).
-    cs = None if sc.space == "se2" else (cspace or res.cspace or CSpace.from_scenario(sc))
+    cs = None if sc.rotates else (cspace or res.cspace or CSpace.from_scenario(sc))
     results = res.queries or [res]
     gap = narrow_gap(sc, cs, results)
     fig, ax = _new_figure(sc, wide=gap is not None)

@@ -79,6 +79,25 @@ def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False) -> Call
     return draw
 
 
+def car_plan_figure(scenario: str, seed: int = 0, animate: bool = False) -> Callable[[str], str]:
+    """A car's plan (scenarios/car/): its curves (reverse dashed) and footprint along them;
+    with ``animate`` also the GIF of ``cspace plan --animate`` beside the PNG."""
+
+    def draw(out: str) -> str:
+        from planners.animate import animate_path
+        from planners.plan import plan
+        from planners.plot import plot_result
+
+        res = plan(os.path.join(SCENARIOS, "car", f"{scenario}.toml"), seed=seed)
+        plot_result(res, out)
+        if animate and res.solved:
+            animate_path(res, os.path.splitext(out)[0] + ".gif")
+        state = f"length {res.length:.6g}" if res.solved else "not solved"
+        return f"{res.planner} seed {res.seed}: {state}" + (" (+ GIF)" if animate and res.solved else "")
+
+    return draw
+
+
 def se2_slab_figure(scenario: str, theta: float) -> Callable[[str], str]:
     """One angle slab's C-space of a rotating robot, as ``cspace show --space se2 --theta``."""
 
@@ -193,6 +212,11 @@ def figures() -> list[Figure]:
     out.append(Figure("se2_car_maze", "se2", "SE(2): a car-shaped body through a maze", se2_plan_figure("car_maze")))
     out.append(Figure("se2_tee_slot_slab", "se2", "SE(2): the slab C-space of theta = pi/2",
                       se2_slab_figure("tee_slot", 1.5707963267948966)))
+    out.append(Figure("car_parking", "car", "car: parallel parking, Reeds-Shepp (GIF beside it)",
+                      car_plan_figure("parking", animate=True)))
+    out.append(Figure("car_u_turn", "car", "car: a three-point turn in a narrow street", car_plan_figure("u_turn")))
+    out.append(Figure("car_loading_dock", "car", "car: backing into a loading bay", car_plan_figure("loading_dock")))
+    out.append(Figure("car_maze", "car", "car: Dubins through a maze", car_plan_figure("maze")))
     out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
     out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure()))
     out.append(Figure("error_vs_time", "acceptance", "cspace bench: the acceptance sweep (4 scenarios, 4 planners)",

@@ -163,7 +163,8 @@ TRI = "[[0, 0], [1, 0], [0, 1]]"
         ("[[obstacle]]\ncenter = [5, 5]\nradius = 1\n", "obstacle", "unknown field (did you mean obstacles?)"),
         # Nothing close: the whole list, so the user still learns what is allowed.
         ("colour = 3\n", "colour", "unknown field (expected one of: bounds, clearance, disk_tolerance, expect, goal, "
-                                   "margin, name, obstacles, planner, queries, robot, slabs, space, start)"),
+                                   "margin, name, obstacles, planner, queries, robot, slabs, space, start, "
+                                   "turning_radius)"),
         ("[robot]\nholes = []\n", "robot.holes", "unknown field (expected one of: parts, polygon, radius)"),
         # Two forms in one table.
         (f"[[obstacles]]\ncenter = [5, 5]\npolygon = {TRI}\n", "obstacles[0]", "center and polygon exclude each other"),
