@@ -165,22 +165,57 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
         return PathClearance(math.inf, (), (), -1, "exact")
     segs = [(pts[i], pts[i + 1]) for i in range(len(pts) - 1)] or [(pts[0], pts[0])]
     best, arg = math.inf, None
-    for i, (p0, p1) in enumerate(segs):
-        same = bool((p0 == p1).all())
-        for j, r in enumerate(rob):
-            swept = r + p0 if same else np.concatenate([r + p0, r + p1])
-            d, k, w = obs.nearest(swept, best)
-            if k >= 0 and (arg is None or d < best):
-                best, arg = d, (i, j, k, w)
+    if not len(obs.pieces):
+        return PathClearance(math.inf, (), (), -1, "exact")
+    # The broad phase over the whole path at once: the box of every (segment, robot piece)
+    # sweep against every obstacle box, the pairs then visited by increasing box distance
+    # (a lower bound) until it reaches the best distance found.
+    a, b = np.array([s[0] for s in segs]), np.array([s[1] for s in segs])
+    rlo = np.array([r.min(axis=0) for r in rob])
+    rhi = np.array([r.max(axis=0) for r in rob])
+    lo = (np.minimum(a, b)[:, None, :] + rlo[None, :, :]).reshape(-1, 2)  # (segment, piece) rows
+    hi = (np.maximum(a, b)[:, None, :] + rhi[None, :, :]).reshape(-1, 2)
+    nr, no = len(rob), len(obs.pieces)
+    step = max(1, (1 << 20) // no)  # bound the (sweeps, obstacles) block
+    cand_lb, cand_row, cand_k = [], [], []
+    for s0 in range(0, len(lo), step):
+        gap = np.maximum(np.maximum(obs.lo[None, :, :] - hi[s0:s0 + step, None, :],
+                                    lo[s0:s0 + step, None, :] - obs.hi[None, :, :]), 0.0)
+        lb = np.hypot(gap[..., 0], gap[..., 1])
+        # Keep, per sweep, the pieces no farther than the nearest piece's far corner could be.
+        row, k = np.nonzero(lb <= lb.min(axis=1, keepdims=True) + _reach(lo[s0:s0 + step], hi[s0:s0 + step],
+                                                                          obs)[:, None])
+        cand_lb.append(lb[row, k])
+        cand_row.append(row + s0)
+        cand_k.append(k)
+    lbs, rows, ks = np.concatenate(cand_lb), np.concatenate(cand_row), np.concatenate(cand_k)
+    for t in np.argsort(lbs, kind="stable").tolist():
+        if lbs[t] >= best:
+            break
+        row, k = int(rows[t]), int(ks[t])
+        i, j = divmod(row, nr)
+        p0, p1 = segs[i]
+        r = rob[j]
+        swept = r + p0 if (p0 == p1).all() else np.concatenate([r + p0, r + p1])
+        d = gjk_distance(swept, obs.pieces[k])
+        if d.distance < best or arg is None:
+            best, arg = d.distance, (i, j, k, d.point_b)
             if best == 0.0:
                 break
-        if best == 0.0:
-            break
     if arg is None:
         return PathClearance(math.inf, (), (), -1, "exact")
     i, j, k, w = arg
     where = _closest_position(segs[i], rob[j], obs.pieces[k])
     return PathClearance(float(best), where, tuple(float(v) for v in w), i, "exact")
+
+
+def _reach(lo: np.ndarray, hi: np.ndarray, obs: Nearest) -> np.ndarray:
+    """Per box, an upper bound of the distance from it to the nearest obstacle piece beyond its
+    box distance: the box's diagonal plus the largest obstacle box's diagonal (any point of a
+    box is that close to any other point of it), so no piece that could be nearest is dropped."""
+    own = np.hypot(*(hi - lo).T)
+    other = float(np.hypot(*(obs.hi - obs.lo).T).max())
+    return own + other
 
 
 def _closest_position(seg, robot_piece: np.ndarray, obstacle: np.ndarray) -> tuple:
