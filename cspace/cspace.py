@@ -143,6 +143,7 @@ class CSpace:
         grid_cells: int | None = None,
         normalized: bool = False,
         obstacle_convex: list[bool] | None = None,
+        margin: list[np.ndarray] | None = None,
     ):
         # Obstacles and robot parts: (N, 2) arrays in either orientation or shapely Polygons /
         # MultiPolygons (cspace.inputs); ``normalized`` says they are already the loader's
@@ -159,7 +160,10 @@ class CSpace:
 
             obstacles, holes, owner = obstacle_shapes(obstacles, obstacle_holes)
             robot = robot_parts(robot)
-        _check_range(self.bounds, obstacles + robot)
+        # Safety margin (cspace.margin): convex operands summed with every robot piece in the
+        # same merge as the obstacle piece; none (the default) is the plain C-space, same code.
+        self.margin = [np.asarray(m, dtype=np.float64) for m in (margin or [])]
+        _check_range(self.bounds, obstacles + robot + self.margin)
         convex = obstacle_convex if normalized else None
         self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes, owner, convex)
         self.robot_pieces = self._decompose_robot(robot, robot_is_disk)
@@ -210,6 +214,7 @@ class CSpace:
             grid_cells=grid_cells,
             normalized=True,
             obstacle_convex=[o.convex for o in sc.obstacles],
+            margin=sc.margins(),
         )
         cs.scenario = sc
         if not isinstance(scenario, Scenario):
@@ -239,6 +244,8 @@ class CSpace:
 
     def _sum(self):
         t = time.perf_counter()
+        if not self.robot_pieces and self.margin:  # a point robot with a margin: O ⊕ −M
+            return self._sum_with([[]])
         if not self.robot_pieces:
             self.stages.append(Stage("minkowski", False, 0.0, {"pieces": len(self.obstacle_pieces)},
                                      "point robot: C-obstacles are the obstacles"))
@@ -247,6 +254,8 @@ class CSpace:
             return list(self.obstacle_pieces), self.obstacle_of
         from .minkowski import reflect
 
+        if self.margin:  # robot piece ⊕ margin: one k-way merge per pair
+            return self._sum_with([[reflect(r)] for r in self.robot_pieces], t)
         neg = [reflect(r) for r in self.robot_pieces]
         out = pair_sums(self.obstacle_pieces, neg)
         nr = len(neg)
@@ -255,6 +264,27 @@ class CSpace:
         self.stages.append(Stage("minkowski", True, time.perf_counter() - t,
                                  {"pairs": len(out), "robot_pieces": len(neg)}))
         return out, owner
+
+    def _sum_with(self, neg: list, t: float | None = None):
+        """obstacle piece ⊕ −robot piece (⊕ −margin operands): one k-way merge per pair.
+        ``neg`` holds, per robot piece, its reflected operands ([] for a point robot)."""
+        from .minkowski import minkowski_sum, reflect
+
+        t = time.perf_counter() if t is None else t
+        extra = [reflect(m) for m in self.margin]
+        ops = [r + extra for r in neg]
+        out, owner, pairs = [], [], []
+        for i, (p, o) in enumerate(zip(self.obstacle_pieces, self.obstacle_of)):
+            for j, r in enumerate(ops):
+                out.append(minkowski_sum(p, *r))
+                owner.append(o)
+                pairs.append((i, j if self.robot_pieces else -1))
+        self._raw_pairs = pairs
+        counts = {"pairs": len(out), "robot_pieces": len(self.robot_pieces)}
+        if self.margin:
+            counts["margin_vertices"] = [len(m) for m in self.margin]
+        self.stages.append(Stage("minkowski", True, time.perf_counter() - t, counts))
+        return out, np.array(owner, dtype=np.int64)
 
     def _prune(self, pieces, owner):
         """Drop pieces that cannot meet the bounds, and pieces inside another piece.

@@ -81,18 +81,22 @@ class DirectChecker:
 
     @classmethod
     def from_cspace(cls, cs) -> "DirectChecker":
-        """Reuse the convex pieces (and bounds) a :class:`cspace.cspace.CSpace` decomposed.
+        """Reuse the convex pieces (and bounds) a :class:`cspace.cspace.CSpace` decomposed
+        (the robot pieces summed with its margin, if it has one).
 
         >>> from cspace.cspace import CSpace
         >>> cs = CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])])
         >>> DirectChecker.from_cspace(cs).is_free((5, 5))
         False
         """
-        return cls(cs.robot_pieces, cs.obstacle_pieces, cs.bounds)
+        from .margin import inflated_pieces
+
+        return cls(inflated_pieces(cs.robot_pieces, getattr(cs, "margin", [])), cs.obstacle_pieces, cs.bounds)
 
     @classmethod
     def from_scenario(cls, scenario) -> "DirectChecker":
-        """Decompose a :class:`Scenario` (or scenario file) into convex pieces; no sums.
+        """Decompose a :class:`Scenario` (or scenario file) into convex pieces; no sums (but
+        a margin, if the scene has one, is summed with each robot piece, as the C-space does).
 
         >>> import os, tempfile
         >>> f = os.path.join(tempfile.mkdtemp(), "s.toml")
@@ -107,7 +111,9 @@ class DirectChecker:
         sc = scenario if isinstance(scenario, Scenario) else load_scenario(os.fspath(scenario))
         obstacles = [p for o in sc.obstacles for p in convex_decompose(o.polygon, o.holes)]
         robot = [p for r in sc.robot for p in convex_decompose(r.polygon)]
-        return cls(robot, obstacles, sc.bounds)
+        from .margin import inflated_pieces
+
+        return cls(inflated_pieces(robot, sc.margins()), obstacles, sc.bounds)  # with the scene's margin
 
     # -- queries ---------------------------------------------------------------------
 
@@ -241,7 +247,9 @@ def cspace_band(cs) -> float:
         return 0.0
     olo = np.array([p.min(axis=0) for p in cs.obstacle_pieces])
     ohi = np.array([p.max(axis=0) for p in cs.obstacle_pieces])
-    rob = cs.robot_pieces or [np.zeros((1, 2))]
+    from .margin import inflated_pieces
+
+    rob = inflated_pieces(cs.robot_pieces, getattr(cs, "margin", [])) or [np.zeros((1, 2))]
     rlo = np.array([p.min(axis=0) for p in rob]).min(axis=0)
     rhi = np.array([p.max(axis=0) for p in rob]).max(axis=0)
     m = max(float(np.abs(olo - rhi).max()), float(np.abs(olo - rlo).max()),

@@ -152,6 +152,8 @@ class Scenario:
     disk_tolerance: float = DEFAULT_RELATIVE_ERROR
     space: str = "translation"  # or "se2", "dubins", "reeds-shepp"
     slabs: int | None = None  # SE(2): angle slabs of the sliced C-space (None: derived)
+    clearance: float = 0.0  # safety margin D: paths keep the robot at least D from obstacles
+    margin: np.ndarray | None = None  # anisotropic convex margin (at theta in translation; body frame in SE(2))
     turning_radius: float | None = None  # car-like spaces: the minimum turning radius
 
     @property
@@ -159,6 +161,13 @@ class Scenario:
         """Whether poses carry an angle: SE(2) and the car-like spaces (a car is a rotating robot
         whose motions are Dubins or Reeds–Shepp curves)."""
         return self.space in ROTATING_SPACES
+
+    def margins(self) -> list[np.ndarray]:
+        """The margin operands the robot is inflated by (:func:`cspace.margin.margin_shapes`);
+        empty without a clearance or a margin polygon."""
+        from .margin import margin_shapes
+
+        return margin_shapes(self.clearance, self.margin, self.disk_tolerance)
 
     @property
     def dim(self) -> int:
@@ -283,7 +292,8 @@ MIN_EXTENT = 2.0**-400
 
 # The keys a scenario may have at its top level (a new section adds its key here).
 TOP_LEVEL_KEYS = frozenset({"name", "expect", "disk_tolerance", "bounds", "robot", "obstacles", "start", "goal",
-                            "planner", "queries", "space", "slabs", "turning_radius"})
+                            "planner", "queries", "space", "slabs", "turning_radius",
+                            "clearance", "margin"})
 # The forms of a robot table and of a shape (obstacle or robot part), by their keys: keys of two
 # different forms in one table exclude each other.
 ROBOT_FORMS = {"polygon": {"polygon"}, "parts": {"parts"}, "disk": {"radius"}}
@@ -373,6 +383,10 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
         theta = theta if theta is not None else (goal_theta or 0.0)
 
     robot, kind = v.robot(data.get("robot"), theta, tol)
+    clearance = v.number(data.get("clearance", 0.0), "clearance")
+    if clearance < 0:
+        raise v.err("clearance", f"must be a distance >= 0, got {data.get('clearance')}")
+    margin = v.margin(data.get("margin"), theta, tol)
     obstacles = v.obstacles(data.get("obstacles", []), tol)
     planner = v.planner(data.get("planner", {}))
     queries = v.queries(data.get("queries", []), se2)
@@ -381,7 +395,7 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
         name=name, bounds=bounds, robot=robot, obstacles=obstacles, start=start, goal=goal,
         theta=theta, planner=planner, queries=queries, expect=expect, path=path,
         robot_kind=kind, disk_tolerance=tol, space=space, slabs=slabs,
-        turning_radius=radius,
+        turning_radius=radius, clearance=clearance, margin=margin,
     )
     probe = CollisionProbe(sc)
     labelled = [(start, "start"), (goal, "goal")]
@@ -555,6 +569,27 @@ class _Validator:
                 if sh.disk is not None:
                     sh.disk = (0.0, 0.0, sh.disk[2])
         return shapes, kind
+
+    def margin(self, t, theta: float, tol: float) -> np.ndarray | None:
+        """``[margin] polygon = [...]``: convex, containing the origin, turned by theta like the robot."""
+        if t is None:
+            return None
+        if not isinstance(t, dict):
+            raise self.err("margin", "must be a table with polygon = [[x, y], ...]")
+        self.no_extra(t, "margin", {"polygon"})
+        if "polygon" not in t:
+            raise self.err("margin.polygon", "missing (a convex polygon around the reference point)")
+        from .margin import check_margin_polygon
+
+        p = self.shape({"polygon": t["polygon"]}, "margin", tol, allow_holes=False).polygon
+        why = check_margin_polygon(p)
+        if why:
+            raise self.err("margin.polygon", why)
+        if theta:
+            from .slab import rotate
+
+            p = rotate(p, theta)
+        return p
 
     def obstacles(self, lst, tol: float) -> list[Shape]:
         """The obstacles, in order, as :meth:`shape` reads each one.

@@ -60,13 +60,22 @@ class SE2CSpace(SE2Motions, CarMotions):
 
     def __init__(self, bounds, obstacles: list[np.ndarray] | None = None, robot: list[np.ndarray] | None = None,
                  *, obstacle_holes: list[list[np.ndarray]] | None = None, robot_is_disk: bool = False,
-                 slabs: int | None = None, grid_cells: int | None = None):
+                 slabs: int | None = None, grid_cells: int | None = None, margin: list[np.ndarray] | None = None):
         t0 = time.perf_counter()
         self.bounds = tuple(float(v) for v in bounds)
         obstacles = obstacles or []
         _check_range(self.bounds, obstacles + (robot or []))
         self.obstacle_pieces, self.obstacle_of, _ = decompose_obstacles(obstacles, obstacle_holes)
         self.robot_pieces, _ = decompose_robot(robot or [], robot_is_disk)
+        # A safety margin (cspace.margin) is summed with each body-frame robot piece in one
+        # merge, so it turns with the robot (a disk margin is the same at every angle, up to
+        # its polygon, which the slab hulls cover); a point robot becomes the margin itself.
+        self.margin = [np.asarray(m, dtype=np.float64) for m in (margin or [])]
+        self.body_pieces = self.robot_pieces  # the robot itself, for clearance measures
+        if self.margin:
+            from .margin import inflated_pieces
+
+            self.robot_pieces = inflated_pieces(self.robot_pieces, self.margin)
         self.grid_cells = grid_cells
         xmin, xmax, ymin, ymax = self.bounds
         self.extent = max(xmax - xmin, ymax - ymin)
@@ -128,7 +137,7 @@ class SE2CSpace(SE2Motions, CarMotions):
         sc = scenario if isinstance(scenario, Scenario) else load_scenario(str(scenario))
         cs = cls(sc.bounds, [o.polygon for o in sc.obstacles], [r.polygon for r in sc.robot],
                  obstacle_holes=[o.holes for o in sc.obstacles], robot_is_disk=sc.robot_kind == "disk",
-                 slabs=slabs, grid_cells=grid_cells)
+                 slabs=slabs, grid_cells=grid_cells, margin=sc.margins())
         cs.scenario = sc
         return cs
 

@@ -26,6 +26,12 @@ def register(sub) -> None:
     p.add_argument("--plot", help="save a picture of the path (.png, .svg or .pdf)")
     p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
     p.add_argument("--json", help="write the result as JSON")
+    p.add_argument("--csv", help="write the path's waypoints as CSV (x,y or x,y,theta, with a header)")
+    p.add_argument("--clearance", type=number, help="safety margin D: keep the robot at least D from every "
+                                                     "obstacle (default: the scenario's clearance, else 0)")
+    p.add_argument("--objective", choices=("length", "clearance", "balanced"), default="length",
+                   help="what optimising planners (RRTstar, PRMstar, BITstar, ...) minimise: path length "
+                        "(default), the inverse of the minimum clearance, or length weighted by clearance")
     p.add_argument("--verbose", "-v", action="store_true", help="print the C-space report and OMPL's messages")
     from .cli_import import add_import_options
 
@@ -63,6 +69,8 @@ def run(args) -> int:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
+    if args.clearance is not None and not (0 <= args.clearance < float("inf")):
+        raise InputError(src, "--clearance", f"must be a finite distance >= 0, got {args.clearance}")
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError(src, "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     from .ompl_glue import MAX_TIME, SEED_LIMIT, planner_name
@@ -80,6 +88,14 @@ def run(args) -> int:
         sys.stderr.write("note: OMPL is not installed: planning with the exact planner instead "
                          f"({OMPL_HINT})\n")
         args.planner = "exact"
+    if args.objective != "length":
+        from .objectives import check_objective
+
+        try:
+            check_objective(args.objective, args.planner or "RRTConnect")
+        except ValueError as exc:
+            if args.planner is not None:
+                raise InputError(src, "--objective", str(exc)) from None
     check_input(src)
     from .cli_import import import_options
 
@@ -89,13 +105,17 @@ def run(args) -> int:
         check_output(args.animate, "--animate", {".gif": "gif"}, inputs=[src])
     if args.json is not None:
         check_output(args.json, "--json", inputs=[src])
-    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate")])
+    if args.csv is not None:
+        check_output(args.csv, "--csv", inputs=[src])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.csv, "--csv")])
     from .plan import plan
 
     if args.verbose and args.planner != "exact":
         from .ompl_glue import ompl
 
         ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
+    from cspace.scenario import ScenarioError
+
     scenario = src
     if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
         from cspace.imported import import_file
@@ -107,13 +127,27 @@ def run(args) -> int:
                 check_output(out, opt, inputs=imp.inputs)
         for w in imp.warnings:
             sys.stderr.write(f"warning: {w}\n")
-        scenario = scenario_from_dict(imp.data, src, space=args.space)
-    res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
-               simplify=not args.no_simplify, all_queries=args.all_queries,
-               space=args.space, slabs=args.slabs, turning_radius=args.turning_radius)
+        scenario = scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
+    try:
+        res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
+                   simplify=not args.no_simplify, all_queries=args.all_queries,
+                   space=args.space, slabs=args.slabs,
+                   turning_radius=None if options is not None else args.turning_radius,
+                   clearance=args.clearance, objective=args.objective)
+    except ScenarioError as exc:
+        if exc.file == "plan()" and exc.field == "objective":  # the file's planner takes no objective
+            raise InputError(src, "--objective", exc.message) from None
+        raise
     print(summary(res, verbose=args.verbose))
     if args.json is not None:
         write_json(args.json, res.as_dict(), "--json")
+    if args.csv is not None:
+        from .output import write_csv
+
+        if res.solved:
+            write_csv(args.csv, res.path, res.path.shape[1] if res.path.ndim == 2 else 2)
+        else:
+            sys.stderr.write(f"note: --csv {args.csv}: no path to write (not solved)\n")
     if args.plot is not None:
         from .plot import plot_result
 
@@ -148,6 +182,8 @@ def summary(res, verbose: bool = False) -> str:
             lines.append(f"{tag}: NOT solved by exact: {r.message}")
         else:
             lines.append(f"{tag}: NOT solved by {by} within the limit: {r.message}")
+        if r.solved:
+            lines.append(clearance_line(r))
     if res.queries:
         for i, r in enumerate(res.queries):
             lines.append(f"query {i} time: " + _times(r.timings, skip=("load", "cspace", "total")))
@@ -171,6 +207,30 @@ def summary(res, verbose: bool = False) -> str:
             lines.append(f"  {s['stage']:<20} {state:<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
         lines.append(f"checks: {res.checks}")
     return "\n".join(lines)
+
+
+def clearance_line(r) -> str:
+    """The clearance of a solved path, in words: how close the robot comes, where, and
+    whether the path touches (exact without a clearance: the limit of free paths).
+
+    >>> class R: min_clearance, min_clearance_at, min_clearance_bound, touches, clearance = 0.5, (1.0, 2.0), "exact", False, 0.0
+    >>> clearance_line(R())
+    'min clearance 0.5 at (1, 2) (exact)'
+    """
+    c = r.min_clearance
+    if c is None:
+        return "min clearance: not measured"
+    if c == float("inf"):
+        return "min clearance: inf (no obstacle)"
+    at = ", ".join(f"{v:.6g}" for v in (r.min_clearance_at or ()))
+    kind = "a certified lower bound" if r.min_clearance_bound == "lower" else "exact"
+    text = f"min clearance {c:.6g} at ({at}) ({kind})"
+    if r.clearance > 0:
+        text += f", margin asked {r.clearance:g}"
+    if r.touches:
+        text += ("; the path TOUCHES obstacles (the limit of free paths, not drivable as it is): "
+                 "set a clearance (--clearance D) to keep away from them")
+    return text
 
 
 def _times(t: dict, skip=()) -> str:

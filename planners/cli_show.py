@@ -18,6 +18,8 @@ def register(sub) -> None:
     add_import_options(p)
     p.add_argument("--theta", type=number, default=0.0,
                    help="SE(2): draw the C-space of the angle slab that holds this angle (radians, default 0)")
+    p.add_argument("--clearance", type=number, help="safety margin D: the C-obstacles of the robot inflated by "
+                                                     "the disk of radius D (default: the scenario's)")
     p.add_argument("--verbose", "-v", action="store_true")
     p.set_defaults(run=run)
 
@@ -25,6 +27,10 @@ def register(sub) -> None:
 def run(args) -> int:
     from cspace.scenario import check_input, load_scenario
 
+    from .errors import InputError
+
+    if args.clearance is not None and not (0 <= args.clearance < float("inf")):
+        raise InputError(args.scenario, "--clearance", f"must be a finite distance >= 0, got {args.clearance}")
     check_input(args.scenario)
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[args.scenario]) if args.plot is not None else None
     if args.json is not None:
@@ -35,11 +41,16 @@ def run(args) -> int:
     from .cli_import import import_options
 
     sc = load_scenario(args.scenario, space=args.space, options=import_options(args, args.scenario))
+    if args.clearance is not None:
+        import dataclasses
+
+        sc = dataclasses.replace(sc, clearance=float(args.clearance))
     if sc.rotates:
         return _show_se2(sc, args, fmt)
     cs = CSpace.from_scenario(sc)
     rep = cs.report()
-    print(f"{sc.name}: {len(sc.obstacles)} obstacles, robot {sc.robot_kind}, "
+    margin = f" (with a margin: clearance {sc.clearance:g})" if sc.margins() else ""
+    print(f"{sc.name}: {len(sc.obstacles)} obstacles, robot {sc.robot_kind}{margin}, "
           f"{rep['pieces']} C-obstacle pieces, built in {rep['build_seconds'] * 1e3:.1f} ms")
     for s in rep["stages"]:
         counts = {k: v for k, v in s.items() if k not in ("stage", "ran", "seconds", "note")}

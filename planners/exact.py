@@ -7,7 +7,10 @@ answers like any other planner: ``cspace plan --planner exact`` or
 
 The optimum is an infimum: it may touch C-obstacle boundaries, which the planners'
 closed-obstacle validity forbids. So its path is reported as the reference length,
-``exact`` is true when it was computed exactly, and ``solved`` means a path exists.
+``exact`` is true when it was computed exactly, and ``solved`` means a path exists;
+``touches`` (filled by :func:`planners.plan.plan`) says the path touches an obstacle.
+With a clearance D > 0 the C-obstacles are those of the robot inflated by the margin,
+so the path is the shortest keeping the robot at least D from every obstacle.
 """
 from __future__ import annotations
 
@@ -35,8 +38,13 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
         sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit,
                                 on_progress=pg.search_reporter(bar) if bar.shown else None)
     dt = time.perf_counter() - t
-    if sp.solved:
-        message = "exact shortest path (touches C-obstacle boundaries where it bends)"
+    d = getattr(sc, "clearance", 0.0)
+    if sp.solved and d > 0:
+        message = (f"exact shortest path keeping clearance {d:g} (it touches the C-obstacles inflated by "
+                   f"the margin where it bends)")
+    elif sp.solved:
+        message = ("exact shortest path: the limit of free paths, it touches C-obstacle boundaries where it "
+                   "bends (set a clearance to drive it)")
     elif sp.proven_unsolvable:
         message = "proven unsolvable (start and goal are in different free components)"
     else:

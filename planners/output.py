@@ -273,3 +273,24 @@ def write_text(path: str, text: str, option: str = "output") -> None:
     with atomic_path(path, option) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)
+
+
+def path_csv(path, dim: int = 2) -> str:
+    """A path as CSV text: a header (``x,y`` or ``x,y,theta``) and one waypoint per line,
+    each number written with ``repr`` (shortest round-trip: read back, the same doubles).
+
+    >>> print(path_csv([[0.0, 1.5], [2.0, 3.0]]), end="")
+    x,y
+    0.0,1.5
+    2.0,3.0
+    """
+    import numpy as np
+
+    rows = np.asarray(path, dtype=np.float64).reshape(-1, dim)
+    header = "x,y,theta" if dim == 3 else "x,y"
+    return header + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in rows.tolist())
+
+
+def write_csv(path: str, waypoints, dim: int = 2, option: str = "--csv") -> None:
+    """Write a path as CSV (:func:`path_csv`), atomically (see :func:`atomic_path`)."""
+    write_text(path, path_csv(waypoints, dim), option)

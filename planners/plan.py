@@ -45,6 +45,19 @@ class PlanResult:
     # solve) and [time, best raw length] pairs along the run (the bench's anytime curve).
     first_solution: float | None = None
     progress: list = field(default_factory=list)
+    # Clearance (filled by plan() on solved paths; cspace.clearance): the smallest distance
+    # between the ROBOT (not inflated) swept along the path and any obstacle, the reference
+    # pose where it occurs, the obstacle's closest point, "exact" (translation) or "lower"
+    # (SE(2): a certified lower bound); ``touches``: the path touches an obstacle (distance 0,
+    # as the exact planner's optimum does at its bends without a clearance); ``clearance``:
+    # the margin D the plan was asked to keep; ``objective``: what the planner optimised.
+    min_clearance: float | None = None
+    min_clearance_at: tuple | None = None
+    min_clearance_obstacle: tuple | None = None
+    min_clearance_bound: str | None = None
+    touches: bool = False
+    clearance: float = 0.0
+    objective: str = "length"
     # A car's path: per motion its start and end poses and its segments (type, length,
     # direction), see planners.space_car.CarSpace.curves; None for other spaces.
     curves: list | None = None
@@ -73,6 +86,13 @@ class PlanResult:
             "checks": self.checks,
             "stages": self.stages,
             "message": self.message,
+            "clearance": self.clearance,
+            "objective": self.objective,
+            "min_clearance": _finite(self.min_clearance),
+            "min_clearance_at": list(self.min_clearance_at) if self.min_clearance_at else None,
+            "min_clearance_obstacle": list(self.min_clearance_obstacle) if self.min_clearance_obstacle else None,
+            "min_clearance_bound": self.min_clearance_bound,
+            "touches": self.touches,
         }
         if self.curves is not None:
             d["curves"] = self.curves
@@ -81,6 +101,11 @@ class PlanResult:
         if nested and self.queries is not None:
             d["queries"] = [q.as_dict(nested=False) for q in self.queries]
         return d
+
+
+def _finite(x):
+    """A float for JSON: None for None, "inf" for no obstacle at all (JSON has no infinity)."""
+    return None if x is None else (float(x) if math.isfinite(x) else "inf")
 
 
 def path_length(path: np.ndarray) -> float:
@@ -148,7 +173,8 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None, t
 def plan(scenario, planner: str | None = None, time: float | None = None, seed: int | None = None,
          *, simplify: bool = True, iterations: int | None = None, cspace: CSpace | None = None,
          all_queries: bool = False, slices: bool = False, on_progress=None, space: str | None = None,
-         slabs: int | None = None, turning_radius: float | None = None) -> PlanResult:
+         slabs: int | None = None, turning_radius: float | None = None, clearance: float | None = None,
+         objective: str = "length") -> PlanResult:
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
@@ -172,12 +198,26 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     shortest Dubins (forward only) or Reeds–Shepp (forward and reverse) curve, certified
     segment by segment; ``PlanResult.curves`` holds each motion's segments.
 
+    ``clearance=D`` (over the file's ``clearance``) inflates the robot by a polygon
+    containing the disk of radius D (:mod:`cspace.margin`): every path then keeps the
+    robot at least D from every obstacle (``exact``: the shortest such path). Each solved
+    result carries ``min_clearance`` (exact in translation, a certified lower bound in
+    SE(2)), where it occurs, and ``touches``. ``objective`` is ``length`` (default),
+    ``clearance`` or ``balanced`` (:mod:`planners.objectives`).
+
     >>> import os
     >>> res = plan(os.path.join(os.path.dirname(__file__), "..", "scenarios", "basic.toml"), seed=3)
     >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
     (True, [1.0, 1.0], [9.0, 9.0])
     """
     sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space, turning_radius)
+    sc = _with_clearance(sc, clearance)
+    try:
+        from .objectives import check_objective
+
+        objective = check_objective(objective, name)
+    except ValueError as exc:
+        raise ScenarioError("plan()", "objective", str(exc)) from None
     se2 = sc.rotates  # SE(2) or a car: poses (x, y, theta) over the sliced C-space
     if slabs is not None and not se2:
         raise ScenarioError("plan()", "slabs", 'applies to a rotating robot only (space = "se2", "dubins" or '
@@ -193,8 +233,12 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         build_s = _now() - t0
     else:
         build_s = 0.0
+        _check_margin(sc, cspace)
     report = cspace.report()
     adapter = _adapter(sc, cspace)
+    if objective != "length" and not hasattr(adapter, "clearance_functions"):
+        raise ScenarioError("plan()", "objective", f"{objective} is not available for space {sc.space!r} "
+                                                   "(translation and se2 only)")
     queries = sc.all_queries() if all_queries else sc.all_queries()[:1]
     src = sc.path or "<scenario>"
     poses = []
@@ -203,7 +247,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         for pt, fld in zip(pair, ("start", "goal")):
             if not adapter.is_free(pt):
                 label = fld if i == 0 else f"queries[{i - 1}].{fld}"
-                raise ScenarioError(src, label, f"{pt} is not a free state of the C-space")
+                why = (f" with clearance {sc.clearance:g} (the robot there is closer than that to an obstacle)"
+                       if sc.clearance > 0 else " with the margin" if sc.margin is not None else "")
+                raise ScenarioError(src, label, f"{pt} is not a free state of the C-space{why}")
         poses.append(pair)
     if name == "exact" and se2:
         from .exact import exact_se2
@@ -217,13 +263,15 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         from .routine import run_planner
 
         results = run_planner(adapter, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
-                              slices=slices, on_progress=on_progress, scenario=sc.name)
+                              slices=slices, on_progress=on_progress, scenario=sc.name, objective=objective)
         if se2:
             _explain_se2_failures(sc, queries, results)
         if hasattr(adapter, "curves"):
             for r in results:
                 r.curves = adapter.curves(r.path) if r.solved else []
     for r in results:
+        r.clearance, r.objective = sc.clearance, objective
+        _measure_clearance(r, adapter)
         r.timings = {"load": load_s, "cspace": build_s, **r.timings}
         r.stages = _stage_names(report) + r.stages
         r.cspace_report = report
@@ -239,6 +287,43 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
 
 def _now() -> float:
     return time.perf_counter()
+
+
+def _with_clearance(sc: Scenario, clearance) -> Scenario:
+    """The scenario with the margin D of ``plan(clearance=D)`` (the file's when None)."""
+    if clearance is None:
+        return sc
+    if isinstance(clearance, bool) or not isinstance(clearance, (int, float)) or not math.isfinite(clearance) \
+            or clearance < 0:
+        raise ScenarioError("plan()", "clearance", f"must be a finite distance >= 0, got {clearance!r}")
+    if float(clearance) == sc.clearance:
+        return sc
+    import dataclasses
+
+    return dataclasses.replace(sc, clearance=float(clearance))
+
+
+def _check_margin(sc: Scenario, cspace) -> None:
+    """A C-space passed in must have been built with the margin the plan asks for."""
+    want, have = sc.margins(), getattr(cspace, "margin", [])
+    if len(want) != len(have) or not all(np.array_equal(a, b) for a, b in zip(want, have)):
+        raise ScenarioError("plan()", "cspace", f"was built with another margin than clearance {sc.clearance:g}"
+                                                f"{' and [margin]' if sc.margin is not None else ''}: build it from "
+                                                f"the same scenario and clearance, or pass none")
+
+
+def _measure_clearance(r: PlanResult, adapter) -> None:
+    """Fill a solved result's min_clearance (timed as ``clearance``) and ``touches``."""
+    measure = getattr(adapter, "path_clearance", None)  # a car's curves: not measured (yet)
+    if not r.solved or not len(r.path) or measure is None:
+        return
+    t = _now()
+    c = measure(r.path)
+    r.timings["clearance"] = _now() - t
+    r.min_clearance, r.min_clearance_bound = float(c.distance), c.bound
+    r.min_clearance_at = tuple(c.where) or None
+    r.min_clearance_obstacle = tuple(c.obstacle_point) or None
+    r.touches = c.distance == 0.0 and c.bound == "exact"
 
 
 def _stage_names(report: dict) -> list[str]:

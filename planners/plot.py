@@ -26,6 +26,7 @@ GOAL = "#c0392b"
 FAILED = "#d6007a"  # magenta: apart from the goal's red and the path's blue
 BOUNDS = "#888888"
 GAP = "#7b2cbf"
+CLOSEST = "#e67e00"  # the closest approach: orange, apart from every other colour
 
 # A passage narrower than this fraction of the scene's size gets an inset zoom.
 GAP_FRACTION = 0.01
@@ -88,6 +89,9 @@ LEGEND = {
     "failed": ("no path found (start to goal)",
                lambda point: _line(color=FAILED, lw=2.0, ls="--", marker="x", ms=8, mew=2.0)),
     "gap": ("narrowest gap (zoomed)", lambda point: _line(color=GAP, lw=1.5, marker="|", ms=6)),
+    "closest": ("closest approach (min clearance)",
+                lambda point: _line(color=CLOSEST, lw=1.2, ls=":", marker="*", ms=9)),
+    "margin": ("robot with its safety margin", lambda point: _line(color=CLOSEST, lw=0.9, ls="--")),
 }
 
 
@@ -156,6 +160,41 @@ def draw_robot(ax, scenario, x: float, y: float, theta: float = 0.0, color=ROBOT
         ax.add_patch(_poly_patch(part, facecolor=color if fill else "none", edgecolor=color,
                                  alpha=alpha, linewidth=0.8))
     ax.plot([x], [y], ".", color=color, markersize=3)
+
+
+def draw_closest(ax, scenario, res) -> list[str]:
+    """The closest approach of a solved path: the robot there (with its margin, dashed, if
+    the plan kept one), a star on the obstacle's closest point, a dotted line to the
+    robot's, and the clearance written beside it. Returns the legend keys drawn."""
+    if not res.solved or not res.min_clearance_obstacle or not res.min_clearance_at:
+        return []
+    from cspace.gjk import gjk_distance
+    from cspace.slab import rotate
+
+    pose = tuple(res.min_clearance_at) + (0.0,) * (3 - len(res.min_clearance_at))
+    x, y, th = pose[:3]
+    ob = np.array(res.min_clearance_obstacle, dtype=np.float64)
+    parts = scenario.robot_at(x, y, th) if not scenario.is_point_robot else [np.array([[x, y]])]
+    near = min((gjk_distance(p, ob[None, :]) for p in parts), key=lambda d: d.distance).point_a
+    keys = ["closest"]
+    draw_robot(ax, scenario, x, y, th, color=CLOSEST, alpha=0.8, fill=False)
+    margins = scenario.margins()
+    if margins:
+        from cspace.minkowski import minkowski_sum
+
+        body = [s.polygon for s in scenario.robot] or [np.zeros((1, 2))]
+        for part in body:
+            ops = [rotate(m, th) if th else m for m in margins]
+            inflated = minkowski_sum(rotate(part, th) if th else part, *ops) + (x, y)
+            ax.add_patch(_poly_patch(inflated, facecolor="none", edgecolor=CLOSEST, linewidth=0.9, ls="--"))
+        keys.append("margin")
+    ax.plot([near[0], ob[0]], [near[1], ob[1]], ":", color=CLOSEST, linewidth=1.2)
+    ax.plot([ob[0]], [ob[1]], "*", color=CLOSEST, markersize=11, markeredgecolor="black", markeredgewidth=0.4)
+    word = "≥" if res.min_clearance_bound == "lower" else "="
+    ax.annotate(f"clearance {word} {res.min_clearance:.3g}", ob, xytext=(6, 6), textcoords="offset points",
+                fontsize=8, color="black", bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": CLOSEST,
+                                                 "alpha": 0.9})
+    return keys
 
 
 def _poses(path: np.ndarray, k: int) -> np.ndarray:
@@ -325,8 +364,14 @@ def figure_result(res, scenario=None, cspace=None, poses: int = 4):
     fig, ax = _new_figure(sc, wide=gap is not None)
     keys = draw_scene(ax, sc, cs)
     keys += _draw_queries(ax, sc, results, poses)
+    if len(results) == 1:
+        keys += draw_closest(ax, sc, res)
     _frame(ax, sc.bounds)
     labels = {}
+    if len(results) == 1 and res.min_clearance is not None and "closest" in keys:
+        labels["closest"] = f"closest approach (clearance {res.min_clearance:.3g})"
+        if sc.clearance > 0:
+            labels["margin"] = f"robot with its safety margin {sc.clearance:g}"
     if len(results) == 1:
         status = f"length {res.length:.4g}" if res.solved else "not solved"
         ax.set_title(f"{sc.name}: {res.planner}, seed {res.seed}, {status}")  # no wall time: same plan, same picture

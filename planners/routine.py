@@ -56,7 +56,8 @@ def _now() -> float:
 
 def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *,
                 iterations: int | None = None, simplify: bool = True, slices: bool = False,
-                on_progress=None, scenario: str = "", until_first: bool = False) -> list[PlanResult]:
+                on_progress=None, scenario: str = "", until_first: bool = False,
+                objective: str = "length") -> list[PlanResult]:
     """THE planning routine: one OMPL planner over a state-space adapter, for each query.
 
     ``space`` is an adapter of :mod:`planners.spaces`; ``queries`` is a list of
@@ -75,13 +76,16 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
     planner stops at its first exact solution, by OMPL's own rule: the path-length
     objective gets an infinite cost threshold, which any solution satisfies. No slices
     are needed then: the first solution is the end of the solve.
+    ``objective`` (:mod:`planners.objectives`): ``length`` (OMPL's default, nothing set),
+    ``clearance`` (maximise the minimum clearance) or ``balanced``; it matters to the
+    optimising planners (RRTstar, PRMstar, BITstar, ...).
     """
     key = name.lower()
     out = []
     held = [None]  # the roadmap planners' setup, kept from query to query
     for i, (start, goal) in enumerate(queries):
         args = (space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify,
-                slices and not until_first, on_progress, scenario, until_first)
+                slices and not until_first, on_progress, objective, scenario, until_first)
         if tuple(start) == tuple(goal):  # nothing to plan: the one-point path
             out.append(_trivial(space, name, seed, scenario, start, goal))
         elif key == "aorrtc" and space.verify(np.array([start, goal], dtype=np.float64), start, goal)[0]:
@@ -94,7 +98,7 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
 
 
 def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify, slices,
-                on_progress, scenario, until_first=False) -> PlanResult:
+                on_progress, objective, scenario, until_first=False) -> PlanResult:
     from .ompl_glue import configure, make_setup, set_query, stop_at_first
 
     t0 = _now()
@@ -103,6 +107,12 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
         configure(held[0][0].getPlanner(), name, iterations)
         if until_first and key in ANYTIME:
             stop_at_first(held[0][0])
+        if objective != "length":
+            from .objectives import make_objective
+
+            obj = make_objective(objective, held[0][0].getSpaceInformation(), space)
+            held[0][0].setOptimizationObjective(obj)
+            held[0] = (*held[0], obj)  # OMPL holds the objective by reference: keep it alive
     else:
         held[0][0].getPlanner().clearQuery()  # keep the roadmap, drop the old start and goal
     ss = held[0][0]
@@ -116,6 +126,8 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
     found = ss.haveExactSolutionPath()
     raw = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
     t2 = _now()
+    # OMPL's simplifier shortens paths, trading clearance away: kept for the length objective only.
+    simplify = simplify and objective == "length"
     if found and simplify:
         ss.simplifySolution()
     simp_s = _now() - t2 if found and simplify else 0.0

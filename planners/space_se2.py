@@ -35,6 +35,39 @@ class SE2Space:
         self.cspace = cspace
         self.k = frame_exponent(cspace.bounds) if k is None else int(k)
 
+    def clearance_functions(self):
+        """``(state -> clearance, (state, state) -> clearance)`` on OMPL states: the GJK
+        distance from the (inflated) robot at the pose to the nearest obstacle piece; a
+        motion takes the least of its two ends and its middle pose (a sample: this feeds
+        the optimisation objective only; the reported clearance is certified)."""
+        from cspace.clearance import Nearest
+        from cspace.se2_motion import interpolate
+        from cspace.slab import rotate_piece
+
+        near, k = Nearest(self.cspace.obstacle_pieces), -self.k
+        pieces = self.cspace.robot_pieces or [np.zeros((1, 2))]
+
+        def at(x: float, y: float, th: float) -> float:
+            return min(near.distance(rotate_piece(p, th) + (x, y)) if len(p) > 2 else near.distance(p + (x, y))
+                       for p in pieces)
+
+        def state(s) -> float:
+            return at(math.ldexp(s.getX(), k), math.ldexp(s.getY(), k), s.getYaw())
+
+        def motion(s1, s2) -> float:
+            q0 = (math.ldexp(s1.getX(), k), math.ldexp(s1.getY(), k), s1.getYaw())
+            q1 = (math.ldexp(s2.getX(), k), math.ldexp(s2.getY(), k), s2.getYaw())
+            return min(at(*q0), at(*q1), at(*interpolate(q0, q1, 0.5)))
+
+        return state, motion
+
+    def path_clearance(self, path: np.ndarray):
+        """A certified lower bound of the clearance of the ROBOT (body pieces, not inflated)
+        along ``path`` (:func:`cspace.clearance.se2_path_clearance`)."""
+        from cspace.clearance import se2_path_clearance
+
+        return se2_path_clearance(path, self.cspace.body_pieces, self.cspace.obstacle_pieces)
+
     def state_space(self):
         from .ompl_glue import ompl
 

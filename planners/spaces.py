@@ -150,6 +150,32 @@ class TranslationSpace:
         """Checks made so far: (state checks, motion checks)."""
         return self.cspace.point_count(), self.cspace.checks["segments"]
 
+    def clearance_functions(self):
+        """``(state -> clearance, (state, state) -> clearance)`` on OMPL states, in the
+        C-space's units: the distance from the reference point (from the segment, for a
+        motion) to the nearest C-obstacle edge, that is, for a free state or motion, how far
+        the robot (inflated by the margin, if any) is from touching an obstacle (floats, all
+        edges at once: :class:`cspace.clearance.EdgeDistance`)."""
+        from cspace.clearance import EdgeDistance
+
+        ed, k = EdgeDistance(self.cspace.pieces), -self.k
+        point, segment = ed.point, ed.segment
+
+        def state(s) -> float:
+            return point(math.ldexp(s[0], k), math.ldexp(s[1], k))
+
+        def motion(s1, s2) -> float:
+            return segment(math.ldexp(s1[0], k), math.ldexp(s1[1], k), math.ldexp(s2[0], k), math.ldexp(s2[1], k))
+
+        return state, motion
+
+    def path_clearance(self, path: np.ndarray):
+        """The exact clearance of the ROBOT (not inflated) swept along ``path``
+        (:func:`cspace.clearance.path_clearance`)."""
+        from cspace.clearance import path_clearance
+
+        return path_clearance(path, self.cspace.robot_pieces, self.cspace.obstacle_pieces)
+
 
 def verify_path(path: np.ndarray, start: tuple, goal: tuple, step_free, *, step: str = "segment",
                 test: str = "exact", ends: str = "start to goal") -> tuple[bool, str]:

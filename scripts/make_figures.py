@@ -223,6 +223,8 @@ def figures() -> list[Figure]:
         Figure("basic_plan", "basic", "first plan: basic.toml, RRTConnect", plan_figure("basic")),
         Figure("basic_cspace", "basic", "C-space of basic.toml", cspace_figure("basic")),
         Figure("basic_exact", "basic", "exact shortest path of basic.toml", plan_figure("basic", planner="exact")),
+        Figure("clearance_plan", "clearance", "clearance.toml: the exact path keeping a 0.3 margin",
+               plan_figure("clearance")),
     ]
     for fam in FAMILIES:
         out.append(Figure(f"{fam}_cspace", "families", f"C-space of {fam}.toml", cspace_figure(fam)))

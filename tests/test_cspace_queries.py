@@ -29,6 +29,30 @@ def _robot_swept(sc, a, b):
     return shapely.union_all(parts) if parts else shapely.LineString([a, b])
 
 
+def _with_margin(sc):
+    """The scenario whose robot is the robot inflated by its margin (issue 21), as the C-space
+    sees it: each convex part summed with the margin polygons, the hull of all vertex sums
+    (numpy + shapely), so the shapely oracle below checks the margin's C-space too."""
+    import dataclasses
+
+    from cspace.polygon import is_convex
+    from cspace.scenario import Shape
+
+    margins = sc.margins()
+    if not margins:
+        return sc
+    parts = [s.polygon for s in sc.robot] or [np.zeros((1, 2))]
+    assert all(len(p) < 3 or is_convex(p) for p in parts), "the oracle sums convex parts only"
+    robot = []
+    for p in parts:
+        pts = p
+        for m in margins:
+            pts = (pts[:, None, :] + m[None, :, :]).reshape(-1, 2)
+        hull = shapely.MultiPoint(pts).convex_hull
+        robot.append(Shape(np.asarray(hull.exterior.coords)[:-1][::1]))
+    return dataclasses.replace(sc, robot=robot)
+
+
 def _scenes():
     names = [os.path.join(OMPL_SCENES, f) for f in ("circles.toml", "env1.toml", "normal.toml")]
     if os.path.isdir(SCENARIOS):
@@ -42,7 +66,7 @@ def test_point_queries_agree_with_shapely(path):
     if len(sc.obstacles) > 300:
         pytest.skip("large scene: covered by the dedicated test")
     cs = CSpace.from_scenario(sc)
-    probe = CollisionProbe(sc)
+    probe = CollisionProbe(_with_margin(sc))
     rng = np.random.default_rng(1)
     xmin, xmax, ymin, ymax = sc.bounds
     pts = rng.uniform([xmin, ymin], [xmax, ymax], size=(1500, 2))
@@ -63,8 +87,9 @@ def test_segment_queries_agree_with_shapely(path):
     xmin, xmax, ymin, ymax = sc.bounds
     a = rng.uniform([xmin, ymin], [xmax, ymax], size=(300, 2))
     b = a + (rng.uniform([xmin, ymin], [xmax, ymax], size=(300, 2)) - a) * rng.uniform(0, 0.4, size=(300, 1))
+    inflated = _with_margin(sc)
     for p, q in zip(a, b):
-        ref = not obstacles.intersects(_robot_swept(sc, p, q))
+        ref = not obstacles.intersects(_robot_swept(inflated, p, q))
         assert cs.segment_free(p, q) == ref, (p, q)
 
 

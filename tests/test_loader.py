@@ -162,8 +162,9 @@ TRI = "[[0, 0], [1, 0], [0, 1]]"
         ("[planner]\nnmae = 'RRT'\n", "planner.nmae", "unknown field (did you mean name?)"),
         ("[[obstacle]]\ncenter = [5, 5]\nradius = 1\n", "obstacle", "unknown field (did you mean obstacles?)"),
         # Nothing close: the whole list, so the user still learns what is allowed.
-        ("colour = 3\n", "colour", "unknown field (expected one of: bounds, disk_tolerance, expect, goal, name, "
-                                   "obstacles, planner, queries, robot, slabs, space, start, turning_radius)"),
+        ("colour = 3\n", "colour", "unknown field (expected one of: bounds, clearance, disk_tolerance, expect, goal, "
+                                   "margin, name, obstacles, planner, queries, robot, slabs, space, start, "
+                                   "turning_radius)"),
         ("[robot]\nholes = []\n", "robot.holes", "unknown field (expected one of: parts, polygon, radius)"),
         # Two forms in one table.
         (f"[[obstacles]]\ncenter = [5, 5]\npolygon = {TRI}\n", "obstacles[0]", "center and polygon exclude each other"),
@@ -185,15 +186,18 @@ def test_messages_name_the_key_and_what_to_do(write_toml, extra, field, message)
 
 
 def test_the_known_keys_are_one_set_to_extend(write_toml, monkeypatch):
-    # A new top-level section (say `clearance`) is one entry in TOP_LEVEL_KEYS; suggestions follow it.
+    # A new top-level section (say `velocity`) is one entry in TOP_LEVEL_KEYS; suggestions follow it.
     from cspace import scenario
 
-    path = write_toml("clearence = 0.5\n" + BASE)
+    path = write_toml("velocty = 0.5\n" + BASE)
     with pytest.raises(ScenarioError, match="expected one of"):
         load_scenario(path)
-    monkeypatch.setattr(scenario, "TOP_LEVEL_KEYS", scenario.TOP_LEVEL_KEYS | {"clearance"})
-    with pytest.raises(ScenarioError, match=r"clearence: unknown field \(did you mean clearance\?\)"):
+    monkeypatch.setattr(scenario, "TOP_LEVEL_KEYS", scenario.TOP_LEVEL_KEYS | {"velocity"})
+    with pytest.raises(ScenarioError, match=r"velocty: unknown field \(did you mean velocity\?\)"):
         load_scenario(path)
+    # `clearance` was added that way (issue 21).
+    with pytest.raises(ScenarioError, match=r"clearence: unknown field \(did you mean clearance\?\)"):
+        load_scenario(write_toml("clearence = 0.5\n" + BASE, "c.toml"))
 
 
 def test_validity_is_checked_at_a_scale_geos_can_compute(write_toml):
