@@ -266,7 +266,7 @@ def import_cfg(path: str, options: ImportOptions) -> Imported:
                             "polygon has none)")
     imp.comments += [f"imported from {os.path.basename(path)} (OMPL.app 2-D problem: robot {pb['robot']}, "
                      f"world {pb['world']})",
-                     f"robot body frame: mean of its mesh vertices ({center[0]!r}, {center[1]!r}) in the mesh frame"]
+                     f"robot body frame: mean of its mesh vertices ({float(center[0])!r}, {float(center[1])!r}) in the mesh frame"]
     if control:
         imp.comments.append(f"kinodynamic in OMPL.app (control = {control}): here its geometric SE(2) problem")
     return imp

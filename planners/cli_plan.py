@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+import time
 
 from .ompl_glue import OMPL_HINT, ompl_available
 from .output import PLOT_FORMATS, check_distinct, check_output, write_json
@@ -121,6 +122,7 @@ def run(args) -> int:
         from cspace.imported import import_file
         from cspace.scenario import scenario_from_dict
 
+        t_import = time.perf_counter()
         imp = import_file(src, options)
         for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate")):
             if out is not None:
@@ -128,6 +130,7 @@ def run(args) -> int:
         for w in imp.warnings:
             sys.stderr.write(f"warning: {w}\n")
         scenario = scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
+        import_s = time.perf_counter() - t_import
     try:
         res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
                    simplify=not args.no_simplify, all_queries=args.all_queries,
@@ -138,6 +141,9 @@ def run(args) -> int:
         if exc.file == "plan()" and exc.field == "objective":  # the file's planner takes no objective
             raise InputError(src, "--objective", exc.message) from None
         raise
+    if options is not None:  # the import (meshes or map, then validation) is this run's load
+        res.timings["load"] = res.timings.get("load", 0.0) + import_s
+        res.timings["total"] = res.timings.get("total", 0.0) + import_s
     print(summary(res, verbose=args.verbose))
     if args.json is not None:
         write_json(args.json, res.as_dict(), "--json")
