@@ -12,29 +12,29 @@ import importlib
 
 # name -> the module (of this package) that defines it
 _NAMES = {
-    "orient2d": "predicates", "orient2d_many": "predicates", "cross_sign": "predicates",
-    "as_array": "polygon", "signed_area": "polygon", "normalize": "polygon", "is_convex": "polygon",
-    "is_simple": "polygon", "lowest_first": "polygon",
-    "disk_polygon": "disk", "disk_sides": "disk", "disk_error": "disk",
-    "Scenario": "scenario", "Shape": "scenario", "Query": "scenario", "ScenarioError": "scenario",
-    "load_scenario": "scenario", "scenario_from_dict": "scenario",
-    "convex_hull": "hull",
-    "minkowski_sum": "minkowski", "reflect": "minkowski",
-    "halfplanes": "halfplane", "support": "halfplane", "support_point": "halfplane", "erode": "halfplane",
-    "Distance": "gjk", "gjk_distance": "gjk", "gjk_intersects": "gjk",
-    "Penetration": "epa", "epa_penetration": "epa",
-    "convex_decompose": "decompose",
-    "pairwise_sums": "pairsums",
-    "convolution_cycles": "convolution", "convex_sums_with": "convolution",
-    "minkowski_pieces": "nonconvex", "minkowski_sum_nonconvex": "nonconvex",
-    "CSpace": "cspace", "decompose_obstacles": "cspace", "decompose_robot": "cspace",
-    "rotate": "slab", "rotate_piece": "slab", "wrap_angle": "slab", "slab_hull": "slab", "slab_inner": "slab",
-    "slab_pad": "slab", "slab_of": "slab", "slab_range": "slab", "inscribed_radius": "slab",
-    "inscribed_polygon": "slab", "default_slabs": "slab", "robot_radius": "slab",
-    "interpolate": "se2_motion",
-    "SE2CSpace": "se2",
-    "DirectChecker": "direct", "cspace_band": "direct",
-    "ShortestPath": "shortest", "shortest_path": "shortest",
+    "orient2d": "kernel.predicates", "orient2d_many": "kernel.predicates", "cross_sign": "kernel.predicates",
+    "as_array": "kernel.polygon", "signed_area": "kernel.polygon", "normalize": "kernel.polygon", "is_convex": "kernel.polygon",
+    "is_simple": "kernel.polygon", "lowest_first": "kernel.polygon",
+    "disk_polygon": "kernel.disk", "disk_sides": "kernel.disk", "disk_error": "kernel.disk",
+    "Scenario": "io.scenario", "Shape": "io.scenario", "Query": "io.scenario", "ScenarioError": "io.scenario",
+    "load_scenario": "io.scenario", "scenario_from_dict": "io.scenario",
+    "convex_hull": "kernel.hull",
+    "minkowski_sum": "kernel.minkowski", "reflect": "kernel.minkowski",
+    "halfplanes": "kernel.halfplane", "support": "kernel.halfplane", "support_point": "kernel.halfplane", "erode": "kernel.halfplane",
+    "Distance": "kernel.gjk", "gjk_distance": "kernel.gjk", "gjk_intersects": "kernel.gjk",
+    "Penetration": "kernel.epa", "epa_penetration": "kernel.epa",
+    "convex_decompose": "kernel.decompose",
+    "pairwise_sums": "kernel.pairsums",
+    "convolution_cycles": "kernel.convolution", "convex_sums_with": "kernel.convolution",
+    "minkowski_pieces": "kernel.nonconvex", "minkowski_sum_nonconvex": "kernel.nonconvex",
+    "CSpace": "spaces.cspace", "decompose_obstacles": "spaces.cspace", "decompose_robot": "spaces.cspace",
+    "rotate": "kernel.slab", "rotate_piece": "kernel.slab", "wrap_angle": "kernel.slab", "slab_hull": "kernel.slab", "slab_inner": "kernel.slab",
+    "slab_pad": "kernel.slab", "slab_of": "kernel.slab", "slab_range": "kernel.slab", "inscribed_radius": "kernel.slab",
+    "inscribed_polygon": "kernel.slab", "default_slabs": "kernel.slab", "robot_radius": "kernel.slab",
+    "interpolate": "spaces.se2_motion",
+    "SE2CSpace": "spaces.se2",
+    "DirectChecker": "spaces.direct", "cspace_band": "spaces.direct",
+    "ShortestPath": "spaces.shortest", "shortest_path": "spaces.shortest",
 }
 
 __all__ = sorted(_NAMES)
@@ -46,7 +46,7 @@ def __getattr__(name: str):
         value = getattr(importlib.import_module("." + _NAMES[name], __name__), name)
         globals()[name] = value
         return value
-    try:  # a submodule: ``cspace.se2`` after ``import cspace``, as when every module loaded eagerly
+    try:  # a submodule: ``cspace.spaces.se2`` after ``import cspace``, as when every module loaded eagerly
         return importlib.import_module(f".{name}", __name__)
     except ModuleNotFoundError as exc:
         if exc.name != f"{__name__}.{name}":

@@ -11,7 +11,7 @@ budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns them 
 Planner Arena database) are written by :mod:`planners.bench_outputs`; the
 ``error_vs_time.png`` figure is drawn here.
 
-The reference is the exact shortest path (:mod:`cspace.shortest`), computed once per
+The reference is the exact shortest path (:mod:`cspace.spaces.shortest`), computed once per
 scenario in the parent. It is an infimum (it touches C-obstacle boundaries), so every
 verified planner path is at least as long: ``error = length / optimum - 1 >= 0``.
 
@@ -195,7 +195,7 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
     apart. With ``held``, ``held[file] = (scenario, cspace)`` keeps each built C-space
     for the runs. A missing or malformed file is a ScenarioError (exit 2).
     """
-    from cspace.scenario import load_scenario
+    from cspace.io.scenario import load_scenario
 
     from .plan import _build_cspace, plan
 
@@ -258,7 +258,7 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
     simplified and verified exactly, and a run is solved only if it passes.
     ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space.
     """
-    from cspace.scenario import load_scenario
+    from cspace.io.scenario import load_scenario
 
     from .plan import plan
 

@@ -37,12 +37,12 @@ HELP = {
 
 
 def clip(text: str, limit: int) -> str:
-    """:func:`cspace.scenario.clip`, imported when needed (it pulls in numpy).
+    """:func:`cspace.io.scenario.clip`, imported when needed (it pulls in numpy).
 
     >>> clip("abc", 10)
     'abc'
     """
-    from cspace.scenario import clip as _clip
+    from cspace.io.scenario import clip as _clip
 
     return _clip(text, limit)
 
@@ -116,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
     first = next((a for a in argv if not a.startswith("-")), None)
     parser = build_parser(first if first in COMMANDS else None)
     args = parser.parse_args(argv)
-    from cspace.scenario import ScenarioError
+    from cspace.io.scenario import ScenarioError
 
     try:
         with warnings.catch_warnings():

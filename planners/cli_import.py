@@ -43,9 +43,9 @@ IMPORT_FLAGS = ("robot", "radius", "polygon", "start", "goal", "unknown", "toler
 
 
 def import_options(args, src: str):
-    """The :class:`cspace.imported.ImportOptions` of the parsed options; for a file that
+    """The :class:`cspace.io.imported.ImportOptions` of the parsed options; for a file that
     is not imported (a scenario TOML) any of them is an error."""
-    from cspace.imported import ImportOptions, is_import
+    from cspace.io.imported import ImportOptions, is_import
 
     given = [f for f in IMPORT_FLAGS if getattr(args, f, None) is not None]
     if not is_import(src):
@@ -87,7 +87,7 @@ def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
 
 def read_robot(path: str) -> dict:
     """The ``[robot]`` table of a TOML file (a robot file, or any scenario)."""
-    from cspace.scenario import read_input, toml_reader
+    from cspace.io.scenario import read_input, toml_reader
 
     tomllib = toml_reader()
     raw = read_input(path)
@@ -102,8 +102,8 @@ def read_robot(path: str) -> dict:
 
 
 def run(args) -> int:
-    from cspace.imported import import_file, is_import, to_toml
-    from cspace.scenario import check_input, scenario_from_dict
+    from cspace.io.imported import import_file, is_import, to_toml
+    from cspace.io.scenario import check_input, scenario_from_dict
 
     from .output import check_output, write_text
 

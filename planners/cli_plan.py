@@ -59,7 +59,7 @@ def integer(s: str) -> int:
 
 
 def run(args) -> int:
-    from cspace.scenario import check_input
+    from cspace.io.scenario import check_input
 
     from .errors import InputError
 
@@ -115,12 +115,12 @@ def run(args) -> int:
         from .ompl_glue import ompl
 
         ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
-    from cspace.scenario import ScenarioError
+    from cspace.io.scenario import ScenarioError
 
     scenario = src
     if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
-        from cspace.imported import import_file
-        from cspace.scenario import scenario_from_dict
+        from cspace.io.imported import import_file
+        from cspace.io.scenario import scenario_from_dict
 
         t_import = time.perf_counter()
         imp = import_file(src, options)

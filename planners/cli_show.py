@@ -25,7 +25,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from cspace.scenario import check_input, load_scenario
+    from cspace.io.scenario import check_input, load_scenario
 
     from .errors import InputError
 
@@ -36,7 +36,7 @@ def run(args) -> int:
     if args.json is not None:
         check_output(args.json, "--json", inputs=[args.scenario])
     check_distinct([(args.json, "--json"), (args.plot, "--plot")])
-    from cspace.cspace import CSpace
+    from cspace.spaces.cspace import CSpace
 
     from .cli_import import import_options
 
@@ -72,8 +72,8 @@ def _show_se2(sc, args, fmt) -> int:
     slab hulls, free there means free at every angle of the slab) and the report."""
     import math
 
-    from cspace.se2 import SE2CSpace
-    from cspace.slab import slab_range, wrap_angle
+    from cspace.spaces.se2 import SE2CSpace
+    from cspace.kernel.slab import slab_range, wrap_angle
 
     from .errors import InputError
 

@@ -1,6 +1,6 @@
 """The ``exact`` planner: the true shortest path over the C-space, as a PlanResult.
 
-The geometry lives in :mod:`cspace.shortest` (a reduced visibility graph over the
+The geometry lives in :mod:`cspace.spaces.shortest` (a reduced visibility graph over the
 C-obstacle corners, searched lazily with A*). Here it is only wrapped so that it
 answers like any other planner: ``cspace plan --planner exact`` or
 ``planners.shortest_path(scenario)``.
@@ -29,7 +29,7 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
     (nodes settled, and a lower bound on the length that rises towards the answer);
     ``progress=False`` silences it, ``None`` draws it only when stderr is a terminal.
     """
-    from cspace.shortest import shortest_path as geometric_shortest
+    from cspace.spaces.shortest import shortest_path as geometric_shortest
 
     from . import progress as pg
 
@@ -76,7 +76,7 @@ def exact_se2(sc, query, source: str, time_limit: float | None = None) -> PlanRe
     rule (:mod:`planners.se2_bounds`) may prove the query unsolvable; then the result says
     so (not solved, exit 1). Otherwise a ScenarioError on ``planner`` (exit 2) says what to
     use instead."""
-    from cspace.scenario import ScenarioError
+    from cspace.io.scenario import ScenarioError
 
     from .se2_bounds import disk_bound
 

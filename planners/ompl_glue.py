@@ -11,7 +11,7 @@ import contextlib
 import os
 import sys
 
-from cspace.scenario import ScenarioError
+from cspace.io.scenario import ScenarioError
 
 from .spaces import frame_exponent  # noqa: F401  (re-exported: scripts use it from here)
 
@@ -171,7 +171,7 @@ def clearance_checker(si, cspace):
                 return self.is_free_xy(state[0], state[1])
 
             def clearance(self, state):
-                return self.cspace.clearance((state[0], state[1]))
+                return self.cspace.spaces.clearance((state[0], state[1]))
 
         _classes["checker"] = CSpaceValidityChecker
     return _classes["checker"](si, cspace)

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cspace.cspace import CSpace
-from cspace.scenario import Scenario, ScenarioError, load_scenario
+from cspace.spaces.cspace import CSpace
+from cspace.io.scenario import Scenario, ScenarioError, load_scenario
 
 
 @dataclass
@@ -45,7 +45,7 @@ class PlanResult:
     # solve) and [time, best raw length] pairs along the run (the bench's anytime curve).
     first_solution: float | None = None
     progress: list = field(default_factory=list)
-    # Clearance (filled by plan() on solved paths; cspace.clearance): the smallest distance
+    # Clearance (filled by plan() on solved paths; cspace.spaces.clearance): the smallest distance
     # between the ROBOT (not inflated) swept along the path and any obstacle, the reference
     # pose where it occurs, the obstacle's closest point, "exact" (translation) or "lower"
     # (SE(2): a certified lower bound); ``touches``: the path touches an obstacle (distance 0,
@@ -188,7 +188,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
 
     ``space="se2"`` (or ``space = "se2"`` in the file) lets the robot rotate: poses and
     the path's rows are (x, y, theta), the C-space is the sliced
-    :class:`cspace.se2.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
+    :class:`cspace.spaces.se2.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
     derived from the scene) and every motion is certified along OMPL's SE(2)
     interpolation. There is no exact planner in SE(2); ``planner="exact"`` there
     answers only when the inscribed-disk rule proves the scene unsolvable.
@@ -199,7 +199,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     segment by segment; ``PlanResult.curves`` holds each motion's segments.
 
     ``clearance=D`` (over the file's ``clearance``) inflates the robot by a polygon
-    containing the disk of radius D (:mod:`cspace.margin`): every path then keeps the
+    containing the disk of radius D (:mod:`cspace.kernel.margin`): every path then keeps the
     robot at least D from every obstacle (``exact``: the shortest such path). Each solved
     result carries ``min_clearance`` (exact in translation, a certified lower bound in
     SE(2)), where it occurs, and ``touches``. ``objective`` is ``length`` (default),
@@ -336,7 +336,7 @@ def _stage_names(report: dict) -> list[str]:
 def _build_cspace(sc: Scenario, slabs: int | None = None):
     """The C-space a scenario's state space needs: translation, or sliced SE(2)."""
     if sc.rotates:
-        from cspace.se2 import SE2CSpace
+        from cspace.spaces.se2 import SE2CSpace
 
         return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)
     return CSpace.from_scenario(sc)

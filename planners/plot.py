@@ -168,8 +168,8 @@ def draw_closest(ax, scenario, res) -> list[str]:
     robot's, and the clearance written beside it. Returns the legend keys drawn."""
     if not res.solved or not res.min_clearance_obstacle or not res.min_clearance_at:
         return []
-    from cspace.gjk import gjk_distance
-    from cspace.slab import rotate
+    from cspace.kernel.gjk import gjk_distance
+    from cspace.kernel.slab import rotate
 
     pose = tuple(res.min_clearance_at) + (0.0,) * (3 - len(res.min_clearance_at))
     x, y, th = pose[:3]
@@ -180,7 +180,7 @@ def draw_closest(ax, scenario, res) -> list[str]:
     draw_robot(ax, scenario, x, y, th, color=CLOSEST, alpha=0.8, fill=False)
     margins = scenario.margins()
     if margins:
-        from cspace.minkowski import minkowski_sum
+        from cspace.kernel.minkowski import minkowski_sum
 
         body = [s.polygon for s in scenario.robot] or [np.zeros((1, 2))]
         for part in body:
@@ -305,8 +305,8 @@ def _new_figure(sc, wide: bool = False):
 
 def narrow_gap(sc, cspace, results: list):
     """The narrowest gap along the solved paths when under :data:`GAP_FRACTION` of the scene, else None."""
-    from cspace.gap import narrowest_gap
-    from cspace.shortest import free_space
+    from cspace.spaces.gap import narrowest_gap
+    from cspace.spaces.shortest import free_space
 
     paths = [r.path for r in results if r.solved and len(r.path) > 1]
     if not paths or cspace is None:
@@ -351,7 +351,7 @@ def draw_inset(ax, sc, cspace, results: list, gap) -> object:
 
 def figure_result(res, scenario=None, cspace=None, poses: int = 4):
     """The Figure of a plan result (one query, or every query of ``--all-queries``)."""
-    from cspace.cspace import CSpace
+    from cspace.spaces.cspace import CSpace
 
     sc = scenario or res.scenario_data
     if sc is None:

@@ -1,13 +1,13 @@
 """Car-like state spaces: OMPL's Dubins and Reeds–Shepp spaces over the sliced SE(2) C-space.
 
-A car is a rotating robot (poses (x, y, theta), the C-space of :mod:`cspace.se2`)
+A car is a rotating robot (poses (x, y, theta), the C-space of :mod:`cspace.spaces.se2`)
 whose motions are not straight lines in SE(2) but the shortest Dubins curves
 (forward only) or Reeds–Shepp curves (forward and reverse) of a minimum turning
 radius. OMPL's ``DubinsStateSpace`` / ``ReedsSheppStateSpace`` give the planners
 their metric and interpolation; every motion the planners ask about is recomputed
-here as its segments (:mod:`cspace.car_curves`, checked against OMPL's own
+here as its segments (:mod:`cspace.spaces.car_curves`, checked against OMPL's own
 ``distance`` and ``interpolate`` by the tests) and certified segment by segment
-(:meth:`cspace.se2.SE2CSpace.curve_free`: exact straight segments, arcs bounded by
+(:meth:`cspace.spaces.se2.SE2CSpace.curve_free`: exact straight segments, arcs bounded by
 hulls about the turning centre), never sampled.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from cspace.car_curves import curve_length, dubins_segments, knots, pose_along, reeds_shepp_segments
+from cspace.spaces.car_curves import curve_length, dubins_segments, knots, pose_along, reeds_shepp_segments
 
 from .space_se2 import SE2Space
 from .spaces import verify_path
@@ -64,7 +64,7 @@ class CarSpace(SE2Space):
 
     def motion_free(self, q0, q1) -> bool:
         """Whether the car, driven along the shortest curve from q0 to q1, touches nothing
-        (certified: :meth:`cspace.se2.SE2CSpace.curve_free`)."""
+        (certified: :meth:`cspace.spaces.se2.SE2CSpace.curve_free`)."""
         return self.cspace.curve_free(q0, self.segments(q0, q1), self.radius, q1=q1)
 
     def motion_validator(self, si):

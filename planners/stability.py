@@ -248,7 +248,7 @@ def _pred_near_line(scale: float, offset: float, n: int = 400, seed: int = 0) ->
 
 def _pred_case(triples: list):
     def run():
-        from cspace.predicates import orient2d
+        from cspace.kernel.predicates import orient2d
 
         signs, dt = _timed(lambda: [orient2d(a, b, c) for a, b, c in triples])
         ref = [_orient_exact(a, b, c) for a, b, c in triples]
@@ -355,7 +355,7 @@ def vertex_error(out: np.ndarray, ref: list) -> float:
 
 
 def _strictly_convex(out: np.ndarray) -> bool:
-    from cspace.predicates import orient2d_many
+    from cspace.kernel.predicates import orient2d_many
 
     if len(out) < 3:
         return True
@@ -427,7 +427,7 @@ def exact_erosion(A: list, B: list) -> list:
 def _erode_case(A, B):
     def run():
         from cspace import erode
-        from cspace.halfplane import erode_exact
+        from cspace.kernel.halfplane import erode_exact
 
         a, b = np.asarray(A, dtype=np.float64), np.asarray(B, dtype=np.float64)
         out, dt = _timed(erode, a, b)
@@ -516,7 +516,7 @@ def _gjk_case(A, B, expect: str | None = None):
 def _epa_case(A, B, expect: str | None = None):
     def run():
         from cspace import epa_penetration
-        from cspace.epa import EPA_TOL
+        from cspace.kernel.epa import EPA_TOL
 
         a, b = np.asarray(A, dtype=np.float64), np.asarray(B, dtype=np.float64)
         p, dt = _timed(epa_penetration, a, b)

@@ -12,10 +12,10 @@ import time
 
 import numpy as np
 
-from cspace.epa import epa_penetration
-from cspace.gjk import exact_relation, gjk_distance
-from cspace.hull import convex_hull
-from cspace.minkowski import minkowski_sum, reflect
+from cspace.kernel.epa import epa_penetration
+from cspace.kernel.gjk import exact_relation, gjk_distance
+from cspace.kernel.hull import convex_hull
+from cspace.kernel.minkowski import minkowski_sum, reflect
 
 
 def rand_convex(rng, n, c):

@@ -13,7 +13,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchutil import median_time  # noqa: E402
-from cspace.minkowski import minkowski_sum
+from cspace.kernel.minkowski import minkowski_sum
 
 
 def random_convex(n, rng, span=2**20):

@@ -50,8 +50,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 
-from cspace.cspace import CSpace, decompose_obstacles, decompose_robot  # noqa: E402
-from cspace.scenario import load_scenario  # noqa: E402
+from cspace.spaces.cspace import CSpace, decompose_obstacles, decompose_robot  # noqa: E402
+from cspace.io.scenario import load_scenario  # noqa: E402
 from planners.routine import run_planner  # noqa: E402
 from planners.spaces import TranslationSpace  # noqa: E402
 
@@ -226,7 +226,7 @@ def scenes(names=None) -> list[str]:
 
 def unsolvable(sc, cs) -> bool:
     """Proven unsolvable by the exact planner (2 s; undecided counts as solvable)."""
-    from cspace.shortest import shortest_path
+    from cspace.spaces.shortest import shortest_path
 
     return bool(shortest_path(cs.pieces, cs.bounds, sc.start[:2], sc.goal[:2], time_limit=2.0).proven_unsolvable)
 

@@ -47,9 +47,9 @@ sys.path.insert(0, ROOT)
 
 from sweep_oracle import sweep_check  # noqa: E402
 
-from cspace.cspace import CSpace  # noqa: E402
-from cspace.scenario import load_scenario  # noqa: E402
-from cspace.se2 import SE2CSpace  # noqa: E402
+from cspace.spaces.cspace import CSpace  # noqa: E402
+from cspace.io.scenario import load_scenario  # noqa: E402
+from cspace.spaces.se2 import SE2CSpace  # noqa: E402
 
 SE2_DIR = os.path.join(ROOT, "scenarios", "se2")
 VALIDITY_SCENES = ("car_maze.toml", "bug_trap.toml", "piano_corridor.toml")

@@ -115,8 +115,8 @@ def cspace_figure(scenario: str) -> Callable[[str], str]:
     """Workspace, C-obstacles and their convex pieces, as ``cspace show --plot``."""
 
     def draw(out: str) -> str:
-        from cspace.cspace import CSpace
-        from cspace.scenario import load_scenario
+        from cspace.spaces.cspace import CSpace
+        from cspace.io.scenario import load_scenario
         from planners.plot import plot_scene
 
         sc = load_scenario(_scenario(scenario))
@@ -153,7 +153,7 @@ def map_figure(seed: int = SEED) -> Callable[[str], str]:
     """The ROS map imported and planned, as ``cspace plan office.yaml --robot robot.toml --plot``."""
 
     def draw(out: str) -> str:
-        from cspace.imported import ImportOptions, load_imported
+        from cspace.io.imported import ImportOptions, load_imported
         from planners.cli_import import read_robot
         from planners.plan import plan
         from planners.plot import plot_result

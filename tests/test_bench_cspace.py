@@ -110,7 +110,7 @@ def test_point_test_matches_brute_force(bench, name):
     # The validity checker's hot path (grid + inlined narrow phase in MIXED cells)
     # against an exact brute force over every piece, on uniform states, piece
     # vertices and edge midpoints (on the boundary: not free) and points just off them.
-    from cspace.predicates import orient2d_many
+    from cspace.kernel.predicates import orient2d_many
 
     cs = CSpace.from_scenario(bench.ROOT / "scenarios" / name)
     xmin, xmax, ymin, ymax = cs.bounds

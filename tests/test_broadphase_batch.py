@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from conftest import SCENARIOS
-from cspace.broadphase import BLOCKED, MIXED, GridIndex
-from cspace.cspace import CSpace
-from cspace.disk import disk_polygon
+from cspace.spaces.broadphase import BLOCKED, MIXED, GridIndex
+from cspace.spaces.cspace import CSpace
+from cspace.kernel.disk import disk_polygon
 
 
 def reference(g: GridIndex, pieces):

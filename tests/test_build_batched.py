@@ -10,9 +10,9 @@ import pytest
 
 from conftest import SCENARIOS
 from cspace import CSpace, minkowski_sum, reflect
-from cspace.cspace import _contained_pieces, pair_sums
-from cspace.pieces import PieceSet
-from cspace.predicates import orient2d_many
+from cspace.spaces.cspace import _contained_pieces, pair_sums
+from cspace.kernel.pieces import PieceSet
+from cspace.kernel.predicates import orient2d_many
 
 
 def contained_reference(pieces):

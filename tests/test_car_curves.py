@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cspace.car_curves import (
+from cspace.spaces.car_curves import (
     _segments,
     advance,
     curve_length,
@@ -23,8 +23,8 @@ from cspace.car_curves import (
     reeds_shepp_segments,
     turning_centre,
 )
-from cspace.dubins import NEAR, dubins_candidates, dubins_frame
-from cspace.reeds_shepp import reeds_shepp_candidates, reeds_shepp_frame
+from cspace.spaces.dubins import NEAR, dubins_candidates, dubins_frame
+from cspace.spaces.reeds_shepp import reeds_shepp_candidates, reeds_shepp_frame
 
 RADII = (0.25, 1.0, 3.7)
 T_SAMPLES = (0.0, 0.07, 0.31, 0.5, 0.82, 0.999, 1.0)

@@ -1,4 +1,4 @@
-"""Certified car motions (cspace.car_motion): never a false "free" along a curve.
+"""Certified car motions (cspace.spaces.car_motion): never a false "free" along a curve.
 
 The judge is independent of cspace: scripts/sweep_oracle.py places the robot with
 shapely along each segment (translation for straight segments, shapely's rotation
@@ -14,8 +14,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import load_script
-from cspace.car_curves import advance, knots
-from cspace.se2 import SE2CSpace
+from cspace.spaces.car_curves import advance, knots
+from cspace.spaces.se2 import SE2CSpace
 
 oracle = load_script("sweep_oracle")
 

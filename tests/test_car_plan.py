@@ -16,8 +16,8 @@ import pytest
 
 import planners
 from conftest import ROOT, SCENARIOS, load_script
-from cspace.car_curves import curve_length, dubins_segments, reeds_shepp_segments
-from cspace.scenario import ScenarioError, load_scenario
+from cspace.spaces.car_curves import curve_length, dubins_segments, reeds_shepp_segments
+from cspace.io.scenario import ScenarioError, load_scenario
 
 CARS = sorted(glob.glob(os.path.join(SCENARIOS, "car", "*.toml")))
 oracle = load_script("sweep_oracle")

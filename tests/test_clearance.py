@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import shapely
 
-from cspace.cspace import CSpace
-from cspace.disk import disk_polygon, disk_sides
-from cspace.scenario import ScenarioError, scenario_from_dict
+from cspace.spaces.cspace import CSpace
+from cspace.kernel.disk import disk_polygon, disk_sides
+from cspace.io.scenario import ScenarioError, scenario_from_dict
 
 TOL = 0.05  # disk_tolerance of the random scenes: an 11-gon margin (few vertices for the oracle)
 
@@ -232,9 +232,9 @@ def test_point_robot_with_margin():
 
 
 def test_se2_lower_bound_never_exceeds_the_truth():
-    from cspace.clearance import se2_path_clearance
-    from cspace.se2_motion import interpolate
-    from cspace.slab import rotate
+    from cspace.spaces.clearance import se2_path_clearance
+    from cspace.spaces.se2_motion import interpolate
+    from cspace.kernel.slab import rotate
 
     rng = np.random.default_rng(3)
     obstacles = [np.array([[4., 4], [6, 4], [6, 6], [4, 6]]), np.array([[1., 7], [3, 7], [2, 9]])]
@@ -258,8 +258,8 @@ def test_se2_lower_bound_never_exceeds_the_truth():
 
 def test_se2_plan_keeps_the_margin(write_toml):
     from planners.plan import plan
-    from cspace.se2_motion import interpolate
-    from cspace.slab import rotate
+    from cspace.spaces.se2_motion import interpolate
+    from cspace.kernel.slab import rotate
 
     f = write_toml("""
         space = "se2"
@@ -374,7 +374,7 @@ def test_csv_of_se2_path_has_theta():
 
 def test_edge_distance_matches_shapely():
     """The objectives' clearance of a state or a motion: distance to the nearest C-obstacle edge."""
-    from cspace.clearance import EdgeDistance
+    from cspace.spaces.clearance import EdgeDistance
 
     rng = np.random.default_rng(0)
     pieces = [np.array([[4., 4], [6, 4], [6, 6], [4, 6]]), np.array([[1., 7], [3, 7], [2, 9]])]

@@ -9,12 +9,12 @@ import pytest
 import shapely
 from hypothesis import assume, given, settings, strategies as st
 
-from cspace.convolution import convex_sums_with, convolution_cycles
-from cspace.decompose import convex_decompose
-from cspace.hull import convex_hull
-from cspace.minkowski import minkowski_sum
-from cspace.nonconvex import _convolution_roles, _operand, _union_of_pairwise_sums, minkowski_sum_nonconvex
-from cspace.polygon import drop_collinear, is_simple, lowest_first, normalize
+from cspace.kernel.convolution import convex_sums_with, convolution_cycles
+from cspace.kernel.decompose import convex_decompose
+from cspace.kernel.hull import convex_hull
+from cspace.kernel.minkowski import minkowski_sum
+from cspace.kernel.nonconvex import _convolution_roles, _operand, _union_of_pairwise_sums, minkowski_sum_nonconvex
+from cspace.kernel.polygon import drop_collinear, is_simple, lowest_first, normalize
 
 from test_decompose import comb, reference_sum
 
@@ -135,7 +135,7 @@ def test_threads_give_the_very_same_regions(monkeypatch, threads):
 
 
 def test_a_failure_on_a_worker_thread_reaches_the_caller(monkeypatch):
-    import cspace.convolution as cv
+    import cspace.kernel.convolution as cv
 
     calls = []
 

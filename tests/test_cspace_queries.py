@@ -14,8 +14,8 @@ import pytest
 import shapely
 
 from cspace import load_scenario
-from cspace.cspace import CSpace
-from cspace.scenario import CollisionProbe
+from cspace.spaces.cspace import CSpace
+from cspace.io.scenario import CollisionProbe
 
 from conftest import OMPL_SCENES, SCENARIOS
 
@@ -35,8 +35,8 @@ def _with_margin(sc):
     (numpy + shapely), so the shapely oracle below checks the margin's C-space too."""
     import dataclasses
 
-    from cspace.polygon import is_convex
-    from cspace.scenario import Shape
+    from cspace.kernel.polygon import is_convex
+    from cspace.io.scenario import Shape
 
     margins = sc.margins()
     if not margins:
@@ -135,7 +135,7 @@ def test_pruning_drops_outside_and_contained_pieces():
 
 
 def test_clearance_matches_shapely_distance():
-    pytest.importorskip("cspace.gjk")
+    pytest.importorskip("cspace.kernel.gjk")
     sc = load_scenario(os.path.join(OMPL_SCENES, "circles.toml"))
     cs = CSpace.from_scenario(sc)
     union = shapely.union_all([shapely.Polygon(p) for p in cs.pieces])
@@ -154,7 +154,7 @@ def test_clearance_matches_shapely_distance():
 def test_mixed_cell_edge_masks_are_conservative(name):
     # The narrow phase of a MIXED cell skips a candidate's edges outside the cell's mask:
     # every point of the cell (and its margin) must lie strictly inside those edges' half-planes.
-    from cspace.predicates import orient2d_many
+    from cspace.kernel.predicates import orient2d_many
 
     cs = CSpace.from_scenario(load_scenario(os.path.join(SCENARIOS, name)))
     g = cs.index

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 import shapely
 
-from cspace.decompose import convex_decompose
-from cspace.minkowski import minkowski_sum
-from cspace.nonconvex import minkowski_pieces, minkowski_sum_nonconvex
-from cspace.polygon import is_convex
-from cspace.predicates import orient2d
+from cspace.kernel.decompose import convex_decompose
+from cspace.kernel.minkowski import minkowski_sum
+from cspace.kernel.nonconvex import minkowski_pieces, minkowski_sum_nonconvex
+from cspace.kernel.polygon import is_convex
+from cspace.kernel.predicates import orient2d
 
 
 def comb(teeth, w=1.0, gap=1.0, h=4.0, spine=1.0):

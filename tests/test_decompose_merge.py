@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from cspace import decompose as dc
-from cspace.polygon import normalize
-from cspace.predicates import CCW_ERRBOUND_A, orient2d_xy
+from cspace.kernel.polygon import normalize
+from cspace.kernel.predicates import CCW_ERRBOUND_A, orient2d_xy
 
 
 def reference(tris, pts, diagonals):

@@ -20,9 +20,9 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cspace.cspace import CSpace
-from cspace.direct import U, DirectChecker, cspace_band
-from cspace.scenario import load_scenario
+from cspace.spaces.cspace import CSpace
+from cspace.spaces.direct import U, DirectChecker, cspace_band
+from cspace.io.scenario import load_scenario
 
 SCENARIOS = sorted(glob.glob(os.path.join(os.path.dirname(os.path.dirname(__file__)), "scenarios", "*.toml")))
 # scene -> [uniform states, their disagreements, boundary states, their disagreements,

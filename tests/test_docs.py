@@ -110,7 +110,7 @@ def test_toml_block_loads_and_plans(doc, line, body, tmp_path):
         tomllib.loads(body)
         return
     import planners
-    from cspace.scenario import load_scenario
+    from cspace.io.scenario import load_scenario
 
     path = tmp_path / "block.toml"
     path.write_text(body, encoding="utf-8")

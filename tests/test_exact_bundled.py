@@ -15,7 +15,7 @@ import shapely
 
 from conftest import SCENARIOS
 from cspace import CSpace, load_scenario
-from cspace.shortest import shortest_path
+from cspace.spaces.shortest import shortest_path
 from test_shortest import brute_force
 
 TOO_LARGE = {"disks_cluttered.toml", "circles.toml", "env2.toml"}

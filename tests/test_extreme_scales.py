@@ -2,8 +2,8 @@
 
 Multiplying all coordinates by a power of two is exact, so this is an oracle for
 every function: exact ones must agree bit for bit, float ones to their own
-tolerance. Before the rescaling of :mod:`cspace.scaling` and the exact orientation
-of :func:`cspace.polygon.orientation`, GJK and EPA answered wrongly from 2^-400 and
+tolerance. Before the rescaling of :mod:`cspace.kernel.scaling` and the exact orientation
+of :func:`cspace.kernel.polygon.orientation`, GJK and EPA answered wrongly from 2^-400 and
 2^700 on, GEOS's triangulation raised from 2^±700, and normalize turned a CCW
 polygon clockwise at 2^-600 (its shoelace area underflowed to 0).
 """
@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import cspace as C
-from cspace.polygon import normalize, orientation
+from cspace.kernel.polygon import normalize, orientation
 
 SCALES = [-1000, -700, -400, 400, 700, 1000]
 
@@ -164,7 +164,7 @@ def test_cspace_outside_its_range_is_a_value_error():
 def test_disk_sides_with_a_tolerance_too_small_to_show():
     # radius 5e-324: its relative tolerance underflows to 0, and 1 - 1e-300 rounds to 1;
     # both divided by acos(1) = 0 before. The finest polygon is the answer.
-    from cspace.disk import MAX_SIDES, disk_sides
+    from cspace.kernel.disk import MAX_SIDES, disk_sides
 
     assert disk_sides(5e-324) == MAX_SIDES
     assert disk_sides(1.0, 1e-300) == MAX_SIDES

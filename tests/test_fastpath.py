@@ -1,4 +1,4 @@
-"""The compiled fast path (cspace/_fast.c) against the pure-Python path, its oracle.
+"""The compiled fast path (cspace/spaces/_fast.c) against the pure-Python path, its oracle.
 
 Every answer the C routines give must be the exact one: on random and degenerate
 queries (integer scenes, segments through vertices and along edges, zero-length
@@ -15,8 +15,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cspace import CSpace, fastpath
-from cspace.predicates import orient2d_exact
+from cspace import CSpace
+
+from cspace.spaces import fastpath
+from cspace.kernel.predicates import orient2d_exact
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 needs_c = pytest.mark.skipif(not fastpath.ENABLED, reason="compiled fast path not built (or CSPACE_PURE=1)")
@@ -115,7 +117,7 @@ def test_nonfinite_and_out_of_bounds_go_to_python():
 
 def test_cspace_pure_forces_the_pure_path():
     env = dict(os.environ, CSPACE_PURE="1")
-    out = subprocess.run([sys.executable, "-c", "import cspace.fastpath as f; print(f.ENABLED)"],
+    out = subprocess.run([sys.executable, "-c", "import cspace.spaces.fastpath as f; print(f.ENABLED)"],
                          env=env, capture_output=True, text=True, cwd=ROOT, check=True)
     assert out.stdout.strip() == "False"
 

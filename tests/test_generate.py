@@ -6,7 +6,7 @@ import sys
 import pytest
 
 import planners
-from cspace.scenario import load_scenario
+from cspace.io.scenario import load_scenario
 from planners.generate import generate
 
 

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 import shapely
 
-from cspace.epa import epa_penetration
-from cspace.gjk import exact_relation, gjk_distance, gjk_intersects
-from cspace.hull import convex_hull
+from cspace.kernel.epa import epa_penetration
+from cspace.kernel.gjk import exact_relation, gjk_distance, gjk_intersects
+from cspace.kernel.hull import convex_hull
 
 SQ = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 
@@ -110,7 +110,7 @@ def test_degenerate_corpus_never_nan():
 
 
 def test_relation_skips_hull_only_for_strictly_convex_ccw_input():
-    from cspace.gjk import _as_hull
+    from cspace.kernel.gjk import _as_hull
 
     t = np.arange(5) * 2 * np.pi / 5
     pent = np.round(np.c_[np.cos(t), np.sin(t)] * 1000)

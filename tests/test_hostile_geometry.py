@@ -18,8 +18,8 @@ from hypothesis import given, settings, strategies as st
 
 import cspace
 from cspace import CSpace, orient2d
-from cspace.pathcheck import open_meets, path_violations, split_pieces
-from cspace.shortest import shortest_path
+from cspace.spaces.pathcheck import open_meets, path_violations, split_pieces
+from cspace.spaces.shortest import shortest_path
 
 NAN, INF = float("nan"), float("inf")
 

@@ -13,9 +13,9 @@ import pytest
 import shapely
 from PIL import Image
 
-from cspace.imported import ImportOptions, import_file, load_imported
-from cspace.occupancy import MapInfo, classify, parse_flat_yaml
-from cspace.scenario import load_scenario
+from cspace.io.imported import ImportOptions, import_file, load_imported
+from cspace.io.occupancy import MapInfo, classify, parse_flat_yaml
+from cspace.io.scenario import load_scenario
 from planners.cli import main
 
 FREE, OCC, UNK = 254, 0, 205  # map_server's grey levels (trinary, not negated)
@@ -100,7 +100,7 @@ def test_every_blocked_cell_is_inside_the_polygons(tmp_path, resolution, origin,
     extra = u.difference(cells.buffer(reach, join_style="mitre")).area
     assert extra <= (filled + 1e-6) * resolution**2 * (1 + 1e-9)
     # the polygons are what the loader accepts: simple shells, holes fitting inside
-    from cspace.polygon import invalid_reason
+    from cspace.kernel.polygon import invalid_reason
 
     for o in imp.data["obstacles"]:
         assert invalid_reason(np.array(o["polygon"])) is None

@@ -15,8 +15,8 @@ import shapely
 
 collada = pytest.importorskip("collada")
 
-from cspace.imported import ImportOptions, import_file, load_imported  # noqa: E402
-from cspace.scenario import load_scenario  # noqa: E402
+from cspace.io.imported import ImportOptions, import_file, load_imported  # noqa: E402
+from cspace.io.scenario import load_scenario  # noqa: E402
 from planners.cli import main  # noqa: E402
 
 

@@ -11,7 +11,7 @@ import pytest
 import shapely
 
 import cspace as C
-from cspace.polygon import is_simple
+from cspace.kernel.polygon import is_simple
 
 SQ = [[0, 0], [1, 0], [1, 1], [0, 1]]
 INPUTS = {
@@ -82,6 +82,6 @@ def test_the_messages_say_what_is_wrong():
         C.convex_decompose(INPUTS["bowtie"])
     with pytest.raises(ValueError, match="expected one polygon, got a MultiPolygon"):
         C.convex_hull(INPUTS["multipolygon"])
-    with pytest.raises(ValueError, match="empty array|no vertices"):  # the one array gate (cspace/arrays.py)
+    with pytest.raises(ValueError, match="empty array|no vertices"):  # the one array gate (cspace/kernel/arrays.py)
         C.minkowski_sum(INPUTS["empty"], SQ)
     assert is_simple(INPUTS["nan"]) is False  # a predicate answers, it does not raise

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from cspace import ScenarioError, load_scenario
-from cspace.disk import disk_error
-from cspace.polygon import signed_area
+from cspace.kernel.disk import disk_error
+from cspace.kernel.polygon import signed_area
 
 BASE = """
 name = "t"
@@ -187,8 +187,7 @@ def test_messages_name_the_key_and_what_to_do(write_toml, extra, field, message)
 
 def test_the_known_keys_are_one_set_to_extend(write_toml, monkeypatch):
     # A new top-level section (say `velocity`) is one entry in TOP_LEVEL_KEYS; suggestions follow it.
-    from cspace import scenario
-
+    from cspace.io import scenario
     path = write_toml("velocty = 0.5\n" + BASE)
     with pytest.raises(ScenarioError, match="expected one of"):
         load_scenario(path)

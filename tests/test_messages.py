@@ -11,7 +11,7 @@ import warnings
 
 import pytest
 
-from cspace.scenario import ScenarioError, clip, load_scenario, show
+from cspace.io.scenario import ScenarioError, clip, load_scenario, show
 from planners.cli import main
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -2,9 +2,9 @@
 import numpy as np
 from hypothesis import given, settings, strategies as st
 
-from cspace.hull import convex_hull
-from cspace.minkowski import minkowski_sum
-from cspace.pairsums import pairwise_sums
+from cspace.kernel.hull import convex_hull
+from cspace.kernel.minkowski import minkowski_sum
+from cspace.kernel.pairsums import pairwise_sums
 
 
 def convex_piece(draw, integer):
@@ -53,7 +53,7 @@ def test_degenerate_and_non_canonical_pieces_fall_back():
 
 
 def test_comb_pieces_match():
-    from cspace.decompose import convex_decompose
+    from cspace.kernel.decompose import convex_decompose
     from test_decompose import comb
 
     th = np.radians(30)

@@ -179,7 +179,7 @@ def test_a_misspelt_planner_blames_the_argument():
 def test_all_queries_each_query_has_its_own_stream(write_toml):
     # Query 0 is closed (RRTConnect runs to its time limit, drawing as many samples as
     # the clock allows); query 1 is open. Query 1's raw path must not depend on that.
-    from cspace.shortest import shortest_path
+    from cspace.spaces.shortest import shortest_path
 
     sc = load_scenario(SC / "narrow_closed.toml")
     cs = CSpace.from_scenario(sc)

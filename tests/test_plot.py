@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from cspace.gap import narrowest_gap  # noqa: E402
+from cspace.spaces.gap import narrowest_gap  # noqa: E402
 from planners import plot  # noqa: E402
 from planners.plan import plan  # noqa: E402
 
@@ -55,8 +55,8 @@ def test_plan_picture_has_a_legend_for_everything_drawn():
 
 
 def test_scene_picture_has_a_legend_and_labels():
-    from cspace.cspace import CSpace
-    from cspace.scenario import load_scenario
+    from cspace.spaces.cspace import CSpace
+    from cspace.io.scenario import load_scenario
 
     sc = load_scenario(os.path.join(SCEN, "basic.toml"))
     fig = plot.figure_scene(sc, CSpace.from_scenario(sc))
@@ -66,8 +66,8 @@ def test_scene_picture_has_a_legend_and_labels():
 
 
 def test_point_robot_scene_names_its_pieces():
-    from cspace.cspace import CSpace
-    from cspace.scenario import load_scenario
+    from cspace.spaces.cspace import CSpace
+    from cspace.io.scenario import load_scenario
 
     sc = load_scenario(os.path.join(SCEN, "ompl", "circles.toml"))
     labels = _legend(plot.figure_scene(sc, CSpace.from_scenario(sc)))

@@ -1,4 +1,4 @@
-"""The loader's batched route (cspace.polygon_batch) gives the scalar route's answers:
+"""The loader's batched route (cspace.kernel.polygon_batch) gives the scalar route's answers:
 the same normalised arrays and convexity flags wherever it decides, None (the scalar
 route then decides and words the error) for everything it does not certify, and the
 loader reports the first faulty obstacle in file order either way."""
@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cspace import ScenarioError, is_convex, normalize, scenario_from_dict
-from cspace.polygon import invalid_reason
-from cspace.polygon_batch import normalize_many
+from cspace.kernel.polygon import invalid_reason
+from cspace.kernel.polygon_batch import normalize_many
 
 
 def scalar(p: np.ndarray):
@@ -101,7 +101,7 @@ def test_stars_are_simple_without_geos_and_match_the_scalar_route():
     a = np.arange(2000) * 2 * math.pi / 2000
     r = np.where(np.arange(2000) % 2 == 0, 10.0, 4.0)
     star = np.column_stack([50 + r * np.cos(a), 50 + r * np.sin(a)])
-    from cspace.polygon_batch import _star_shaped
+    from cspace.kernel.polygon_batch import _star_shaped
 
     assert _star_shaped(star[None], np.ones((1, 2000))).tolist() == [True]
     twice = np.vstack([star[::2], star[::2]])[::1]  # the same vertices wound twice: not simple

@@ -4,7 +4,7 @@ from fractions import Fraction
 import numpy as np
 from hypothesis import given, settings, strategies as st
 
-from cspace.predicates import cross_diff_cols, cross_diff_exact, cross_diff_sign, error_free_cross_sign, orient2d_xy
+from cspace.kernel.predicates import cross_diff_cols, cross_diff_exact, cross_diff_sign, error_free_cross_sign, orient2d_xy
 
 
 def exact(ax, ay, bx, by, cx, cy, dx, dy):
@@ -64,7 +64,7 @@ def test_underflowing_products_are_not_taken_as_exact():
 def test_column_predicates_take_plain_scalars_in_doubt():
     # Scalars whose sign the filter cannot decide (a collinear triple, and the note's
     # near-parallel pair) reach the exact stage as 0-d arrays.
-    from cspace.predicates import cross_diff_cols, orient2d_cols
+    from cspace.kernel.predicates import cross_diff_cols, orient2d_cols
 
     assert int(orient2d_cols(0.0, 0.0, 1.0, 1.0, 3.0, 3.0)) == 0
     assert int(orient2d_cols(0.1, 0.1, 0.3, 0.3, 0.7, 0.7)) == orient2d_xy(0.1, 0.1, 0.3, 0.3, 0.7, 0.7)

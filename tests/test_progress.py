@@ -11,9 +11,9 @@ import sys
 import numpy as np
 import pytest
 
-from cspace.cspace import CSpace
-from cspace.scenario import load_scenario
-from cspace.shortest import shortest_path
+from cspace.spaces.cspace import CSpace
+from cspace.io.scenario import load_scenario
+from cspace.spaces.shortest import shortest_path
 from planners import progress as pg
 from planners.cli import main
 
@@ -130,9 +130,9 @@ def _circles():
 
 
 def test_search_reports_a_rising_lower_bound_that_ends_at_the_length(monkeypatch):
-    import cspace.shortest
+    import cspace.spaces.shortest
 
-    monkeypatch.setattr(cspace.shortest, "PROGRESS_EVERY", 1)  # a report per settled node
+    monkeypatch.setattr(cspace.spaces.shortest, "PROGRESS_EVERY", 1)  # a report per settled node
     sc, cs = _circles()
     calls = []
     sp = shortest_path(cs.pieces, cs.bounds, sc.start, sc.goal, on_progress=lambda *a: calls.append(a))

@@ -9,7 +9,7 @@ import pytest
 import shapely
 
 import planners
-from cspace.scenario import load_scenario
+from cspace.io.scenario import load_scenario
 from conftest import SCENARIOS
 
 FILES = sorted(glob.glob(os.path.join(SCENARIOS, "*.toml")) + glob.glob(os.path.join(SCENARIOS, "ompl", "*.toml")))

@@ -1,4 +1,4 @@
-"""The SE(2) C-space (cspace/se2.py) against independent oracles.
+"""The SE(2) C-space (cspace/spaces/se2.py) against independent oracles.
 
 Oracles: shapely (the robot turned by shapely.affinity, translated, against the
 obstacles); the translation C-space of the robot turned to a fixed angle (the same
@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 from shapely import affinity
 
 from cspace import CSpace, load_scenario
-from cspace.se2 import SE2CSpace, default_slabs, interpolate
-from cspace.slab import rotate_piece, slab_inner
+from cspace.spaces.se2 import SE2CSpace, default_slabs, interpolate
+from cspace.kernel.slab import rotate_piece, slab_inner
 
 from conftest import SCENARIOS
 
@@ -222,7 +222,7 @@ def test_point_robot_and_default_slabs():
 def test_inner_sets_are_inside_the_robot_at_every_angle_of_their_slab():
     """The certified-blocked inner set of each slab lies in rotate_piece(piece, θ) at every θ of the slab
     (dense θ plus both widened ends; exact predicate on the float vertices)."""
-    from cspace.predicates import orient2d_xy
+    from cspace.kernel.predicates import orient2d_xy
 
     u = _scene("u_robot.toml")
     pieces = [BAR, np.array([[0.3, -0.2], [1.0, 0.1], [0.2, 0.6]])] + [p.polygon for p in u.robot]
@@ -240,9 +240,9 @@ def test_inner_sets_are_inside_the_robot_at_every_angle_of_their_slab():
 
 def test_pair_filter_decides_like_the_exact_sum():
     """The float filter in front of the exact test never contradicts the exact sum, and defers near its boundary."""
-    from cspace.minkowski import minkowski_sum, reflect
-    from cspace.polygon import point_in_convex
-    from cspace.se2 import _edges, _pair_filter
+    from cspace.kernel.minkowski import minkowski_sum, reflect
+    from cspace.kernel.polygon import point_in_convex
+    from cspace.spaces.se2 import _edges, _pair_filter
 
     rng = np.random.default_rng(17)
     O = np.array([[4.0, 4.0], [6.0, 4.5], [5.5, 6.0], [4.2, 5.5]])
@@ -275,8 +275,8 @@ def test_pair_filter_decides_like_the_exact_sum():
 def test_piece_pairs_cover_every_sum():
     """CSpace.piece_pairs: each kept piece lists pairs whose sums lie inside it, and every pair
     whose sum meets the bounds is listed once (including sums pruned as inside another piece)."""
-    from cspace.minkowski import minkowski_sum, reflect
-    from cspace.predicates import orient2d_xy
+    from cspace.kernel.minkowski import minkowski_sum, reflect
+    from cspace.kernel.predicates import orient2d_xy
 
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     parts = [sq * 0.3, sq * 0.2 + 0.05, sq * 0.1 + 0.1, np.array([[-0.5, -0.5], [-0.4, -0.5], [-0.45, -0.3]])]

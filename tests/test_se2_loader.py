@@ -5,7 +5,7 @@ import os
 import pytest
 
 from conftest import SCENARIOS
-from cspace.scenario import ScenarioError, load_scenario, scenario_from_dict
+from cspace.io.scenario import ScenarioError, load_scenario, scenario_from_dict
 
 SE2 = os.path.join(SCENARIOS, "se2")
 

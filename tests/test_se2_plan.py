@@ -15,7 +15,7 @@ import pytest
 
 import planners
 from conftest import ROOT, SCENARIOS, load_script
-from cspace.scenario import load_scenario
+from cspace.io.scenario import load_scenario
 
 SE2 = sorted(glob.glob(os.path.join(SCENARIOS, "se2", "*.toml")))
 oracle = load_script("sweep_oracle")

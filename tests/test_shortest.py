@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import shapely
 
-from cspace.hull import convex_hull
-from cspace.shortest import shortest_path
+from cspace.kernel.hull import convex_hull
+from cspace.spaces.shortest import shortest_path
 
 
 def brute_force(pieces, bounds, s, g):
@@ -110,8 +110,8 @@ def test_path_slides_along_shared_edges_of_overlapping_pieces():
 
 
 def test_peer_scenarios_against_brute_force():
-    from cspace.cspace import CSpace
-    from cspace.scenario import load_scenario
+    from cspace.spaces.cspace import CSpace
+    from cspace.io.scenario import load_scenario
 
     from conftest import SCENARIOS
 

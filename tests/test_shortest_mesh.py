@@ -1,5 +1,5 @@
-"""The mesh search (exact triangular expansion, cspace.visibility) against the lazy search
-(cspace.shortest_lazy, today's answers), brute-force visibility and brute-force shortest paths.
+"""The mesh search (exact triangular expansion, cspace.spaces.visibility) against the lazy search
+(cspace.spaces.shortest_lazy, today's answers), brute-force visibility and brute-force shortest paths.
 
 Integer grid scenes (unit cells, like OMPL's env2) are the hard cases: collinear
 walls, cells touching at a corner (points where rings of F touch), sight lines
@@ -17,10 +17,10 @@ from hypothesis import strategies as st
 
 from conftest import SCENARIOS
 from cspace import CSpace, load_scenario
-from cspace.freemesh import FreeMesh, MeshError
-from cspace.hull import convex_hull
-from cspace.shortest import free_space, shortest_path
-from cspace.visibility import visible_from
+from cspace.spaces.freemesh import FreeMesh, MeshError
+from cspace.kernel.hull import convex_hull
+from cspace.spaces.shortest import free_space, shortest_path
+from cspace.spaces.visibility import visible_from
 from test_shortest import brute_force
 
 SKIP = {"env2.toml"}  # the lazy search takes minutes there (tests/test_scenarios.py plans it)
@@ -119,7 +119,7 @@ def test_visible_vertices_equal_geos_covers(args):
 
 
 def test_a_triangulation_failing_the_checks_falls_back(monkeypatch):
-    import cspace.freemesh
+    import cspace.spaces.freemesh
 
     sq = np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]])
     good = shortest_path([sq], (0, 10, 0, 10), (1, 5), (9, 5))
@@ -127,7 +127,7 @@ def test_a_triangulation_failing_the_checks_falls_back(monkeypatch):
     monkeypatch.setattr(shapely, "constrained_delaunay_triangles",
                         lambda poly: shapely.GeometryCollection(list(shapely.get_parts(real(poly)))[1:]))
     with pytest.raises(MeshError):
-        cspace.freemesh.FreeMesh(free_space([sq], (0, 10, 0, 10)))
+        cspace.spaces.freemesh.FreeMesh(free_space([sq], (0, 10, 0, 10)))
     sp = shortest_path([sq], (0, 10, 0, 12), (1, 5), (9, 5))  # other bounds: not the scene cached above
     assert sp.stats["method"] == "lazy" and "mesh_error" in sp.stats
     assert sp.length == good.length == pytest.approx(2 + 2 * math.hypot(3, 1))

@@ -1,4 +1,4 @@
-"""Slab hulls, the one rotation, slab indexing and the inscribed disk (cspace/slab.py).
+"""Slab hulls, the one rotation, slab indexing and the inscribed disk (cspace/kernel/slab.py).
 
 Oracles: exact rational rotations (cos = (1 − t²)/(1 + t²), sin = 2t/(1 + t²), the
 angle 2·atan(t)) with Fraction orientation tests; the exact predicate on the float
@@ -15,8 +15,8 @@ import pytest
 import shapely
 
 from cspace import CSpace, load_scenario
-from cspace.predicates import orient2d_xy
-from cspace.slab import (ANGLE_SLACK, inscribed_polygon, inscribed_radius, rotate, rotate_piece, slab_hull, slab_of,
+from cspace.kernel.predicates import orient2d_xy
+from cspace.kernel.slab import (ANGLE_SLACK, inscribed_polygon, inscribed_radius, rotate, rotate_piece, slab_hull, slab_of,
                          slab_range, wrap_angle)
 
 from conftest import SCENARIOS

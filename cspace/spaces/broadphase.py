@@ -1,0 +1,550 @@
+"""Broad phase for point and segment queries: a uniform grid with a precomputed occupancy.
+
+This module owns the question "which convex pieces can a query near (x, y) touch?".
+The grid covers the bounds; each cell is classified once, at build time:
+
+- ``FREE``: no piece meets the closed cell, so every state in it is free;
+- ``BLOCKED``: the closed cell lies inside one (closed, convex) piece, so every
+  state in it collides;
+- ``MIXED``: otherwise; the cell keeps the list of pieces that may meet it.
+
+The classification is conservative: a cell is called FREE or BLOCKED only when the
+float test is certified with a margin far larger than its rounding error; anything
+in doubt is MIXED and goes to the exact narrow phase. A point query in a FREE or
+BLOCKED cell therefore costs a few arithmetic operations, which is what makes a
+Python validity checker affordable inside OMPL.
+"""
+from __future__ import annotations
+
+import math
+from array import array
+
+import numpy as np
+
+from ..kernel.polygon import piece_boxes
+
+FREE, MIXED, BLOCKED = 0, 1, 2
+
+# Relative margin for the certified cell classification: far above the rounding
+# error of the few float operations used (about 1e-15 of the scene's scale).
+_MARGIN = 1e-9
+
+
+# Boxes wider than this many cells are classified row by row (GridIndex._scan_rows).
+SCAN_COLUMNS = 8
+
+# Most (piece, cell) pairs the build classifies, before the grid is coarsened.
+_PAIR_BUDGET = float(1 << 22)
+
+
+def _runs(rows: np.ndarray, jj: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """The cells (row, i, j) of the column runs [lo, hi] of each row (empty where lo > hi).
+
+    >>> [x.tolist() for x in _runs(np.array([5, 6]), np.array([0, 1]), np.array([2, 4]), np.array([3, 3]))]
+    [[5, 5], [2, 3], [0, 0]]
+    """
+    n = np.maximum(hi - lo + 1, 0)
+    total = int(n.sum())
+    k = np.repeat(np.arange(len(n)), n)
+    i = lo[k] + (np.arange(total) - np.repeat(np.cumsum(n) - n, n))
+    return rows[k], i, jj[k]
+
+
+def _ints(a: np.ndarray) -> array:
+    """An int64 numpy array as an ``array.array('q')`` (one buffer copy).
+
+    >>> _ints(np.array([3, -1])).tolist()
+    [3, -1]
+    """
+    out = array("q")
+    out.frombytes(np.ascontiguousarray(a, dtype=np.int64).tobytes())
+    return out
+
+
+def _box_shares(lo: np.ndarray, hi: np.ndarray, xmin: float, xmax: float, ymin: float, ymax: float) -> np.ndarray:
+    """Fraction of the bounds covered by each piece's bounding box (clipped to the bounds).
+
+    >>> _box_shares(np.array([[-1., 0]]), np.array([[1., 2]]), 0.0, 2.0, 0.0, 2.0).tolist()
+    [0.5]
+    """
+    bw = np.minimum(hi[:, 0], xmax) - np.maximum(lo[:, 0], xmin)
+    bh = np.minimum(hi[:, 1], ymax) - np.maximum(lo[:, 1], ymin)
+    return np.maximum(bw, 0.0) * np.maximum(bh, 0.0) / ((xmax - xmin) * (ymax - ymin))
+
+
+class GridIndex:
+    """Uniform grid over ``bounds`` classifying cells against convex ``pieces``.
+
+    ``cells`` sets the cell count (default: from the pieces); ``shape`` = (nx, ny)
+    fixes the columns and rows instead, to share another grid's cells.
+
+    >>> g = GridIndex([np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])], (0, 4, 0, 4), cells=16)
+    >>> int(g.state_at(3.5, 3.5)), int(g.state_at(0.5, 0.5))
+    (0, 2)
+    """
+
+    def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None,
+                 shape: tuple[int, int] | None = None):
+        xmin, xmax, ymin, ymax = map(float, bounds)
+        self.bounds = (xmin, xmax, ymin, ymax)
+        n = len(pieces)
+        w, h = xmax - xmin, ymax - ymin
+        self._lo, self._hi = piece_boxes(pieces)  # each piece's box, in one pass
+        if cells is None:
+            cells = int(min(max(1024 * n, 1 << 16), 1 << 20))
+            # Large, overlapping pieces (comb sums) would each cover a big share of that
+            # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
+            cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist())
+            if cover * cells > _PAIR_BUDGET:
+                cells = max(int(_PAIR_BUDGET / cover), 1 << 12)
+        nx = max(1, min(4096, int(round(math.sqrt(cells * w / h)))))
+        ny = max(1, min(4096, int(round(cells / nx))))
+        if shape is not None:  # the same cells as another grid (the SE(2) inner grid)
+            nx, ny = int(shape[0]), int(shape[1])
+        self.nx, self.ny = nx, ny
+        self.x0, self.y0 = xmin, ymin
+        self.cw, self.ch = w / nx, h / ny
+        self.inv_w, self.inv_h = nx / w, ny / h
+        # Classification runs in a local frame centred on the bounds, so its rounding
+        # error scales with the scene's extent; the shift itself may round by up to
+        # an ulp of the largest coordinate, which the margin also covers.
+        self.ox, self.oy = 0.5 * (xmin + xmax), 0.5 * (ymin + ymax)
+        full = np.isfinite(self._lo[:, 0])  # non-empty pieces
+        big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] +
+                  ([float(max(np.abs(self._lo[full]).max(), np.abs(self._hi[full]).max()))] if full.any() else []))
+        self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
+        state = np.zeros(nx * ny, dtype=np.int8)
+        blocker = np.full(nx * ny, -1, dtype=np.int64)
+        cand_cells: list[np.ndarray] = []
+        cand_piece: list[np.ndarray] = []
+        cand_mask: list[np.ndarray] = []
+        # Pieces of up to 62 edges are classified together, in blocks of (piece, cell)
+        # pairs (one numpy pass instead of one per piece); wider ones one by one (their
+        # edge masks are Python ints).
+        narrow = [k for k, p in enumerate(pieces) if len(p) <= 62]
+        if narrow:
+            pid, cells_k, inside, masks = self._classify_many(pieces, narrow)
+            cand_cells.append(cells_k)
+            cand_piece.append(pid)
+            inside_parts = [inside]
+            cand_mask.append(masks)
+        else:
+            inside_parts = []
+        for k, p in enumerate(pieces):
+            if len(p) <= 62:
+                continue
+            cells_k, inside, masks = self._classify(p)
+            cand_cells.append(cells_k)
+            cand_piece.append(np.full(cells_k.size, k, dtype=np.int64))
+            inside_parts.append(inside)
+            cand_mask.append(masks)
+        if cand_cells:
+            cc = np.concatenate(cand_cells)
+            cp = np.concatenate(cand_piece)
+            cm = np.concatenate(cand_mask)
+            inside = np.concatenate(inside_parts)
+            # A cell inside a piece is BLOCKED, its blocker the last such piece.
+            blk = cc[inside]
+            state[blk] = BLOCKED
+            np.maximum.at(blocker, blk, cp[inside])
+            cc, cp, cm = cc[~inside], cp[~inside], cm[~inside]
+        if cand_cells and cc.size:
+            # A cell touched by any piece but not wholly inside one is MIXED; its
+            # candidates in piece order.
+            order = np.lexsort((cp, cc))
+            cc, cp, cm = cc[order], cp[order], cm[order]
+            touched = np.zeros(nx * ny, dtype=bool)
+            touched[cc] = True
+            state[touched & (state != BLOCKED)] = MIXED
+            starts = np.zeros(nx * ny + 1, dtype=np.int64)  # cc is sorted: counts, summed
+            np.cumsum(np.bincount(cc, minlength=nx * ny), out=starts[1:])
+        else:
+            cp = np.zeros(0, dtype=np.int64)
+            cm = np.zeros(0, dtype=np.int64)
+            starts = np.zeros(nx * ny + 1, dtype=np.int64)
+        self.state = state
+        self.blocker = blocker
+        self._cand = cp
+        self._starts = starts
+        # Compact copies for the scalar hot path: indexing bytes or an array.array yields
+        # a Python int as cheaply as a list does, and they are built by one copy of the
+        # buffer instead of one Python object per cell (a million cells: ~1 ms, not ~50).
+        self.state_list = state.astype(np.uint8).tobytes()
+        self.blocker_list = _ints(blocker)
+        self._cand_list = _ints(cp)
+        # For each candidate (cell, piece): a bit mask of the piece's edges whose line
+        # may pass within the margin of the cell (bit e: edge from vertex e-1 to e).
+        # Every other edge has the whole widened cell strictly on its
+        # inner side, so a point located in the cell needs no test against it.
+        # (Pieces of more than 62 edges have Python-int masks: a list then.)
+        self.cand_masks_list = cm.tolist() if cm.dtype == object else _ints(cm)
+        self._starts_list = _ints(starts)
+        # Summed-area table of non-FREE cells: the count in any block of cells in O(1),
+        # read as sat[j][i] (one array.array per row).
+        busy = (state != FREE).reshape(ny, nx).astype(np.int64)
+        sat = np.zeros((ny + 1, nx + 1), dtype=np.int64)
+        np.cumsum(busy, axis=0, out=sat[1:, 1:])
+        np.cumsum(sat[1:, 1:], axis=1, out=sat[1:, 1:])
+        self._sat = [_ints(r) for r in sat]
+        self._rows = None
+
+    def state_rows(self) -> list[bytes]:
+        """The point test's view of the grid (built once, shared by every test made):
+        one bytes row per grid row (FREE 0, MIXED 1, BLOCKED 2), each with a border
+        cell (3) after the last column, and a border row after the last row."""
+        if self._rows is None:
+            nx, ny, flat = self.nx, self.ny, self.state_list
+            border = bytes([3])
+            self._rows = [flat[r * nx:(r + 1) * nx] + border for r in range(ny)] + [border * (nx + 1)]
+        return self._rows
+
+    # -- build -------------------------------------------------------------------
+
+    def _classify_many(self, pieces: list[np.ndarray], ks: list[int]):
+        """:meth:`_classify` for the pieces ``ks`` (each of at most 62 edges) at once:
+        ``(piece, cell, inside, mask)`` per (piece, cell) pair that may meet, piece-major,
+        each piece's cells in :meth:`_classify`'s order, with the same arithmetic.
+
+        Edges are padded to the widest piece with a dummy edge (zero normal, offset
+        +inf) that every cell lies strictly inside and no cell is separated by.
+        """
+        m = self.margin
+        sizes = np.array([len(pieces[k]) for k in ks], dtype=np.int64)
+        E = int(sizes.max())
+        K = len(ks)
+        Q = np.zeros((K, E, 2))
+        for r, k in enumerate(ks):
+            Q[r, : sizes[r]] = pieces[k]
+        Q -= (self.ox, self.oy)
+        slot = np.arange(E)
+        valid = slot[None, :] < sizes[:, None]
+        nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
+        e = np.take_along_axis(Q, nxt[:, :, None], axis=1) - Q
+        nrm = np.stack([e[:, :, 1], -e[:, :, 0]], axis=2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
+        nrm[~valid] = 0.0
+        c = np.einsum("kij,kij->ki", nrm, Q)
+        c[~valid] = np.inf
+        hi = np.maximum(nrm[:, :, 0], 0.0) * self.cw + np.maximum(nrm[:, :, 1], 0.0) * self.ch
+        lo = np.minimum(nrm[:, :, 0], 0.0) * self.cw + np.minimum(nrm[:, :, 1], 0.0) * self.ch
+        # Bit e stands for the edge ending at vertex e: slot i (edge i -> i+1) is bit (i + 1) % n.
+        weights = np.where(valid, np.left_shift(np.int64(1), (slot[None, :] + 1) % sizes[:, None]), 0)
+        # Each piece's box of cells (widened by the margin), clipped to the grid.
+        lo_xy, hi_xy = self._lo[ks], self._hi[ks]
+        i0 = np.maximum(np.floor((lo_xy[:, 0] - m - self.x0) * self.inv_w), 0).astype(np.int64)
+        i1 = np.minimum(np.floor((hi_xy[:, 0] + m - self.x0) * self.inv_w), self.nx - 1).astype(np.int64)
+        j0 = np.maximum(np.floor((lo_xy[:, 1] - m - self.y0) * self.inv_h), 0).astype(np.int64)
+        j1 = np.minimum(np.floor((hi_xy[:, 1] + m - self.y0) * self.inv_h), self.ny - 1).astype(np.int64)
+        W = np.maximum(i1 - i0 + 1, 0)
+        H = np.maximum(j1 - j0 + 1, 0)
+        x_off, y_off, cw, ch = self.x0 - self.ox, self.y0 - self.oy, self.cw, self.ch
+
+        def evaluate(row, ii, jj):
+            """inside, separated, mask of the cells (piece row[k], cell ii[k], jj[k])."""
+            n = len(row)
+            inside = np.empty(n, dtype=bool)
+            separated = np.empty(n, dtype=bool)
+            masks = np.empty(n, dtype=np.int64)
+            step = max(1, (1 << 21) // E)
+            for s in range(0, n, step):
+                r = row[s : s + step]
+                cx0 = x_off + ii[s : s + step] * cw
+                cy0 = y_off + jj[s : s + step] * ch
+                d = cx0[:, None] * nrm[r, :, 0]
+                d += cy0[:, None] * nrm[r, :, 1]
+                d -= c[r]
+                strictly_in = d <= -m - hi[r]
+                inside[s : s + step] = strictly_in.all(axis=1)
+                masks[s : s + step] = ((~strictly_in) * weights[r]).sum(axis=1)
+                separated[s : s + step] = (d >= m - lo[r]).any(axis=1)
+            return inside, separated, masks
+
+        # Pieces at most SCAN_COLUMNS cells wide: every cell of their box is evaluated.
+        # Wider ones row by row (_scan_rows): per row and edge the column where the edge's
+        # test flips is found exactly, so only the cells near the boundary are evaluated.
+        narrow_box = W <= SCAN_COLUMNS
+        parts = []
+        dense = np.flatnonzero(narrow_box & (W * H > 0))
+        if len(dense):
+            counts = (W * H)[dense]
+            total = int(counts.sum())
+            row = np.repeat(dense, counts)
+            t = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+            ii = i0[row] + t % W[row]
+            jj = j0[row] + t // W[row]
+            inside, separated, masks = evaluate(row, ii, jj)
+            keep = ~separated
+            parts.append((row[keep], ii[keep], jj[keep], inside[keep], masks[keep]))
+        scan = np.flatnonzero(~narrow_box & (H > 0))
+        if len(scan):
+            parts += self._scan_rows(scan, i0, i1, j0, H, nrm, c, hi, lo, evaluate)
+        if not parts:
+            z = np.zeros(0, dtype=np.int64)
+            return z, z, np.zeros(0, dtype=bool), z
+        row, ii, jj, inside, masks = (np.concatenate(x) for x in zip(*parts))
+        pid = np.asarray(ks, dtype=np.int64)[row]
+        return pid, jj * self.nx + ii, inside, masks
+
+    def _scan_rows(self, pieces, i0, i1, j0, H, nrm, c, hi, lo, evaluate) -> list:
+        """:meth:`_classify_many`'s cells of wide boxes, row by row, the same answers.
+
+        Along a row the classification value d = ((x0 - ox) + i cw) n_x + (cy n_y) - c of
+        an edge is evaluated in floats, each operation rounded monotonically, so as a
+        function of the column i it is monotone (with the sign of n_x; constant when
+        n_x is 0 or NaN). Each edge's "strictly inside" and "separating" tests therefore
+        flip at most once along the row, at a column found exactly by bisection on the
+        same float expression. Cells inside for every edge are inside (no edge near
+        them: mask 0), cells separated by an edge are dropped, and only the cells in
+        between are evaluated in full, as the dense route does.
+        """
+        m, x_off, y_off, cw, ch = self.margin, self.x0 - self.ox, self.y0 - self.oy, self.cw, self.ch
+        out = []
+        E = nrm.shape[1]
+        per = max(1, (1 << 20) // E)  # rows per block
+        rows_all = np.repeat(pieces, H[pieces])
+        local = np.arange(len(rows_all)) - np.repeat(np.cumsum(H[pieces]) - H[pieces], H[pieces])
+        for s in range(0, len(rows_all), per):
+            rr = rows_all[s : s + per]
+            jj = j0[rr] + local[s : s + per]
+            n0 = nrm[rr, :, 0]
+            yterm = (y_off + jj * ch)[:, None] * nrm[rr, :, 1]
+            cc = c[rr]
+            t_in, t_sep = -m - hi[rr], m - lo[rr]
+            a, b = i0[rr][:, None], i1[rr][:, None]
+            pos, neg = n0 > 0, n0 < 0
+
+            def d_at(i):
+                d = (x_off + i * cw) * n0
+                d += yterm
+                d -= cc
+                return d
+
+            def flip(test):
+                """First column where test(d) turns True (monotone False..True), b + 1 if none."""
+                L = np.broadcast_to(a, n0.shape).copy()
+                U = np.broadcast_to(b + 1, n0.shape).copy()
+                while True:
+                    act = L < U
+                    if not act.any():
+                        return L
+                    mid = (L + U) // 2
+                    f = test(d_at(np.minimum(mid, b))) & act
+                    U = np.where(f, mid, U)
+                    L = np.where(act & ~f, mid + 1, L)
+
+            d0 = d_at(a)
+            # strictly inside edge e: a prefix of the row (n_x > 0), a suffix (n_x < 0), all or none
+            f_in = flip(lambda d: np.where(pos, ~(d <= t_in), d <= t_in))
+            lo_in = np.where(pos, a, np.where(neg, f_in, np.where(d0 <= t_in, a, b + 1)))
+            hi_in = np.where(pos, f_in - 1, np.where(neg, b, np.where(d0 <= t_in, b, a - 1)))
+            # not separated by edge e: likewise
+            f_ns = flip(lambda d: np.where(pos, d >= t_sep, ~(d >= t_sep)))
+            lo_ns = np.where(pos, a, np.where(neg, f_ns, np.where(~(d0 >= t_sep), a, b + 1)))
+            hi_ns = np.where(pos, f_ns - 1, np.where(neg, b, np.where(~(d0 >= t_sep), b, a - 1)))
+            in_lo, in_hi = lo_in.max(axis=1), hi_in.min(axis=1)
+            ns_lo, ns_hi = lo_ns.max(axis=1), hi_ns.min(axis=1)
+            in_lo, in_hi = np.maximum(in_lo, ns_lo), np.minimum(in_hi, ns_hi)
+            has_in = in_lo <= in_hi
+            # runs of cells: inside [in_lo, in_hi]; to evaluate: the rest of [ns_lo, ns_hi]
+            left_hi = np.where(has_in, in_lo - 1, ns_hi)
+            right_lo = np.where(has_in, in_hi + 1, ns_hi + 1)
+            cells = [_runs(rr, jj, ns_lo, left_hi), _runs(rr, jj, right_lo, ns_hi)]
+            er, ei, ej = (np.concatenate(x) for x in zip(*cells))
+            inside, separated, masks = evaluate(er, ei, ej)
+            keep = ~separated
+            out.append((er[keep], ei[keep], ej[keep], inside[keep], masks[keep]))
+            ir, ic, ij = _runs(rr, jj, in_lo, in_hi)
+            out.append((ir, ic, ij, np.ones(len(ir), dtype=bool), np.zeros(len(ir), dtype=np.int64)))
+        return out
+
+    def _classify(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Cells that closed convex ``p`` may meet, which of them lie inside ``p``, and for
+        each the bit mask of the edges whose line passes within the margin of it."""
+        m = self.margin
+        i0 = math.floor((p[:, 0].min() - m - self.x0) * self.inv_w)
+        i1 = math.floor((p[:, 0].max() + m - self.x0) * self.inv_w)
+        j0 = math.floor((p[:, 1].min() - m - self.y0) * self.inv_h)
+        j1 = math.floor((p[:, 1].max() + m - self.y0) * self.inv_h)
+        i0, j0 = max(i0, 0), max(j0, 0)
+        i1, j1 = min(i1, self.nx - 1), min(j1, self.ny - 1)
+        if i0 > i1 or j0 > j1:
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool), np.zeros(0, dtype=np.int64)
+        ii, jj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
+        ii, jj = ii.ravel(), jj.ravel()
+        q = p - (self.ox, self.oy)
+        # Edge half-planes of p: n . x <= c, n the outward unit normal.
+        e = np.roll(q, -1, axis=0) - q
+        nrm = np.column_stack([e[:, 1], -e[:, 0]])
+        # A piece that rounded to a point (a disk of radius 1e-200 at (5, 5)) has zero-length
+        # edges: their NaN normals make every comparison below False, so no cell is called
+        # inside or separated by them and the exact narrow phase decides (quietly).
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
+        c = np.einsum("ij,ij->i", nrm, q)
+        inside = np.empty(ii.size, dtype=bool)
+        separated = np.empty(ii.size, dtype=bool)
+        # Bit e stands for the edge ending at vertex e (q[e-1] -> q[e]); the half-planes
+        # above are for q[e] -> q[e+1], i.e. bit e+1. Up to 62 edges the masks are int64,
+        # beyond that Python ints (an object array).
+        wide = len(q) > 62
+        masks = np.empty(ii.size, dtype=object if wide else np.int64)
+        weights = None if wide else np.left_shift(np.int64(1), (np.arange(len(q)) + 1) % len(q))
+        # Over a cell [x, x + cw] x [y, y + ch] the signed distance n . corner - c is
+        # largest at the corner picked by the signs of n and smallest at the opposite one:
+        # d = n . (x, y) - c, plus hi (resp. lo) per edge. One (cells, edges) block.
+        hi = np.maximum(nrm[:, 0], 0.0) * self.cw + np.maximum(nrm[:, 1], 0.0) * self.ch
+        lo = np.minimum(nrm[:, 0], 0.0) * self.cw + np.minimum(nrm[:, 1], 0.0) * self.ch
+        step = max(1, (1 << 21) // len(q))  # bound the (cells, edges) block
+        for s in range(0, ii.size, step):
+            cx0 = (self.x0 - self.ox) + ii[s : s + step] * self.cw
+            cy0 = (self.y0 - self.oy) + jj[s : s + step] * self.ch
+            d = np.multiply.outer(cx0, nrm[:, 0])
+            d += np.multiply.outer(cy0, nrm[:, 1])
+            d -= c
+            strictly_in = d <= -m - hi  # (cells, edges): every corner well inside the edge's half-plane
+            inside[s : s + step] = strictly_in.all(axis=1)
+            if wide:
+                bits = np.packbits(np.roll(~strictly_in, 1, axis=1), axis=1, bitorder="little")
+                masks[s : s + step] = [int.from_bytes(b.tobytes(), "little") for b in bits]
+            else:
+                masks[s : s + step] = (~strictly_in) @ weights
+            # Separated when every corner lies beyond one edge; the cell's own axes are
+            # covered by the bounding-box range above.
+            separated[s : s + step] = (d >= m - lo).any(axis=1)
+        keep = ~separated
+        return (jj * self.nx + ii)[keep], inside[keep], masks[keep]
+
+    # -- queries -----------------------------------------------------------------
+
+    def cell_of(self, x: float, y: float) -> int:
+        """Flat index of the cell holding (x, y) (clamped to the grid)."""
+        i = math.floor((x - self.x0) * self.inv_w)
+        j = math.floor((y - self.y0) * self.inv_h)
+        i = 0 if i < 0 else (self.nx - 1 if i >= self.nx else i)
+        j = 0 if j < 0 else (self.ny - 1 if j >= self.ny else j)
+        return j * self.nx + i
+
+    def state_at(self, x: float, y: float) -> int:
+        """FREE, MIXED or BLOCKED for the cell holding (x, y)."""
+        return self.state_list[self.cell_of(x, y)]
+
+    def candidates(self, cell: int) -> np.ndarray:
+        """Pieces that may meet a MIXED cell."""
+        return self._cand[self._starts[cell] : self._starts[cell + 1]]
+
+    def candidates_of(self, cells: np.ndarray) -> np.ndarray:
+        """Distinct pieces that may meet any of ``cells`` (one vectorised gather)."""
+        s, e = self._starts[cells], self._starts[cells + 1]
+        counts = e - s
+        total = int(counts.sum())
+        if total == 0:
+            return np.zeros(0, dtype=np.int64)
+        idx = np.repeat(s - (np.cumsum(counts) - counts), counts) + np.arange(total)
+        return np.unique(self._cand[idx])
+
+    def segment_candidates(self, ax: float, ay: float, bx: float, by: float, on_blocker=None):
+        """Pieces the closed segment a-b may meet: ``(blockers, candidates)`` as sets.
+
+        The segment is halved recursively; a piece of it whose cell bounding box
+        (widened by the margin) holds no non-FREE cell is free and dropped, in O(1)
+        through the summed-area table. Pieces of at most 2 x 2 cells are leaves:
+        their BLOCKED cells contribute their blocking piece, their MIXED cells their
+        candidate pieces. The caller tests the original segment exactly against
+        both sets, so the halving only has to be conservative, never exact.
+        ``on_blocker(k)``, if given, is called on each new blocking piece as soon as
+        it is found (nearest ``a`` first); when it returns True the walk stops and
+        ``None`` is returned (the caller found a hit).
+        """
+        m, x0, y0, iw, ih = self.margin, self.x0, self.y0, self.inv_w, self.inv_h
+        nx1, ny1 = self.nx - 1, self.ny - 1
+        sat, state, nx = self._sat, self.state_list, self.nx
+        blockers: set[int] = set()
+        cands: set[int] = set()
+        stack = [(ax, ay, bx, by)]
+        while stack:
+            px, py, qx, qy = stack.pop()
+            i0 = math.floor(((px if px < qx else qx) - m - x0) * iw)
+            i1 = math.floor(((qx if px < qx else px) + m - x0) * iw)
+            j0 = math.floor(((py if py < qy else qy) - m - y0) * ih)
+            j1 = math.floor(((qy if py < qy else py) + m - y0) * ih)
+            i0 = 0 if i0 < 0 else i0
+            j0 = 0 if j0 < 0 else j0
+            i1 = nx1 if i1 > nx1 else i1
+            j1 = ny1 if j1 > ny1 else j1
+            if i1 < i0 or j1 < j0:
+                continue
+            if sat[j1 + 1][i1 + 1] - sat[j0][i1 + 1] - sat[j1 + 1][i0] + sat[j0][i0] == 0:
+                continue  # every cell near this piece of the segment is FREE
+            # A leaf: at most 2 x 2 cells, or a piece shorter than a cell (the margin may
+            # span many cells when the scene is tiny against its coordinates, and halving
+            # cannot shrink the widened box then), or one floats can no longer halve.
+            if ((i1 - i0) < 2 and (j1 - j0) < 2) or (abs(qx - px) * iw < 1.0 and abs(qy - py) * ih < 1.0):
+                for j in range(j0, j1 + 1):
+                    for i in range(i0, i1 + 1):
+                        c = j * nx + i
+                        st = state[c]
+                        if st == BLOCKED:
+                            k = self.blocker_list[c]
+                            if k not in blockers:
+                                blockers.add(k)
+                                if on_blocker is not None and on_blocker(k):
+                                    return None
+                        elif st == MIXED:
+                            cands.update(self._cand_list[self._starts_list[c]:self._starts_list[c + 1]])
+                continue
+            mx, my = 0.5 * (px + qx), 0.5 * (py + qy)
+            if (mx == px and my == py) or (mx == qx and my == qy):
+                stack.append((px, py, px, py))  # cannot halve: one more pass as a leaf
+                stack.append((qx, qy, qx, qy))
+                continue
+            stack.append((mx, my, qx, qy))
+            stack.append((px, py, mx, my))
+        return blockers, cands
+
+    def cells_on_segment(self, ax: float, ay: float, bx: float, by: float) -> np.ndarray:
+        """Every cell the closed segment a-b may meet (a conservative supercover).
+
+        For each grid column the segment crosses, the rows spanned by the segment's
+        y-range inside that column, widened by the margin, are taken.
+        """
+        m = self.margin
+        xlo, xhi = min(ax, bx), max(ax, bx)
+        i0 = max(math.floor((xlo - m - self.x0) * self.inv_w), 0)
+        i1 = min(math.floor((xhi + m - self.x0) * self.inv_w), self.nx - 1)
+        if i1 < i0:
+            return np.zeros(0, dtype=np.int64)
+        cols = np.arange(i0, i1 + 1)
+        # x-interval of each column, widened by the margin, intersected with the
+        # segment's x-range. Widening makes the y-range below grow by m |slope|,
+        # which dominates the rounding of the column boundary times the slope, so
+        # even near-vertical segments keep a conservative row range.
+        lo = np.maximum(self.x0 + cols * self.cw - m, xlo)
+        hi = np.minimum(self.x0 + (cols + 1) * self.cw + m, xhi)
+        ylo_seg, yhi_seg = min(ay, by), max(ay, by)
+        if bx != ax:
+            t = (ay - by) / (ax - bx)
+            ylo_x, yhi_x = ay + (lo - ax) * t, ay + (hi - ax) * t
+            y_lo = np.maximum(np.minimum(ylo_x, yhi_x), ylo_seg)
+            y_hi = np.minimum(np.maximum(ylo_x, yhi_x), yhi_seg)
+        else:
+            y_lo = np.full(cols.size, ylo_seg)
+            y_hi = np.full(cols.size, yhi_seg)
+        r0 = np.clip(np.floor((y_lo - m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
+        r1 = np.clip(np.floor((y_hi + m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
+        counts = r1 - r0 + 1
+        total = int(counts.sum())
+        col_rep = np.repeat(cols, counts)
+        offs = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+        rows = np.repeat(r0, counts) + offs
+        return rows * self.nx + col_rep
+
+    def stats(self) -> dict:
+        """Cell counts by class, for reports."""
+        return {
+            "cells": int(self.nx * self.ny),
+            "grid": [int(self.nx), int(self.ny)],
+            "free": int((self.state == FREE).sum()),
+            "blocked": int((self.state == BLOCKED).sum()),
+            "mixed": int((self.state == MIXED).sum()),
+        }

@@ -1,0 +1,268 @@
+"""Certified motions of a car-like robot: straight segments and arcs of its turning circle.
+
+A Dubins or Reeds–Shepp motion (:mod:`cspace.spaces.car_curves`) is a chain of segments
+from the start pose: "S" drives straight at a fixed heading, "L" / "R" turn about
+the centre c of the turning circle on that side. This module answers "is every
+pose of the chain free?" for :class:`cspace.spaces.se2.SE2CSpace`, never by sampling
+(note se2-rotation.md, section 3):
+
+- a straight segment is a translation at one fixed angle: the SE(2) C-space's exact
+  fixed-angle motion test (:meth:`SE2Motions.motion_free` with equal angles);
+- an arc is a rotation of the whole robot about c: in a frame centred at c the
+  robot's convex pieces P_c (placed at the arc's start) turn by α over an interval
+  [a, b], so they stay inside the padded hull H of the triangles T(v) (the slab
+  bound with radii measured from c). H is separated from the obstacle pieces near
+  it by separating axes with a margin above the rounding (:meth:`_turn_hits`): a
+  certificate. Otherwise [a, b] is halved and the pose at the middle angle tested
+  exactly. The answer is False on an exact pose in collision, or, counted in
+  ``checks["motion_floor"]``, when an interval shrinks below a floor or a budget of
+  bounds is spent (conservative, never a false "free").
+- The reference point stays within the bounds: each arc's box (its end points and
+  the axis-extreme points of the circle it passes) must lie inside them.
+
+The certified set is the union of the exact primitive motions started from the
+float knots (:func:`cspace.spaces.car_curves.advance`); consecutive knots meet within
+rounding, which the hull's pad (hundreds of units of roundoff of the coordinates)
+covers, and the curve's end is joined to the goal pose by a certified SE(2) motion.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .car_curves import advance, turning_centre
+from ..kernel.slab import rotate_piece, slab_pad, wrap_angle
+
+# Initial split of an arc: intervals of at most this angle (the bound's excess over
+# the swept set grows as radius · Δ²/4, so a quarter turn would be loose).
+ARC_CHUNK = math.pi / 8
+# Refinement stops (answer "not free", counted) when an interval's sweep is below
+# this fraction of the scene's extent, or after this many hulls for one curve.
+FLOOR_REL = 1e-9
+MAX_HULLS = 4096
+
+
+def _normals(p: np.ndarray) -> np.ndarray:
+    """Outward normals (dy, −dx) of a CCW convex polygon's edges (zero rows for a point)."""
+    e = np.roll(p, -1, axis=0) - p
+    return np.column_stack([e[:, 1], -e[:, 0]])
+
+
+def _unit_planes(pieces: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every piece's edge lines as unit outward normals and offsets, padded to the largest
+    edge count with copies of the piece's first line: arrays of shape (pieces, edges)."""
+    k = max((len(p) for p in pieces), default=0)
+    ux = np.zeros((len(pieces), k))
+    uy = np.zeros((len(pieces), k))
+    off = np.zeros((len(pieces), k))
+    for i, p in enumerate(pieces):
+        n = _normals(p)
+        ln = np.hypot(n[:, 0], n[:, 1])
+        ln[ln == 0.0] = 1.0
+        nx, ny = n[:, 0] / ln, n[:, 1] / ln
+        o = nx * p[:, 0] + ny * p[:, 1]
+        m = len(p)
+        ux[i, :m], uy[i, :m], off[i, :m] = nx, ny, o
+        ux[i, m:], uy[i, m:], off[i, m:] = nx[0], ny[0], o[0]
+    return ux, uy, off
+
+
+class CarMotions:
+    """The car-like motion queries of :class:`cspace.spaces.se2.SE2CSpace` (a mixin)."""
+
+    _car_planes = None
+
+    def curve_free(self, q0, segments, radius: float, q1=None) -> bool:
+        """Is every pose of the segment chain from q0 free? Certified (see module doc).
+
+        ``segments`` are ``(kind, signed length)`` pairs (``"L"``, ``"S"``, ``"R"``;
+        length < 0 drives in reverse), ``radius`` the turning radius. With ``q1`` the
+        chain's end is joined to q1 by a certified SE(2) motion (it differs only by
+        rounding when the segments were computed from q0 to q1).
+
+        >>> import numpy as np
+        >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+        >>> box = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
+        >>> from cspace.spaces.se2 import SE2CSpace
+        >>> cs = SE2CSpace((0, 10, 0, 10), [sq], [box], slabs=16)
+        >>> cs.curve_free((2, 2, 0), [("L", math.pi / 2), ("S", 5)], 1.0)  # quarter turn, then up x = 3
+        True
+        >>> cs.curve_free((2, 2, 0), [("S", 3), ("L", math.pi / 2), ("S", 5)], 1.0)  # up x = 6: hits
+        False
+        """
+        self.checks["curves"] += 1
+        radius = float(radius)
+        pose = (float(q0[0]), float(q0[1]), wrap_angle(float(q0[2])))
+        if not self._pose(*pose):
+            self.checks["motion_collisions"] += 1
+            return False
+        budget = [MAX_HULLS]
+        # The knots (segment ends, wrapped) and, first, a probe of a few exact poses (each
+        # knot and each segment's middle): a colliding curve is usually refused here at
+        # the cost of a handful of pose tests. The probe only ever answers "not free".
+        chain = []
+        for kind, length in segments:
+            length = float(length)
+            if length == 0.0:
+                continue
+            end = advance(pose, kind, length, radius)
+            chain.append((pose, kind, length, (end[0], end[1], wrap_angle(end[2]))))
+            pose = chain[-1][3]
+        for start, kind, length, end in chain:
+            mid = advance(start, kind, 0.5 * length, radius)
+            if not (self._pose(*end) and self._pose(mid[0], mid[1], wrap_angle(mid[2]))):
+                self.checks["motion_collisions"] += 1
+                return False
+        # Then the certificates: straight segments (exact, cheap) before arcs.
+        for start, kind, length, end in chain:
+            if kind == "S" and not self.motion_free(start, (end[0], end[1], start[2])):  # one fixed angle
+                return False
+        for start, kind, length, end in chain:
+            if kind != "S" and not self._arc_free(start, kind, length, radius, budget):
+                return False
+        if q1 is not None:
+            q1 = (float(q1[0]), float(q1[1]), wrap_angle(float(q1[2])))
+            if pose != q1 and not self.motion_free(pose, q1):
+                return False
+        return True
+
+    def _arc_free(self, pose, kind: str, length: float, radius: float, budget: list) -> bool:
+        """The arc of one turn segment, certified by hulls about the turning centre."""
+        self.checks["arcs"] += 1
+        x, y, th = pose
+        cx, cy = turning_centre(pose, kind, radius)
+        A = length / radius if kind == "L" else -length / radius  # signed turn about c (CCW > 0)
+        rx, ry = x - cx, y - cy
+        # The robot's pieces at the arc's start, in the frame centred at c (a point robot: the point).
+        rel = np.array([[rx, ry]])
+        arrays = [rotate_piece(p, th) + rel for p in self.robot_pieces] or [rel]
+        pieces = [p.tolist() for p in arrays]
+        normals = [_normals(p).tolist() for p in arrays]
+        reach = math.hypot(rx, ry) + self.radius
+        scale = self.scale + abs(cx) + abs(cy) + reach
+        # The robot stays within `reach` of c while it turns: only obstacle pieces nearer
+        # than that (a lower bound of the distance, see _within) can be met.
+        near = self._within(cx, cy, reach, scale)
+        lo, hi = min(0.0, A), max(0.0, A)
+        n = max(1, math.ceil((hi - lo) / ARC_CHUNK))
+        stack = [(lo + (hi - lo) * (i / n), lo + (hi - lo) * ((i + 1) / n)) for i in range(n - 1, -1, -1)]
+        floor_len = FLOOR_REL * self.extent
+        while stack:
+            a, b = stack.pop()
+            if not self._arc_in_bounds(cx, cy, rx, ry, a, b):
+                self.checks["motion_collisions"] += 1
+                return False  # the reference point leaves the bounds
+            budget[0] -= 1
+            self.checks["arc_sweeps"] += 1
+            if not near.size or not any(self._turn_hits(p, nrm, cx, cy, a, b, scale, near)
+                                        for p, nrm in zip(pieces, normals)):
+                continue
+            m = 0.5 * (a + b)
+            c, s = math.cos(m), math.sin(m)
+            if not self._pose(cx + rx * c - ry * s, cy + rx * s + ry * c, wrap_angle(th + m)):
+                self.checks["motion_collisions"] += 1
+                return False  # an exact pose in collision
+            if reach * (b - a) <= floor_len or budget[0] <= 0 or not (a < m < b):
+                self.checks["motion_floor"] += 1
+                return False  # undecided at the floor: conservative
+            stack.append((m, b))
+            stack.append((a, m))
+        return True
+
+    def _within(self, cx: float, cy: float, reach: float, scale: float) -> np.ndarray:
+        """Indices of the obstacle pieces that may come within ``reach`` of (cx, cy).
+
+        A piece is out of reach when one of its edge lines has the point on its outer
+        side farther than ``reach``: the distance to that line bounds the distance to
+        the piece from below. The margin 2δ (:func:`cspace.kernel.slab.slab_pad` of the
+        coordinates) covers the rounding of the unit normals and the products."""
+        planes = self._car_planes
+        if planes is None:
+            planes = self._car_planes = _unit_planes(self.obstacle_pieces)
+        ux, uy, off = planes
+        if not len(off):
+            return np.zeros(0, dtype=np.intp)
+        gap = (ux * cx + uy * cy - off).max(axis=1)
+        return np.flatnonzero(gap <= reach + 2.0 * slab_pad(scale))
+
+    def _turn_hits(self, piece: list, normals: list, cx: float, cy: float, a: float, b: float, scale: float,
+                   near: np.ndarray) -> bool:
+        """Might the convex piece (vertex list about the centre c), turned through every
+        angle of [a, b] (b − a ≤ π/4), meet an obstacle piece? False is a certificate;
+        True may be wrong (it only costs a refinement).
+
+        Every turned vertex lies in its triangle T(v) = {R_a v, R_b v, R_m v / cos(Δ/2)}
+        (note, section 1), so the turned piece lies in H = conv ⋃ T(v), padded by δ
+        (:func:`cspace.kernel.slab.slab_pad`) for the rounding of the rotations. H is never
+        built: a separating axis needs only H's support, the largest projection of the
+        3n triangle points (plus δ·(|nx| + |ny|) for the pad). The axes tried are the
+        obstacle piece's edge normals and the piece's own edge normals turned to a, m
+        and b; an axis separates only with a gap above a further δ·|n|, which covers
+        the rounding of the projections. Plain floats: the pieces are small.
+        """
+        h = 0.5 * (b - a)
+        m = a + h
+        k = 1.0 / math.cos(h)
+        ca, sa, cb, sb, cm, sm = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(m), math.sin(m)
+        pts = []
+        for x, y in piece:
+            pts.append((x * ca - y * sa + cx, x * sa + y * ca + cy))
+            pts.append((x * cb - y * sb + cx, x * sb + y * cb + cy))
+            pts.append(((x * cm - y * sm) * k + cx, (x * sm + y * cm) * k + cy))
+        xs = [p[0] for p in pts]
+        ys = [p[1] for p in pts]
+        x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+        d = slab_pad(max(max(-x0, x1, -y0, y1) * 1.5, scale))
+        olo, ohi = self._olo[near], self._ohi[near]
+        cand = near[(olo[:, 0] <= x1 + d) & (ohi[:, 0] >= x0 - d) & (olo[:, 1] <= y1 + d) & (ohi[:, 1] >= y0 - d)]
+        if not cand.size:
+            return False
+        axes = None
+        for i in cand.tolist():
+            separated = False
+            for nx, ny, off, ln in self._obstacle_edges[i]:  # beyond one of the obstacle's edges?
+                lo = min(nx * px + ny * py for px, py in pts)
+                if lo - off > d * (abs(nx) + abs(ny) + ln):
+                    separated = True
+                    break
+            if separated:
+                continue
+            if axes is None:  # the piece's normals turned to a, m and b, with H's support along them
+                axes = []
+                for nx, ny in normals:
+                    for c, s in ((ca, sa), (cm, sm), (cb, sb)):
+                        ax, ay = nx * c - ny * s, nx * s + ny * c
+                        g = d * (abs(ax) + abs(ay) + math.hypot(ax, ay))
+                        axes.append((ax, ay, max(ax * px + ay * py for px, py in pts) + g, g))
+            obst = self.obstacle_lists[i]
+            for ax, ay, top, g in axes:  # the obstacle beyond H along a turned normal?
+                if min(ax * ox + ay * oy for ox, oy in obst) - top > g:
+                    separated = True
+                    break
+            if not separated:
+                return True
+        return False
+
+    def _arc_in_bounds(self, cx: float, cy: float, rx: float, ry: float, a: float, b: float) -> bool:
+        """Does the reference point's arc (about c, from c + R_a r to c + R_b r) stay in bounds?
+
+        The arc's box is spanned by its end points and by the circle's axis-extreme
+        points whose angles it passes, computed in floats: the bounds are the state
+        space's (OMPL's), checked in floats as OMPL checks states, not an obstacle."""
+        xmin, xmax, ymin, ymax = self.bounds
+        rho = math.hypot(rx, ry)
+        phi0 = math.atan2(ry, rx)
+        xs, ys = [], []
+        for ang in (a, b):
+            c, s = math.cos(ang), math.sin(ang)
+            xs.append(cx + rx * c - ry * s)
+            ys.append(cy + rx * s + ry * c)
+        # Circle angles φ0 + α for α in [a, b]: which of 0, π/2, π, 3π/2 (mod 2π) lie inside?
+        for q, (dx, dy) in enumerate(((1, 0), (0, 1), (-1, 0), (0, -1))):
+            target = q * 0.5 * math.pi
+            k = math.ceil((phi0 + a - target) / (2 * math.pi))
+            if target + 2 * math.pi * k <= phi0 + b:
+                xs.append(cx + dx * rho)
+                ys.append(cy + dy * rho)
+        return xmin <= min(xs) and max(xs) <= xmax and ymin <= min(ys) and max(ys) <= ymax

@@ -1,0 +1,179 @@
+"""The optional compiled fast path: which C routines are available, and their handles.
+
+This module owns the choice between the compiled routines of ``cspace/spaces/_fast.c`` and the
+pure-Python path. The extension is built by ``setup.py`` when a C compiler is present
+(``optional=True``: without one, cspace installs and runs pure). ``CSPACE_PURE=1`` in
+the environment, read at import, forces the pure path.
+
+The C routines decide only what Shewchuk's stage-A float filter certifies and answer
+"undecided" (-1) otherwise; the caller then runs the pure path, which is exact
+(rationals). So both paths give the same answers, the pure one being the oracle
+(tests/test_fastpath.py checks that on random and degenerate queries).
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+
+import numpy as np
+
+_fast = None
+if os.environ.get("CSPACE_PURE", "") in ("", "0"):
+    try:
+        from . import _fast  # type: ignore[attr-defined,no-redef]
+    except ImportError:  # not built (no compiler): the pure path
+        _fast = None
+
+ENABLED: bool = _fast is not None
+
+
+def grid_handle(index, packed, bounds):
+    """A handle on a copy of ``index`` (a :class:`cspace.spaces.broadphase.GridIndex`) and
+    ``packed`` (its :class:`cspace.kernel.pieces.PieceSet`) for the compiled queries, or None
+    on the pure path.
+
+    >>> import numpy as np
+    >>> from cspace.spaces.broadphase import GridIndex
+    >>> from cspace.kernel.pieces import PieceSet
+    >>> sq = [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])]
+    >>> h = grid_handle(GridIndex(sq, (0, 10, 0, 10)), PieceSet(sq), (0, 10, 0, 10))
+    >>> h is None or (_fast.point(h, 5.0, 5.0), _fast.segment(h, 1.0, 5.0, 9.0, 5.0)) == (0, 0)
+    True
+    """
+    if _fast is None:
+        return None
+    xy = packed.start if len(packed) else np.zeros((0, 2))
+    return _fast.grid(
+        np.ascontiguousarray(index.state, dtype=np.uint8),
+        np.ascontiguousarray(index.blocker, dtype=np.int64),
+        np.ascontiguousarray(index._starts, dtype=np.int64),
+        np.ascontiguousarray(index._cand, dtype=np.int64),
+        np.ascontiguousarray(packed.offsets, dtype=np.int64),
+        np.ascontiguousarray(xy, dtype=np.float64),
+        index.nx, index.ny, index.x0, index.y0, index.inv_w, index.inv_h, index.cw, index.ch, index.margin,
+        *map(float, bounds))
+
+
+def segment_test(handle, pure, checks: dict):
+    """The C-space's ``(ax, ay, bx, by) -> bool`` segment test: the compiled routine's
+    certified answer when it has one, else ``pure`` (exact); ``pure`` itself on the pure
+    path (``handle`` None). Counted in ``checks`` as the pure test counts.
+
+    >>> segment_test(None, max, {}) is max
+    True
+    """
+    if handle is None:
+        return pure
+    seg = _fast.segment
+
+    def segment(ax: float, ay: float, bx: float, by: float) -> bool:
+        r = seg(handle, ax, ay, bx, by)  # 1 or 3 free, 0 not, -1 undecided or out of bounds
+        if r < 0:
+            return pure(ax, ay, bx, by)
+        checks["segments"] += 1
+        if r != 1:
+            checks["exact_segments"] += 1  # the narrow phase ran
+        return r != 0
+
+    return segment
+
+
+def mixed_cell_test(handle, pure, checks: dict):
+    """``(cell, x, y) -> bool``, the point test of a MIXED cell: the compiled test's
+    certified answer when it has one, else ``pure`` (the Python narrow phase).
+
+    >>> mixed_cell_test(None, max, {}) is max
+    True
+    """
+    if handle is None:
+        return pure
+    point = _fast.point
+
+    def free_in_cell(cell: int, x: float, y: float) -> bool:
+        r = point(handle, x, y)  # 1 free, 0 not, -1 undecided
+        if r < 0:
+            return pure(cell, x, y)
+        checks["exact_points"] += 1
+        return r == 1
+
+    return free_in_cell
+
+
+def se2_slow_test(slab_handle, handle, pure, checks: dict):
+    """``(x, y, th) -> bool``, the slow path of an SE(2) slab's pose test (free in the
+    slab's C-space, else the exact test) in one compiled call; ``pure`` when it cannot
+    decide. ``math.cos``/``math.sin`` are taken here, so the C filter turns the robot by
+    the same doubles as the Python one.
+
+    >>> se2_slow_test(None, None, max, {}) is max
+    True
+    """
+    if handle is None or slab_handle is None:
+        return pure
+    both, cos, sin = _fast.se2_slow, math.cos, math.sin
+
+    def slow(x: float, y: float, th: float) -> bool:
+        r = both(slab_handle, handle, x, y, cos(th), sin(th))  # 1 free in the slab, 2 free, 0 not, -1 undecided
+        if r < 0:
+            return pure(x, y, th)
+        if r != 1:
+            checks["exact_states"] += 1  # decided by the exact test's filter stage
+        return r != 0
+
+    return slow
+
+
+def se2_handle(cs):
+    """A handle on the pose filter's data of a :class:`cspace.spaces.se2.SE2CSpace` (its obstacle
+    edges and vertices, body-frame robot pieces and normals, and pair grid) for the
+    compiled filter stage of its exact pose test, or None on the pure path (or without
+    robot pieces).
+
+    >>> import numpy as np
+    >>> from cspace.spaces.se2 import SE2CSpace
+    >>> cs = SE2CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])],
+    ...                [np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])], slabs=8)
+    >>> h = se2_handle(cs)
+    >>> h is None or (_fast.se2_pose(h, 5.0, 5.0, 1.0, 0.0), _fast.se2_pose(h, 1.0, 1.0, 1.0, 0.0)) == (0, 1)
+    True
+    """
+    if _fast is None or not cs.robot_pieces:
+        return None
+    o_off = np.concatenate([[0], np.cumsum([len(p) for p in cs.obstacle_lists])]).astype(np.int64)
+    r_off = np.concatenate([[0], np.cumsum([len(p) for p in cs._robot_lists])]).astype(np.int64)
+    o_edge = np.array([e for edges in cs._obstacle_edges for e in edges], dtype=np.float64).reshape(-1, 4)
+    o_pt = np.array([v for pts in cs.obstacle_lists for v in pts], dtype=np.float64).reshape(-1, 2)
+    r_pt = np.array([v for pts in cs._robot_lists for v in pts], dtype=np.float64).reshape(-1, 2)
+    r_nrm = np.array([v for nrm in cs._robot_normals for v in nrm], dtype=np.float64).reshape(-1, 3)
+    cells = cs._pg_cells
+    starts = np.concatenate([[0], np.cumsum([len(c) for c in cells])]).astype(np.int64)
+    entries = [e for c in cells for e in c]
+    e_ij = np.array([(e[0], e[1]) for e in entries], dtype=np.int64).reshape(-1, 2)
+    e_box = np.array([e[5:9] for e in entries], dtype=np.float64).reshape(-1, 4)
+    xmin, xmax, ymin, ymax = cs.bounds
+    return _fast.se2(o_off, np.ascontiguousarray(o_edge), np.ascontiguousarray(o_pt), r_off,
+                     np.ascontiguousarray(r_pt), np.ascontiguousarray(r_nrm), starts, np.ascontiguousarray(e_ij),
+                     np.ascontiguousarray(e_box), cs._pg_n, len(cs.obstacle_lists), len(cs._robot_lists),
+                     len(entries), xmin, xmax, ymin, ymax, cs.pad, cs._pg_x0, cs._pg_y0, cs._pg_iw, cs._pg_ih)
+
+
+@contextlib.contextmanager
+def disabled():
+    """Within the block, C-spaces are built on the pure path (no compiled handle): the
+    oracle of the tests and the pure column of the benches. Objects keep the path they
+    were built with (an SE(2) C-space's slabs: build them inside the block).
+
+    >>> from cspace.spaces import fastpath
+    >>> with fastpath.disabled():
+    ...     inside = fastpath._fast
+    >>> inside is None
+    True
+    """
+    global _fast
+    saved = _fast
+    _fast = None
+    try:
+        yield
+    finally:
+        _fast = saved
