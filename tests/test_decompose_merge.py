@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from cspace import decompose as dc
+from cspace.kernel import decompose as dc
 from cspace.kernel.polygon import normalize
 from cspace.kernel.predicates import CCW_ERRBOUND_A, orient2d_xy
 
