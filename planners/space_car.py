@@ -12,7 +12,6 @@ hulls about the turning centre), never sampled.
 """
 from __future__ import annotations
 
-import contextlib
 import math
 
 import numpy as np
@@ -20,9 +19,6 @@ import numpy as np
 from cspace.spaces.car_curves import curve_length, dubins_segments, knots, pose_along, reeds_shepp_segments
 
 from .space_se2 import SE2Space
-from .spaces import verify_path
-
-_classes: dict = {}
 
 SEGMENT_NAMES = {"L": "left", "S": "straight", "R": "right"}
 
@@ -32,6 +28,7 @@ class CarSpace(SE2Space):
     minimum turning radius (OMPL's states and radius scaled by 2^k, exactly)."""
 
     unsolved_hint = "try a longer --time (a car needs room to turn: check the turning radius)"
+    step = "curve"
 
     def __init__(self, cspace, kind: str, radius: float, k: int | None = None):
         super().__init__(cspace, k)
@@ -67,41 +64,13 @@ class CarSpace(SE2Space):
         (certified: :meth:`cspace.spaces.se2.SE2CSpace.curve_free`)."""
         return self.cspace.curve_free(q0, self.segments(q0, q1), self.radius, q1=q1)
 
-    def motion_validator(self, si):
-        if "validator" not in _classes:
-            from .ompl_glue import ompl
-
-            ob = ompl()[0]
-
-            class CertifiedCurveValidator(ob.MotionValidator):
-                """A motion is valid iff the car, driven along the Dubins / Reeds–Shepp curve,
-                touches nothing: certified segment by segment, never sampled."""
-
-                def __init__(self, si, adapter):
-                    super().__init__(si)
-                    self.motion_free = adapter.motion_free
-                    self.k = -adapter.k
-
-                def checkMotion(self, s1, s2, *rest):
-                    k = self.k
-                    ok = self.motion_free((math.ldexp(s1.getX(), k), math.ldexp(s1.getY(), k), s1.getYaw()),
-                                          (math.ldexp(s2.getX(), k), math.ldexp(s2.getY(), k), s2.getYaw()))
-                    if rest and not ok:  # the (s1, s2, lastValid) form: report no progress
-                        with contextlib.suppress(Exception):
-                            rest[0].second = 0.0
-                    return ok
-
-            _classes["validator"] = CertifiedCurveValidator
-        return _classes["validator"](si, self)
-
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every curve between consecutive poses certified free, from the start pose to the goal pose.
 
         A Dubins curve is one-way (the curve from b to a is not the one from a to b
         reversed); planners that use a motion in both directions (PRM, PRMstar,
         BKPIECE1, ...) can return paths that fail here, and the message says so."""
-        ok, msg = verify_path(path, self.pose(start), self.pose(goal), self.motion_free, step="curve",
-                              test="certified", ends="the start pose to the goal pose")
+        ok, msg = super().verify(path, start, goal)
         if not ok and self.name == "dubins":
             msg += (" (Dubins curves are one-way: planners that use a motion in both directions, such as "
                     "PRM, PRMstar and BKPIECE1, return such paths; use RRT, RRTConnect, RRTstar or BITstar)")

@@ -28,6 +28,7 @@ class SE2Space:
 
     dim = 3
     name = "se2"
+    step = "motion"  # what verify() calls one step of a path
     # Said when a sampling planner fails (the inscribed-disk rule has already been tried).
     unsolved_hint = "try a longer --time, or more --slabs for a tighter C-space near obstacles"
 
@@ -109,13 +110,13 @@ class SE2Space:
             ob = ompl()[0]
 
             class CertifiedSE2MotionValidator(ob.MotionValidator):
-                """A motion is valid iff the robot, swept along OMPL's SE(2) interpolation,
-                touches nothing: certified by the sliced C-space, never sampled."""
+                """A motion is valid iff the robot, moved as the adapter moves it (OMPL's SE(2)
+                interpolation, or a car's curve), touches nothing: certified, never sampled."""
 
-                def __init__(self, si, cspace, k):
+                def __init__(self, si, adapter):
                     super().__init__(si)
-                    self.motion_free = cspace.motion_free
-                    self.k = -k
+                    self.motion_free = adapter.motion_free
+                    self.k = -adapter.k
 
                 def checkMotion(self, s1, s2, *rest):
                     k = self.k
@@ -127,7 +128,12 @@ class SE2Space:
                     return ok
 
             _classes["validator"] = CertifiedSE2MotionValidator
-        return _classes["validator"](si, self.cspace, self.k)
+        return _classes["validator"](si, self)
+
+    def motion_free(self, q0, q1) -> bool:
+        """Whether the robot, moved along OMPL's SE(2) interpolation from q0 to q1, touches
+        nothing (certified: :meth:`cspace.spaces.se2.SE2CSpace.motion_free`)."""
+        return self.cspace.motion_free(q0, q1)
 
     def pose(self, p) -> tuple:
         """A pose as a tuple of 3 floats (theta 0 when only (x, y) is given).
@@ -143,7 +149,7 @@ class SE2Space:
 
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every motion certified free, from the start pose exactly to the goal pose exactly."""
-        return verify_path(path, self.pose(start), self.pose(goal), self.cspace.motion_free, step="motion",
+        return verify_path(path, self.pose(start), self.pose(goal), self.motion_free, step=self.step,
                            test="certified", ends="the start pose to the goal pose")
 
     def length(self, path: np.ndarray) -> float:

@@ -60,35 +60,17 @@ def plan_figure(scenario: str, planner: str | None = None, seed: int = SEED) -> 
     return draw
 
 
-def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False) -> Callable[[str], str]:
-    """A rotating robot's plan (scenarios/se2/), its footprint along the path; with ``animate``
-    also the GIF of ``cspace plan --animate`` beside the PNG (same name, .gif)."""
+def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False, folder: str = "se2") -> Callable[[str], str]:
+    """A rotating robot's plan (scenarios/se2/, or a car's in scenarios/car/ with
+    ``folder="car"``), its footprint along the path; with ``animate`` also the GIF of
+    ``cspace plan --animate`` beside the PNG (same name, .gif)."""
 
     def draw(out: str) -> str:
         from planners.animate import animate_path
         from planners.plan import plan
         from planners.plot import plot_result
 
-        res = plan(os.path.join(SCENARIOS, "se2", f"{scenario}.toml"), seed=seed)
-        plot_result(res, out)
-        if animate and res.solved:
-            animate_path(res, os.path.splitext(out)[0] + ".gif")
-        state = f"length {res.length:.6g}" if res.solved else "not solved"
-        return f"{res.planner} seed {res.seed}: {state}" + (" (+ GIF)" if animate and res.solved else "")
-
-    return draw
-
-
-def car_plan_figure(scenario: str, seed: int = 0, animate: bool = False) -> Callable[[str], str]:
-    """A car's plan (scenarios/car/): its curves (reverse dashed) and footprint along them;
-    with ``animate`` also the GIF of ``cspace plan --animate`` beside the PNG."""
-
-    def draw(out: str) -> str:
-        from planners.animate import animate_path
-        from planners.plan import plan
-        from planners.plot import plot_result
-
-        res = plan(os.path.join(SCENARIOS, "car", f"{scenario}.toml"), seed=seed)
+        res = plan(os.path.join(SCENARIOS, folder, f"{scenario}.toml"), seed=seed)
         plot_result(res, out)
         if animate and res.solved:
             animate_path(res, os.path.splitext(out)[0] + ".gif")
@@ -236,10 +218,10 @@ def figures() -> list[Figure]:
     out.append(Figure("se2_tee_slot_slab", "se2", "SE(2): the slab C-space of theta = pi/2",
                       se2_slab_figure("tee_slot", 1.5707963267948966)))
     out.append(Figure("car_parking", "car", "car: parallel parking, Reeds-Shepp (GIF beside it)",
-                      car_plan_figure("parking", animate=True)))
-    out.append(Figure("car_u_turn", "car", "car: a three-point turn in a narrow street", car_plan_figure("u_turn")))
-    out.append(Figure("car_loading_dock", "car", "car: backing into a loading bay", car_plan_figure("loading_dock")))
-    out.append(Figure("car_maze", "car", "car: Dubins through a maze", car_plan_figure("maze")))
+                      se2_plan_figure("parking", animate=True, folder="car")))
+    out.append(Figure("car_u_turn", "car", "car: a three-point turn in a narrow street", se2_plan_figure("u_turn", folder="car")))
+    out.append(Figure("car_loading_dock", "car", "car: backing into a loading bay", se2_plan_figure("loading_dock", folder="car")))
+    out.append(Figure("car_maze", "car", "car: Dubins through a maze", se2_plan_figure("maze", folder="car")))
     out.append(Figure("map_office", "maps", "a ROS occupancy map imported and planned", map_figure()))
     out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
     out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure()))

@@ -84,7 +84,7 @@ def test_build_with_the_loaders_convexity_equals_a_fresh_one(path):
     sc = cs.scenario
     fresh = CSpace(sc.bounds, [o.polygon for o in sc.obstacles], [r.polygon for r in sc.robot],
                    obstacle_holes=[o.holes for o in sc.obstacles], robot_is_disk=sc.robot_kind == "disk",
-                   normalized=True)
+                   normalized=True, margin=sc.margins())
     assert len(cs.pieces) == len(fresh.pieces) and all(np.array_equal(a, b) for a, b in zip(cs.pieces, fresh.pieces))
     assert cs.piece_pairs == fresh.piece_pairs
 

@@ -70,7 +70,7 @@ def import_file(path, options: ImportOptions | None = None) -> Imported:
     """Import a map YAML or an OMPL.app cfg into a scenario dict and a report.
 
     >>> import os
-    >>> root = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps")
+    >>> root = os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "maps")
     >>> imp = import_file(os.path.join(root, "office.yaml"), ImportOptions(start=(0.5, 0.5), goal=(9.5, 6.5)))
     >>> len(imp.data["obstacles"]), imp.data["bounds"]["xmax"]
     (54, 11.0)
@@ -93,7 +93,7 @@ def load_imported(path, space: str | None = None, options: ImportOptions | None 
     """:func:`import_file`, then validated into a :class:`cspace.io.scenario.Scenario`.
 
     >>> import os
-    >>> root = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps")
+    >>> root = os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "maps")
     >>> sc = load_imported(os.path.join(root, "office.yaml"),
     ...                    options=ImportOptions(robot={"radius": 0.2}, start=(0.5, 0.5), goal=(9.5, 6.5)))
     >>> sc.robot_kind, sc.start, sc.space
@@ -107,7 +107,7 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     """A ROS map (YAML + image) as a scenario dict: obstacles traced conservatively.
 
     >>> import os
-    >>> root = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps")
+    >>> root = os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "maps")
     >>> imp = import_map(os.path.join(root, "office.yaml"), ImportOptions(start=(0.5, 0.5), goal=(9.5, 6.5),
     ...                                                                   tolerance=0.0))
     >>> imp.report[2]

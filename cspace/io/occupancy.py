@@ -178,7 +178,7 @@ def read_image(info: MapInfo, yaml_path: str) -> tuple[np.ndarray, np.ndarray | 
     """The image as (H, W) uint8 channel averages (``map_server``'s value) and its alpha
     channel or None; 8-bit grey, grey+alpha, RGB, RGBA, palette and 1-bit images.
 
-    >>> f = os.path.join(os.path.dirname(__file__), "..", "scenarios", "maps", "office.yaml")
+    >>> f = os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "maps", "office.yaml")
     >>> values, alpha = read_image(read_map_yaml(f), f); values.shape, values.dtype.name, alpha
     ((180, 240), 'uint8', None)
     """
