@@ -25,7 +25,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 
-from cspace import CSpace, fastpath, load_scenario  # noqa: E402
+from cspace import CSpace, load_scenario  # noqa: E402
+from cspace.spaces import fastpath  # noqa: E402
 
 DEFAULT = ("maze.toml", "random_polygons.toml")
 

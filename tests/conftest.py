@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import importlib.util
+import sys
 import os
 import textwrap
 
@@ -30,5 +31,6 @@ def load_script(name: str):
     """Import ``scripts/NAME.py`` (the scripts are not a package) as a module."""
     spec = importlib.util.spec_from_file_location(name, os.path.join(ROOT, "scripts", f"{name}.py"))
     mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod  # as an import does: dataclasses and pickling look the module up there
     spec.loader.exec_module(mod)
     return mod

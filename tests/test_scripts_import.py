@@ -1,0 +1,16 @@
+"""Every script under scripts/ imports (its top-level imports resolve), so a moved module or a
+renamed name cannot leave a benchmark broken until someone runs it."""
+import glob
+import os
+
+import pytest
+
+from conftest import ROOT, load_script
+
+SCRIPTS = sorted(os.path.splitext(os.path.basename(p))[0] for p in glob.glob(os.path.join(ROOT, "scripts", "*.py")))
+
+
+@pytest.mark.parametrize("name", SCRIPTS)
+def test_script_imports(name):
+    mod = load_script(name)
+    assert mod.__name__ == name
