@@ -236,7 +236,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         _check_margin(sc, cspace)
     report = cspace.report()
     adapter = _adapter(sc, cspace)
-    if objective != "length" and not hasattr(adapter, "clearance_functions"):
+    if objective != "length" and getattr(adapter, "clearance_functions", None) is None:
         raise ScenarioError("plan()", "objective", f"{objective} is not available for space {sc.space!r} "
                                                    "(translation and se2 only)")
     queries = sc.all_queries() if all_queries else sc.all_queries()[:1]

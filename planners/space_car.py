@@ -29,6 +29,10 @@ class CarSpace(SE2Space):
 
     unsolved_hint = "try a longer --time (a car needs room to turn: check the turning radius)"
     step = "curve"
+    # The SE(2) clearance (its bound, its objective) follows OMPL's SE(2) interpolation between
+    # waypoints, not a car's curves: not inherited. A car's path clearance is not measured (yet).
+    path_clearance = None
+    clearance_functions = None
 
     def __init__(self, cspace, kind: str, radius: float, k: int | None = None):
         super().__init__(cspace, k)

@@ -172,3 +172,14 @@ def test_a_failed_dubins_path_says_curves_are_one_way():
     assert not ok and "one-way" in msg and "RRTConnect" in msg
     ok, msg = ad.verify(through_wall[::-1], sc.goal, sc.start)
     assert not ok
+
+
+def test_a_car_path_reports_no_clearance_it_did_not_measure(tmp_path):
+    """The SE(2) clearance bound follows OMPL's SE(2) interpolation, not a car's curves: a car's
+    result must not carry it (found in review: the adapter inherited it from the SE(2) one)."""
+    res = planners.plan(os.path.join(SCENARIOS, "car", "maze.toml"), seed=0)
+    assert res.solved and res.min_clearance is None and res.min_clearance_bound is None
+    r = cli("plan", os.path.join(SCENARIOS, "car", "maze.toml"), "--objective", "clearance")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "objective" in r.stderr
+    r = cli("plan", os.path.join(SCENARIOS, "car", "maze.toml"))
+    assert r.returncode == 0 and "min clearance: not measured" in r.stdout
