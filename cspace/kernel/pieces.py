@@ -39,9 +39,16 @@ class PieceSet:
             lo = hi = np.zeros((0, 2))
         self.owner = np.repeat(np.arange(len(self.pieces)), sizes)
         self.lo, self.hi = lo, hi
-        # Scalar copies for the one-piece hot path.
-        flat, cut = self.start.tolist(), self.offsets.tolist()
-        self._lists = [flat[cut[k]:cut[k + 1]] for k in range(len(self.pieces))]
+        self._scalar = None
+
+    @property
+    def _lists(self) -> list[list]:
+        """Scalar copies of the pieces (lists of [x, y]) for the one-piece hot path, made
+        on first use: the compiled fast path never asks for them."""
+        if self._scalar is None:
+            flat, cut = self.start.tolist(), self.offsets.tolist()
+            self._scalar = [flat[cut[k]:cut[k + 1]] for k in range(len(self.pieces))]
+        return self._scalar
 
     def __len__(self) -> int:
         return len(self.pieces)

@@ -33,8 +33,22 @@ _MARGIN = 1e-9
 # Boxes wider than this many cells are classified row by row (GridIndex._scan_rows).
 SCAN_COLUMNS = 8
 
+# The default grid: cells per piece, and the fewest cells (see GridIndex).
+CELLS_PER_PIECE = 256
+MIN_CELLS = 1 << 12
+
 # Most (piece, cell) pairs the build classifies, before the grid is coarsened.
 _PAIR_BUDGET = float(1 << 22)
+
+# Pieces of at most this many edges get their edge masks at build time (int64 bits);
+# wider ones (a margin's rounded corners, big disks) store WIDE_MASK and have a cell's
+# mask computed when a point first lands there (GridIndex.edge_mask), by the same test.
+MASK_EDGES = 62
+WIDE_MASK = -1  # every bit set: "test every edge" is always a valid mask
+
+# Pieces up to this many edges are classified in padded (piece, cell, edge) blocks;
+# wider ones one by one (a 10^6-gon must not pad every other piece to its size).
+_BLOCK_EDGES = 1024
 
 
 def _runs(rows: np.ndarray, jj: np.ndarray, lo: np.ndarray, hi: np.ndarray):
@@ -91,7 +105,12 @@ class GridIndex:
         w, h = xmax - xmin, ymax - ymin
         self._lo, self._hi = piece_boxes(pieces)  # each piece's box, in one pass
         if cells is None:
-            cells = int(min(max(1024 * n, 1 << 16), 1 << 20))
+            # About 256 cells per piece, at least 64 x 64: measured on the bundled scenes
+            # (plans of RRTConnect, compiled and pure paths), 1024 per piece and at least
+            # 256 x 256 classified 2-4x longer for no faster query: a MIXED cell costs
+            # the compiled narrow phase less than the Python call around it, and a
+            # segment walks fewer cells.
+            cells = int(min(max(CELLS_PER_PIECE * n, MIN_CELLS), 1 << 20))
             # Large, overlapping pieces (comb sums) would each cover a big share of that
             # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
             cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist())
@@ -118,22 +137,23 @@ class GridIndex:
         cand_cells: list[np.ndarray] = []
         cand_piece: list[np.ndarray] = []
         cand_mask: list[np.ndarray] = []
-        # Pieces of up to 62 edges are classified together, in blocks of (piece, cell)
-        # pairs (one numpy pass instead of one per piece); wider ones one by one (their
-        # edge masks are Python ints).
-        narrow = [k for k, p in enumerate(pieces) if len(p) <= 62]
-        if narrow:
-            pid, cells_k, inside, masks = self._classify_many(pieces, narrow)
-            cand_cells.append(cells_k)
-            cand_piece.append(pid)
-            inside_parts = [inside]
-            cand_mask.append(masks)
-        else:
-            inside_parts = []
+        # Pieces are classified together, in blocks of (piece, cell) pairs (one numpy
+        # pass instead of one per piece), those with masks apart from the wider ones so
+        # that a 4-gon is not padded to a margin's 70 edges; huge pieces one by one.
+        inside_parts = []
+        sizes = [len(p) for p in pieces]
+        for group in ([k for k, e in enumerate(sizes) if e <= MASK_EDGES],
+                      [k for k, e in enumerate(sizes) if MASK_EDGES < e <= _BLOCK_EDGES]):
+            if group:
+                pid, cells_k, inside, masks = self._classify_many(pieces, group)
+                cand_cells.append(cells_k)
+                cand_piece.append(pid)
+                inside_parts.append(inside)
+                cand_mask.append(masks)
         for k, p in enumerate(pieces):
-            if len(p) <= 62:
+            if sizes[k] <= _BLOCK_EDGES:
                 continue
-            cells_k, inside, masks = self._classify(p)
+            cells_k, inside, masks = self._classify(p, with_masks=False)
             cand_cells.append(cells_k)
             cand_piece.append(np.full(cells_k.size, k, dtype=np.int64))
             inside_parts.append(inside)
@@ -176,17 +196,60 @@ class GridIndex:
         # may pass within the margin of the cell (bit e: edge from vertex e-1 to e).
         # Every other edge has the whole widened cell strictly on its
         # inner side, so a point located in the cell needs no test against it.
-        # (Pieces of more than 62 edges have Python-int masks: a list then.)
-        self.cand_masks_list = cm.tolist() if cm.dtype == object else _ints(cm)
+        # (Pieces of more than MASK_EDGES edges: WIDE_MASK, see edge_mask.)
+        self.cand_masks_list = _ints(cm)
         self._starts_list = _ints(starts)
-        # Summed-area table of non-FREE cells: the count in any block of cells in O(1),
-        # read as sat[j][i] (one array.array per row).
-        busy = (state != FREE).reshape(ny, nx).astype(np.int64)
-        sat = np.zeros((ny + 1, nx + 1), dtype=np.int64)
-        np.cumsum(busy, axis=0, out=sat[1:, 1:])
-        np.cumsum(sat[1:, 1:], axis=1, out=sat[1:, 1:])
-        self._sat = [_ints(r) for r in sat]
         self._rows = None
+        self._sat_rows = None
+
+    @property
+    def _sat(self) -> list[array]:
+        """Summed-area table of non-FREE cells: the count in any block of cells in O(1),
+        read as sat[j][i] (one array.array per row). Built on first use: only the pure
+        segment walk reads it (the compiled one walks the cells itself)."""
+        if self._sat_rows is None:
+            busy = (self.state != FREE).reshape(self.ny, self.nx).astype(np.int64)
+            sat = np.zeros((self.ny + 1, self.nx + 1), dtype=np.int64)
+            np.cumsum(busy, axis=0, out=sat[1:, 1:])
+            np.cumsum(sat[1:, 1:], axis=1, out=sat[1:, 1:])
+            self._sat_rows = [_ints(r) for r in sat]
+        return self._sat_rows
+
+    def edge_mask(self, p: np.ndarray, cell: int) -> int:
+        """The edge mask of convex piece ``p`` in ``cell``, as the build computes it for
+        pieces of at most MASK_EDGES edges (bit e: the edge from vertex e-1 to e, set
+        when the edge's line may pass within the margin of the cell). Wider pieces
+        store WIDE_MASK at build; the point test asks this once per cell it visits.
+        Below, the cell meets the edges on x = 2 (bit 2) and y = 2 (bit 3).
+
+        >>> g = GridIndex([np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])], (0, 4, 0, 4), cells=16)
+        >>> bin(g.edge_mask(np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]]), 6))  # cell [2, 3] x [1, 2]
+        '0b1100'
+        """
+        nrm, c, hi, _ = self._half_planes(p)
+        i, j = cell % self.nx, cell // self.nx
+        d = ((self.x0 - self.ox) + i * self.cw) * nrm[:, 0]
+        d += ((self.y0 - self.oy) + j * self.ch) * nrm[:, 1]
+        d -= c
+        near = np.flatnonzero(~(d <= -self.margin - hi))
+        return sum(1 << ((int(e) + 1) % len(p)) for e in near)
+
+    def _half_planes(self, p: np.ndarray):
+        """Edge half-planes of ``p`` in the grid's local frame, n . x <= c with n the
+        outward unit normal of edge q[i] -> q[i+1]; and per edge the largest (``hi``)
+        and smallest (``lo``) of n . (corner - lower-left corner) over a cell."""
+        q = p - (self.ox, self.oy)
+        e = np.roll(q, -1, axis=0) - q
+        nrm = np.column_stack([e[:, 1], -e[:, 0]])
+        # A piece that rounded to a point (a disk of radius 1e-200 at (5, 5)) has zero-length
+        # edges: their NaN normals make every comparison False, so no cell is called
+        # inside or separated by them and the exact narrow phase decides (quietly).
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
+        c = np.einsum("ij,ij->i", nrm, q)
+        hi = np.maximum(nrm[:, 0], 0.0) * self.cw + np.maximum(nrm[:, 1], 0.0) * self.ch
+        lo = np.minimum(nrm[:, 0], 0.0) * self.cw + np.minimum(nrm[:, 1], 0.0) * self.ch
+        return nrm, c, hi, lo
 
     def state_rows(self) -> list[bytes]:
         """The point test's view of the grid (built once, shared by every test made):
@@ -201,12 +264,14 @@ class GridIndex:
     # -- build -------------------------------------------------------------------
 
     def _classify_many(self, pieces: list[np.ndarray], ks: list[int]):
-        """:meth:`_classify` for the pieces ``ks`` (each of at most 62 edges) at once:
-        ``(piece, cell, inside, mask)`` per (piece, cell) pair that may meet, piece-major,
-        each piece's cells in :meth:`_classify`'s order, with the same arithmetic.
+        """:meth:`_classify` for the pieces ``ks`` at once: ``(piece, cell, inside, mask)``
+        per (piece, cell) pair that may meet, piece-major, each piece's cells in
+        :meth:`_classify`'s order, with the same arithmetic.
 
         Edges are padded to the widest piece with a dummy edge (zero normal, offset
         +inf) that every cell lies strictly inside and no cell is separated by.
+        Pieces wider than MASK_EDGES are classified through their chord polygons
+        (:meth:`_chords`): conservatively, and with WIDE_MASK as their masks.
         """
         m = self.margin
         sizes = np.array([len(pieces[k]) for k in ks], dtype=np.int64)
@@ -216,6 +281,12 @@ class GridIndex:
         for r, k in enumerate(ks):
             Q[r, : sizes[r]] = pieces[k]
         Q -= (self.ox, self.oy)
+        # Pieces wider than MASK_EDGES get WIDE_MASK (their cells' masks on demand).
+        wide = sizes > MASK_EDGES
+        sag = None
+        if wide.all():
+            Q, sizes, sag = self._chords(Q, sizes)
+            E = Q.shape[1]
         slot = np.arange(E)
         valid = slot[None, :] < sizes[:, None]
         nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
@@ -228,8 +299,12 @@ class GridIndex:
         c[~valid] = np.inf
         hi = np.maximum(nrm[:, :, 0], 0.0) * self.cw + np.maximum(nrm[:, :, 1], 0.0) * self.ch
         lo = np.minimum(nrm[:, :, 0], 0.0) * self.cw + np.minimum(nrm[:, :, 1], 0.0) * self.ch
+        if sag is not None:  # separation from a chord's line pushed out past every vertex
+            lo -= sag
         # Bit e stands for the edge ending at vertex e: slot i (edge i -> i+1) is bit (i + 1) % n.
-        weights = np.where(valid, np.left_shift(np.int64(1), (slot[None, :] + 1) % sizes[:, None]), 0)
+        with_masks = not wide.all()
+        shift = np.where(wide[:, None], 0, (slot[None, :] + 1) % sizes[:, None])
+        weights = np.where(valid & ~wide[:, None], np.left_shift(np.int64(1), shift), 0)
         # Each piece's box of cells (widened by the margin), clipped to the grid.
         lo_xy, hi_xy = self._lo[ks], self._hi[ks]
         i0 = np.maximum(np.floor((lo_xy[:, 0] - m - self.x0) * self.inv_w), 0).astype(np.int64)
@@ -256,7 +331,7 @@ class GridIndex:
                 d -= c[r]
                 strictly_in = d <= -m - hi[r]
                 inside[s : s + step] = strictly_in.all(axis=1)
-                masks[s : s + step] = ((~strictly_in) * weights[r]).sum(axis=1)
+                masks[s : s + step] = ((~strictly_in) * weights[r]).sum(axis=1) if with_masks else 0
                 separated[s : s + step] = (d >= m - lo[r]).any(axis=1)
             return inside, separated, masks
 
@@ -284,7 +359,63 @@ class GridIndex:
             return z, z, np.zeros(0, dtype=bool), z
         row, ii, jj, inside, masks = (np.concatenate(x) for x in zip(*parts))
         pid = np.asarray(ks, dtype=np.int64)[row]
+        if wide.any():
+            masks = np.where(wide[row], np.int64(WIDE_MASK), masks)
         return pid, jj * self.nx + ii, inside, masks
+
+    def _chords(self, Q: np.ndarray, sizes: np.ndarray):
+        """Wide pieces (padded vertices ``Q``, counts ``sizes``) as chord polygons: four
+        vertices and both ends of every edge longer than a cell, then, while a
+        chord's sagitta exceeds a quarter of a cell, the vertex halfway along the arc it
+        cuts off. Returns the chord polygons (padded), their vertex counts, and each
+        chord's sagitta.
+
+        The hull of a subset of a convex piece's vertices lies inside the piece, so a cell
+        inside it is inside the piece; a chord's line pushed out by its sagitta (the
+        largest n . v - c over all the piece's vertices) has the whole piece on its inner
+        side, so a cell beyond it is separated from the piece. Cells between the two are
+        MIXED, which only costs the narrow phase a test: a piece of 75 edges (a margin's
+        rounded corners) is classified at the cost of a dozen, its band of MIXED cells
+        at most half a cell wider.
+        """
+        K, E, _ = Q.shape
+        slot = np.arange(E)
+        valid = slot[None, :] < sizes[:, None]
+        nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
+        e = np.take_along_axis(Q, nxt[:, :, None], axis=1) - Q
+        long = valid & (np.abs(e[:, :, 0]) + np.abs(e[:, :, 1]) > self.cw + self.ch)
+        prev = (slot[None, :] - 1) % sizes[:, None]
+        quarter = slot[None, :] % np.maximum(sizes[:, None] // 4, 1) == 0  # four vertices to start from
+        keep = valid & (long | np.take_along_axis(long, prev, axis=1) | quarter)
+        limit = 0.25 * min(self.cw, self.ch)
+        while True:
+            n = keep.sum(axis=1)
+            C = int(n.max())
+            order = np.argsort(~keep, axis=1, kind="stable")[:, :C]  # kept slots first, in order
+            R = np.take_along_axis(Q, order[:, :, None], axis=1)
+            ok = np.arange(C)[None, :] < n[:, None]
+            rn = np.where(np.arange(C)[None, :] + 1 < n[:, None], np.arange(C)[None, :] + 1, 0)
+            d = np.take_along_axis(R, rn[:, :, None], axis=1) - R
+            nrm = np.stack([d[:, :, 1], -d[:, :, 0]], axis=2)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
+                c = nrm[:, :, 0] * R[:, :, 0] + nrm[:, :, 1] * R[:, :, 1]
+                reach = nrm[:, :, None, 0] * Q[:, None, :, 0]  # n . v - c per (piece, chord, vertex)
+                reach += nrm[:, :, None, 1] * Q[:, None, :, 1]
+                reach -= c[:, :, None]
+            reach[~np.broadcast_to(valid[:, None, :], reach.shape)] = -np.inf
+            sag = np.maximum(reach.max(axis=2), 0.0)  # NaN (a degenerate chord) stays NaN: never separates
+            sag[~ok] = 0.0
+            # Chords cutting off too much: add the middle vertex of the arc each spans.
+            a = order
+            b = np.take_along_axis(order, rn, axis=1)
+            span = (b - a) % sizes[:, None]
+            bad = ok & (sag > limit) & (span > 1)
+            if not bad.any():
+                return R, n.astype(np.int64), sag
+            rows, cols = np.nonzero(bad)
+            mid = (a[rows, cols] + span[rows, cols] // 2) % sizes[rows]
+            keep[rows, mid] = True
 
     def _scan_rows(self, pieces, i0, i1, j0, H, nrm, c, hi, lo, evaluate) -> list:
         """:meth:`_classify_many`'s cells of wide boxes, row by row, the same answers.
@@ -320,10 +451,23 @@ class GridIndex:
                 d -= cc
                 return d
 
-            def flip(test):
-                """First column where test(d) turns True (monotone False..True), b + 1 if none."""
+            def flip(test, t):
+                """First column where test(d) turns True (monotone False..True), b + 1 if none.
+
+                The column where d crosses t, solved in reals, is a guess: the float test at
+                it and at the column before narrow [L, U] to it when it is right (almost
+                always), and the bisection on the float test finishes what it leaves, so
+                the answer is the bisection's whatever the guess."""
                 L = np.broadcast_to(a, n0.shape).copy()
                 U = np.broadcast_to(b + 1, n0.shape).copy()
+                with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                    g = ((t - yterm + cc) / n0 - x_off) / cw
+                g = np.clip(np.nan_to_num(np.floor(g), nan=-1.0, posinf=-1.0, neginf=-1.0) + 1, L, U).astype(np.int64)
+                for probe in (g, g - 1):  # test(probe) True: the flip is at or before it
+                    at = (probe >= L) & (probe < U)
+                    f = test(d_at(np.clip(probe, a, b))) & at
+                    U = np.where(f, probe, U)
+                    L = np.where(at & ~f, probe + 1, L)
                 while True:
                     act = L < U
                     if not act.any():
@@ -335,11 +479,11 @@ class GridIndex:
 
             d0 = d_at(a)
             # strictly inside edge e: a prefix of the row (n_x > 0), a suffix (n_x < 0), all or none
-            f_in = flip(lambda d: np.where(pos, ~(d <= t_in), d <= t_in))
+            f_in = flip(lambda d: np.where(pos, ~(d <= t_in), d <= t_in), t_in)
             lo_in = np.where(pos, a, np.where(neg, f_in, np.where(d0 <= t_in, a, b + 1)))
             hi_in = np.where(pos, f_in - 1, np.where(neg, b, np.where(d0 <= t_in, b, a - 1)))
             # not separated by edge e: likewise
-            f_ns = flip(lambda d: np.where(pos, d >= t_sep, ~(d >= t_sep)))
+            f_ns = flip(lambda d: np.where(pos, d >= t_sep, ~(d >= t_sep)), t_sep)
             lo_ns = np.where(pos, a, np.where(neg, f_ns, np.where(~(d0 >= t_sep), a, b + 1)))
             hi_ns = np.where(pos, f_ns - 1, np.where(neg, b, np.where(~(d0 >= t_sep), b, a - 1)))
             in_lo, in_hi = lo_in.max(axis=1), hi_in.min(axis=1)
@@ -358,9 +502,10 @@ class GridIndex:
             out.append((ir, ic, ij, np.ones(len(ir), dtype=bool), np.zeros(len(ir), dtype=np.int64)))
         return out
 
-    def _classify(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _classify(self, p: np.ndarray, with_masks: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cells that closed convex ``p`` may meet, which of them lie inside ``p``, and for
-        each the bit mask of the edges whose line passes within the margin of it."""
+        each the bit mask of the edges whose line passes within the margin of it (Python
+        ints beyond 62 edges; WIDE_MASK for every cell without ``with_masks``)."""
         m = self.margin
         i0 = math.floor((p[:, 0].min() - m - self.x0) * self.inv_w)
         i1 = math.floor((p[:, 0].max() + m - self.x0) * self.inv_w)
@@ -372,30 +517,20 @@ class GridIndex:
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool), np.zeros(0, dtype=np.int64)
         ii, jj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
         ii, jj = ii.ravel(), jj.ravel()
-        q = p - (self.ox, self.oy)
-        # Edge half-planes of p: n . x <= c, n the outward unit normal.
-        e = np.roll(q, -1, axis=0) - q
-        nrm = np.column_stack([e[:, 1], -e[:, 0]])
-        # A piece that rounded to a point (a disk of radius 1e-200 at (5, 5)) has zero-length
-        # edges: their NaN normals make every comparison below False, so no cell is called
-        # inside or separated by them and the exact narrow phase decides (quietly).
-        with np.errstate(invalid="ignore", divide="ignore"):
-            nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
-        c = np.einsum("ij,ij->i", nrm, q)
+        nrm, c, hi, lo = self._half_planes(p)
         inside = np.empty(ii.size, dtype=bool)
         separated = np.empty(ii.size, dtype=bool)
         # Bit e stands for the edge ending at vertex e (q[e-1] -> q[e]); the half-planes
-        # above are for q[e] -> q[e+1], i.e. bit e+1. Up to 62 edges the masks are int64,
+        # are for q[e] -> q[e+1], i.e. bit e+1. Up to 62 edges the masks are int64,
         # beyond that Python ints (an object array).
-        wide = len(q) > 62
-        masks = np.empty(ii.size, dtype=object if wide else np.int64)
-        weights = None if wide else np.left_shift(np.int64(1), (np.arange(len(q)) + 1) % len(q))
+        wide = len(p) > 62
+        masks = (np.full(ii.size, WIDE_MASK, dtype=np.int64) if not with_masks
+                 else np.empty(ii.size, dtype=object if wide else np.int64))
+        weights = None if wide else np.left_shift(np.int64(1), (np.arange(len(p)) + 1) % len(p))
         # Over a cell [x, x + cw] x [y, y + ch] the signed distance n . corner - c is
         # largest at the corner picked by the signs of n and smallest at the opposite one:
         # d = n . (x, y) - c, plus hi (resp. lo) per edge. One (cells, edges) block.
-        hi = np.maximum(nrm[:, 0], 0.0) * self.cw + np.maximum(nrm[:, 1], 0.0) * self.ch
-        lo = np.minimum(nrm[:, 0], 0.0) * self.cw + np.minimum(nrm[:, 1], 0.0) * self.ch
-        step = max(1, (1 << 21) // len(q))  # bound the (cells, edges) block
+        step = max(1, (1 << 21) // len(p))  # bound the (cells, edges) block
         for s in range(0, ii.size, step):
             cx0 = (self.x0 - self.ox) + ii[s : s + step] * self.cw
             cy0 = (self.y0 - self.oy) + jj[s : s + step] * self.ch
@@ -404,7 +539,9 @@ class GridIndex:
             d -= c
             strictly_in = d <= -m - hi  # (cells, edges): every corner well inside the edge's half-plane
             inside[s : s + step] = strictly_in.all(axis=1)
-            if wide:
+            if not with_masks:
+                pass
+            elif wide:
                 bits = np.packbits(np.roll(~strictly_in, 1, axis=1), axis=1, bitorder="little")
                 masks[s : s + step] = [int.from_bytes(b.tobytes(), "little") for b in bits]
             else:

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import fastpath
-from .broadphase import BLOCKED, FREE, GridIndex
+from .broadphase import BLOCKED, FREE, WIDE_MASK, GridIndex
 from ..kernel.pieces import PieceSet
 from .inputs import query_points
 from ..kernel.polygon import piece_boxes
@@ -51,7 +51,7 @@ class Stage:
 SMALL_GRID = 4096  # cells: a grid this small is also the segment walk's grid
 # Minkowski sums of pieces of at most PAIR_BATCH_EDGES vertices are batched, about
 # PAIR_BATCH_CELLS (obstacle edge, robot edge) comparisons per batch.
-PAIR_BATCH_EDGES = 64
+PAIR_BATCH_EDGES = 128  # a robot piece with a margin's rounded corners (~75 edges) is still batched
 PAIR_BATCH_CELLS = 1 << 20
 
 
@@ -172,13 +172,8 @@ class CSpace:
         t = time.perf_counter()
         self.packed = PieceSet(self.pieces)
         self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells)
-        # Segments walk a 4x coarser grid: fewer cells per motion, same exact answer. A grid
-        # of at most 64 x 64 cells (an SE(2) slab's) is walked as it is.
-        cells = self.index.nx * self.index.ny
-        self.coarse = (self.index if cells <= SMALL_GRID
-                       else GridIndex(self.pieces, self.bounds, cells=max(cells // 16, 64)))
-        self.stages.append(Stage("index", True, time.perf_counter() - t,
-                                 {**self.index.stats(), "segment_grid": [self.coarse.nx, self.coarse.ny]}))
+        self._coarse = None
+        self.stages.append(Stage("index", True, time.perf_counter() - t, self.index.stats()))
         # The compiled fast path's copy of the grid and pieces (None on the pure path).
         self._fast = fastpath.grid_handle(self.index, self.packed, self.bounds)
         self.checks = {"points": 0, "segments": 0, "exact_points": 0, "exact_segments": 0}
@@ -188,6 +183,18 @@ class CSpace:
         self._is_free_q = self.is_free_xy.by_state  # the same test, on one indexable (x, y)
         self._point_uncounted = self.point_test(None)
         self._segment = fastpath.segment_test(self._fast, self._segment_pure, self.checks)
+
+    @property
+    def coarse(self) -> GridIndex:
+        """The pure segment walk's grid, built on first use (the compiled walk uses
+        :attr:`index` itself, so a default install never builds it): 4x coarser than the
+        index, fewer cells per motion, the same exact answer; a grid of at most 64 x 64
+        cells (an SE(2) slab's) is walked as it is."""
+        if self._coarse is None:
+            cells = self.index.nx * self.index.ny
+            self._coarse = (self.index if cells <= SMALL_GRID
+                            else GridIndex(self.pieces, self.bounds, cells=max(cells // 16, 64)))
+        return self._coarse
 
     # -- construction --------------------------------------------------------------
 
@@ -243,48 +250,33 @@ class CSpace:
         return pieces
 
     def _sum(self):
+        """obstacle piece ⊕ −(robot piece ⊕ margin) for every pair, batched (:func:`pair_sums`).
+
+        A margin inflates each robot piece once, in one k-way merge with its operands
+        (:func:`cspace.kernel.margin.inflated_pieces`, as the SE(2) C-space does; the margin
+        alone for a point robot); the inflated pieces then meet the obstacle pieces in
+        the same batched pair sums as a plain robot."""
         t = time.perf_counter()
-        if not self.robot_pieces and self.margin:  # a point robot with a margin: O ⊕ −M
-            return self._sum_with([[]])
-        if not self.robot_pieces:
+        if not self.robot_pieces and not self.margin:
             self.stages.append(Stage("minkowski", False, 0.0, {"pieces": len(self.obstacle_pieces)},
                                      "point robot: C-obstacles are the obstacles"))
             n = len(self.obstacle_pieces)
             self._raw_pairs = [(i, -1) for i in range(n)]
             return list(self.obstacle_pieces), self.obstacle_of
+        from ..kernel.margin import inflated_pieces
         from ..kernel.minkowski import reflect
 
-        if self.margin:  # robot piece ⊕ margin: one k-way merge per pair
-            return self._sum_with([[reflect(r)] for r in self.robot_pieces], t)
-        neg = [reflect(r) for r in self.robot_pieces]
+        neg = [reflect(r) for r in inflated_pieces(self.robot_pieces, self.margin)]
         out = pair_sums(self.obstacle_pieces, neg)
         nr = len(neg)
         owner = np.repeat(np.asarray(self.obstacle_of, dtype=np.int64), nr)
-        self._raw_pairs = [(i, j) for i in range(len(self.obstacle_pieces)) for j in range(nr)]
-        self.stages.append(Stage("minkowski", True, time.perf_counter() - t,
-                                 {"pairs": len(out), "robot_pieces": len(neg)}))
-        return out, owner
-
-    def _sum_with(self, neg: list, t: float | None = None):
-        """obstacle piece ⊕ −robot piece (⊕ −margin operands): one k-way merge per pair.
-        ``neg`` holds, per robot piece, its reflected operands ([] for a point robot)."""
-        from ..kernel.minkowski import minkowski_sum, reflect
-
-        t = time.perf_counter() if t is None else t
-        extra = [reflect(m) for m in self.margin]
-        ops = [r + extra for r in neg]
-        out, owner, pairs = [], [], []
-        for i, (p, o) in enumerate(zip(self.obstacle_pieces, self.obstacle_of)):
-            for j, r in enumerate(ops):
-                out.append(minkowski_sum(p, *r))
-                owner.append(o)
-                pairs.append((i, j if self.robot_pieces else -1))
-        self._raw_pairs = pairs
+        self._raw_pairs = [(i, j if self.robot_pieces else -1)
+                           for i in range(len(self.obstacle_pieces)) for j in range(nr)]
         counts = {"pairs": len(out), "robot_pieces": len(self.robot_pieces)}
         if self.margin:
             counts["margin_vertices"] = [len(m) for m in self.margin]
         self.stages.append(Stage("minkowski", True, time.perf_counter() - t, counts))
-        return out, np.array(owner, dtype=np.int64)
+        return out, owner
 
     def _prune(self, pieces, owner):
         """Drop pieces that cannot meet the bounds, and pieces inside another piece.
@@ -453,7 +445,8 @@ class CSpace:
 
         starts, cand = self.index._starts_list, self.index._cand_list
         masks = self.index.cand_masks_list
-        lists = self.packed._lists
+        packed = self.packed
+        edge_mask, pieces = self.index.edge_mask, self.pieces
         by_cell: dict = {}  # cell -> per candidate piece, its edges named by the cell's mask
         checks = self.checks
         tiny = CCW_ERRBOUND_A * _UNDERFLOW_GUARD
@@ -463,7 +456,9 @@ class CSpace:
             # inside every other edge's half-plane (certified at build, with margin).
             groups = []
             for t in range(starts[cell], starts[cell + 1]):
-                pts, mask = lists[cand[t]], masks[t]
+                pts, mask = packed._lists[cand[t]], masks[t]
+                if mask == WIDE_MASK:  # a wide piece: its mask in this cell, once
+                    mask = edge_mask(pieces[cand[t]], cell)
                 edges = []
                 px, py = pts[-1]
                 for e, (qx, qy) in enumerate(pts):
