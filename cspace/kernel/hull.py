@@ -59,3 +59,67 @@ def _chain(pts: list) -> list:
             out.pop()
         out.append((x, y))
     return out
+
+
+def ring_hulls(points: np.ndarray, sizes) -> list[np.ndarray]:
+    """``[convex_hull(ring) for ring in rings]`` for rings stored one after another
+    (``sizes`` points each) that are convex up to rounding, such as rounded Minkowski
+    sums: many rings at once, in numpy.
+
+    Each ring is peeled: every vertex that does not turn strictly left (exact) between
+    its live neighbours is dropped, until none is left; what remains turns strictly
+    left everywhere, and if its edges turn around once it is a convex polygon with
+    vertices among the points. It is
+    the hull when every dropped point lies in it (checked exactly against each of its
+    edges); a ring where that fails, or that peels to fewer than 3 vertices, gets
+    :func:`convex_hull` instead. So the answer is :func:`convex_hull`'s, array for array.
+
+    >>> sq = [[0., 0], [1, 0], [1, 1], [0, 1]]
+    >>> [h.tolist() for h in ring_hulls(np.array(sq + [[2., 0], [3, 0], [3, 1], [2.5, 0.5], [2, 1]]), [4, 5])]
+    [[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], [[2.0, 0.0], [3.0, 0.0], [3.0, 1.0], [2.0, 1.0]]]
+    """
+    from .polygon import ring_neighbours
+    from .predicates import lower_half, orient2d_many
+
+    p = np.asarray(points, dtype=np.float64)
+    sizes = np.asarray(sizes, dtype=np.intp)
+    ring = np.repeat(np.arange(len(sizes)), sizes)
+    alive = np.ones(len(p), dtype=bool)
+    while True:
+        idx = np.flatnonzero(alive)
+        prv, nxt = ring_neighbours(np.bincount(ring[idx], minlength=len(sizes)))
+        turn = orient2d_many(p[idx[prv]], p[idx], p[idx[nxt]])
+        drop = idx[turn <= 0]
+        if not drop.size:
+            break
+        alive[drop] = False
+    live = np.bincount(ring[alive], minlength=len(sizes))
+    ok = live >= 3
+    idx = np.flatnonzero(alive)
+    nxt = idx[ring_neighbours(live)[1]]
+    # Strict left turns everywhere make a convex polygon only if the edges turn around
+    # once (a pentagram turns left everywhere, twice around): the edge directions then
+    # change half-plane (exact signs of float differences) exactly twice.
+    d = p[nxt] - p[idx]
+    half = lower_half(d[:, 0], d[:, 1])
+    change = half != half[ring_neighbours(live)[0]]
+    ok &= np.bincount(ring[idx][change], minlength=len(sizes)) == 2
+    # Every dropped point against every edge of its ring's peeled polygon: on or left.
+    gone = np.flatnonzero(~alive & ok[ring])
+    if gone.size:
+        ends = np.cumsum(live)
+        first = ends - live
+        reps = live[ring[gone]]
+        g = np.repeat(gone, reps)
+        e = np.repeat(first[ring[gone]], reps) + (np.arange(len(g)) - np.repeat(np.cumsum(reps) - reps, reps))
+        side = orient2d_many(p[idx[e]], p[nxt[e]], p[g])
+        ok &= np.bincount(ring[g[side < 0]], minlength=len(sizes)) == 0
+    out = []
+    cut = np.cumsum(sizes) - sizes
+    live_cut = np.cumsum(live) - live
+    for r in range(len(sizes)):
+        if ok[r]:
+            out.append(lowest_first(p[idx[live_cut[r]:live_cut[r] + live[r]]]))
+        else:
+            out.append(convex_hull(p[cut[r]:cut[r] + sizes[r]]))
+    return out

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .hull import convex_hull
+from .hull import ring_hulls
 from .minkowski import minkowski_sum
 from .polygon import PackedPieces, ring_neighbours
 from .predicates import cross_diff_cols, orient2d_many
@@ -99,6 +99,8 @@ def _batch(A: PackedPieces, B: PackedPieces, out: list) -> None:
     good = np.repeat(A.ok, nb) & np.tile(B.ok, len(A.ok))
     for p in np.flatnonzero(good & ~doubt).tolist():
         out[p] = s[starts[p]:ends[p]]
-    for p in np.flatnonzero(good & doubt).tolist():
-        # a rounded turn that is not strictly left: minkowski_sum's repair, the exact hull
-        out[p] = convex_hull(s[starts[p]:ends[p]])
+    bad = np.flatnonzero(good & doubt)
+    if bad.size:  # a rounded turn that is not strictly left: minkowski_sum's repair, the exact hull
+        rings = np.concatenate([s[starts[p]:ends[p]] for p in bad.tolist()])
+        for p, h in zip(bad.tolist(), ring_hulls(rings, counts[bad])):
+            out[p] = h
