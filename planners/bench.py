@@ -46,9 +46,10 @@ FIELDS = (
     "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
     "length", "length_unsimplified", "optimum", "reference", "error", "error_unsimplified",
     "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks",
-    "wall_s", "message",
+    "wall_s", "message", "min_clearance", "min_clearance_bound", "clearance_s",
 )
-TIMING_FIELDS = ("first_solution_s", "solve_s", "simplify_s", "wall_s")
+# clearance_s: measuring min_clearance, after the run's timed solve (in wall_s, not in solve_s).
+TIMING_FIELDS = ("first_solution_s", "solve_s", "simplify_s", "wall_s", "clearance_s")
 STATUSES = ("ok", "crashed", "timeout")
 _MARK = "CSPACE_BENCH_ROW "
 
@@ -256,7 +257,9 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
     The run goes through :func:`planners.plan.plan`, the routine of ``cspace plan``
     (anytime planners solved in slices to time the first solution): the path is
     simplified and verified exactly, and a run is solved only if it passes.
-    ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space.
+    ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space. The row's
+    ``min_clearance`` is the one ``plan()`` measures on the solved path, after the solve
+    (so outside ``solve_s``; its time is ``clearance_s``).
     """
     from cspace.io.scenario import load_scenario
 
@@ -282,6 +285,9 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
         "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
         "motion_checks": int(res.checks["motions"]), "wall_s": None,
         "message": res.message, "progress": res.progress,
+        # Measured by plan() on the solved path after its solve (None: unsolved, or a car).
+        "min_clearance": res.min_clearance, "min_clearance_bound": res.min_clearance_bound,
+        "clearance_s": res.timings.get("clearance"),
     }
 
 
