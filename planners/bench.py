@@ -29,6 +29,7 @@ import threading
 import time
 
 from .errors import InputError
+from .objectives import OBJECTIVES
 # The figure and the progress bar live in their own modules (matplotlib and tqdm are
 # imported only when drawn); the bench keeps these names for its callers.
 from .plot_bench import curves, plot_error_vs_time  # noqa: F401
@@ -64,8 +65,8 @@ def register(sub) -> None:
                                    "path, per time budget. Exit 0 done, 2 bad input, 130 interrupted "
                                    "(finished rows are written).")
     p.add_argument("scenario", nargs="+", help="scenario TOML files")
-    p.add_argument("--planners", default=",".join(DEFAULT_PLANNERS),
-                   help=f"comma-separated OMPL planners (default {','.join(DEFAULT_PLANNERS)})")
+    p.add_argument("--planners", help=f"comma-separated OMPL planners (default {','.join(DEFAULT_PLANNERS)}; "
+                                      "with --objective clearance or balanced, those of them that take it)")
     p.add_argument("--times", default=",".join(f"{t:g}" for t in DEFAULT_TIMES),
                    help="comma-separated time budgets in seconds (default 0.01,0.03,0.1,0.3,1)")
     p.add_argument("--runs", type=int, default=10, help="seeded runs per planner and budget (seeds 0..N-1)")
@@ -73,6 +74,9 @@ def register(sub) -> None:
     p.add_argument("--workers", type=int, default=1, help="runs in parallel (local processes)")
     p.add_argument("--out", default="bench_out", help="output folder (created if missing)")
     p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on")
+    p.add_argument("--objective", choices=OBJECTIVES, default="length",
+                   help="what the optimising planners (RRTstar, SORRTstar, BITstar) optimise: path length "
+                        "(default), the minimum clearance, or length weighted by clearance")
     p.add_argument("--no-plot", action="store_true", help="skip error_vs_time.png")
     from .cli_plan import add_space_options
 
@@ -134,7 +138,11 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
 def run(args) -> int:
     from .ompl_glue import OMPL_HINT, ompl_available
 
-    planners = parse_planners(args.planners)
+    from .bench_clearance import check_planners, check_scenarios, default_planners
+
+    objective = getattr(args, "objective", "length")
+    planners = parse_planners(args.planners or ",".join(default_planners(objective, DEFAULT_PLANNERS)))
+    check_planners(objective, planners)
     times = parse_times(args.times)
     if not ompl_available():
         raise InputError("bench", "--planners", f"the bench runs OMPL's planners, and OMPL is not installed "
@@ -157,14 +165,15 @@ def run(args) -> int:
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
+    check_scenarios(objective, held)
     os.makedirs(out, exist_ok=True)
     _clear_outputs(out)  # never mix two sweeps in one folder
-    tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on)
+    tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on, objective)
     t0 = time.perf_counter()
     rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
                               held=held)
     meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
-            "iterations": args.iterations, "workers": args.workers, "scheduler": args.scheduler,
+            "iterations": args.iterations, "objective": objective, "workers": args.workers, "scheduler": args.scheduler,
             "wall_s": time.perf_counter() - t0, "complete": not interrupted,
             "hard_limit": f"budget * {HARD_FACTOR:g} + {HARD_MARGIN:g} s"}
     interrupted = _write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
@@ -234,7 +243,7 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
     return out
 
 
-def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None) -> list[dict]:
+def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None, objective="length") -> list[dict]:
     """One task per (scenario, planner, budget, seed), in the deterministic row order."""
     tasks = []
     for si, sc in enumerate(scenarios):
@@ -245,7 +254,8 @@ def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None)
                                   "optimum": sc["optimum"], "reference": sc.get("reference", "optimum"),
                                   "space": sc.get("space"), "slabs": sc.get("slabs"),
                                   "planner": p, "time_budget": t, "seed": seed,
-                                  "iterations": iterations, "abort": abort_on == (p, seed)})
+                                  "iterations": iterations, "objective": objective,
+                                  "abort": abort_on == (p, seed)})
     return tasks
 
 
@@ -270,7 +280,8 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
     sc = scenario if scenario is not None else load_scenario(task["file"], space=task.get("space"))
     planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
     res = plan(sc, planner=planner, time=budget, seed=int(task["seed"]), iterations=iters,
-               cspace=cspace, slices=True, slabs=task.get("slabs") if cspace is None else None)
+               cspace=cspace, slices=True, slabs=task.get("slabs") if cspace is None else None,
+               objective=task.get("objective", "length"))
     ok = bool(res.solved)
     opt = task["optimum"]
     length = float(res.length) if ok else None

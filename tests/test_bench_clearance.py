@@ -62,3 +62,75 @@ def test_a_car_run_has_no_min_clearance(sweep):
     for r, c in cars:
         assert r["min_clearance"] is None and r["min_clearance_bound"] is None and r["clearance_s"] is None
         assert c["min_clearance"] == "" and c["clearance_s"] == ""
+
+
+BASIC = str(ROOT / "scenarios" / "basic.toml")
+
+
+def _objective_sweep(out: Path, objective: str) -> list[dict]:
+    # An iteration budget (the time is only a backstop): RRTstar's runs are deterministic for a seed.
+    code = main(["bench", BASIC, "--objective", objective, "--planners", "RRTstar", "--times", "30",
+                 "--iterations", "300", "--runs", "3", "--out", str(out), "--no-plot", "-q"])
+    assert code == 0
+    data = json.loads((out / "results.json").read_text())
+    assert data["meta"]["objective"] == objective
+    return data["rows"]
+
+
+def test_clearance_objective_gives_clearer_paths_than_length(tmp_path):
+    """RRTstar, same seeds and iterations: the length objective's simplified paths graze the
+    obstacles (clearance under 0.05 here), the clearance objective's keep about 0.45 and more."""
+    med = {}
+    for objective in ("length", "clearance"):
+        rows = _objective_sweep(tmp_path / objective, objective)
+        assert all(r["solved"] for r in rows)
+        med[objective] = float(np.median([r["min_clearance"] for r in rows]))
+    assert med["clearance"] > 2 * med["length"], med
+
+
+def test_the_objective_object_reaches_the_planner(monkeypatch):
+    """One run in this process: the routine builds the clearance objective and OMPL's setup holds it."""
+    from planners import bench, objectives
+
+    made = []
+    real = objectives.make_objective
+
+    def spy(name, si, adapter):
+        made.append(real(name, si, adapter))
+        return made[-1]
+
+    monkeypatch.setattr(objectives, "make_objective", spy)
+    sc = {"file": BASIC, "scenario": "basic", "optimum": 1.0}
+    task = bench.make_tasks([sc], ["RRTstar"], [30.0], 1, iterations=300, objective="clearance")[0]
+    row = bench.run_one(task)
+    assert [type(o).__name__ for o in made] == ["MaximizeMinClearance"]
+    assert row["solved"] and row["min_clearance"] > 0
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["--objective", "shortest"], "invalid choice: 'shortest'"),
+    (["--objective", "clearance", "--planners", "RRTstar,RRTConnect"], "--objective: clearance needs an optimising"),
+])
+def test_bad_objective_exits_2_with_one_line(argv, says, capsys, tmp_path):
+    try:
+        code = main(["bench", BASIC, "--out", str(tmp_path / "o"), "-q", *argv])
+    except SystemExit as exc:  # argparse's own refusal
+        code = exc.code
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and says in err, err
+    assert not (tmp_path / "o").exists()
+
+
+def test_clearance_objective_on_a_car_exits_2(capsys, tmp_path):
+    code = main(["bench", CAR, "--objective", "balanced", "--out", str(tmp_path / "o"), "-q"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and f"{CAR}: --objective: balanced is not available" in err
+    assert not (tmp_path / "o" / "results.json").exists()  # refused before any run
+
+
+def test_default_planners_are_those_that_take_the_objective(tmp_path):
+    code = main(["bench", BASIC, "--objective", "balanced", "--times", "30", "--iterations", "20", "--runs", "1",
+                 "--out", str(tmp_path / "o"), "--no-plot", "-q"])
+    assert code == 0
+    rows = json.loads((tmp_path / "o" / "results.json").read_text())["rows"]
+    assert [r["planner"] for r in rows] == ["RRTstar", "BITstar"]
