@@ -436,15 +436,23 @@ def _sweep_dask(tasks, scheduler, rows, bar) -> None:
 # ---------------------------------------------------------------- statistics
 
 def summary(rows: list[dict]) -> str:
-    """A table: median error and success rate at the largest budget, per scenario and planner."""
-    cs = curves(rows)
+    """A table: median error, median min clearance and success rate at the largest budget,
+    per scenario and planner."""
+    from .bench_clearance import clearance_cell
+
+    cs, clear = curves(rows), curves(rows, "min_clearance")
     bounded = {r["scenario"] for r in rows if r.get("reference") == "lower_bound"}
-    lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'success':>8}"]
+    lower = {r["scenario"] for r in rows if r.get("min_clearance_bound") == "lower"}
+    lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'min clearance':>14} "
+             f"{'success':>8}"]
     for (scen, p), c in cs.items():
         m = c["median"][-1]
         text = "-" if m is None else (f"<= {m:.4f}" if scen in bounded else f"{m:.4f}")
-        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} {c['success'][-1]:>8.0%}")
+        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} "
+                     f"{clearance_cell(clear[scen, p]['median'][-1], scen in lower):>14} {c['success'][-1]:>8.0%}")
     if bounded:
         lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
                      "bound on the error")
+    if lower:
+        lines.append(">= : an SE(2) path's min clearance is a certified lower bound")
     return "\n".join(lines)

@@ -60,3 +60,15 @@ def check_scenarios(objective: str, held: dict) -> None:
         if getattr(_adapter(sc, cs), "clearance_functions", None) is None:
             raise InputError(file, "--objective", f"{objective} is not available for space {sc.space!r} "
                                                   "(translation and se2 only)")
+
+
+def clearance_cell(median: float | None, lower: bool) -> str:
+    """The summary's min-clearance cell: the median over solved runs, ``>=`` where it is a
+    certified lower bound (SE(2)), ``-`` where nothing was measured (no solved run, a car).
+
+    >>> clearance_cell(0.30168, False), clearance_cell(0.2, True), clearance_cell(None, False)
+    ('0.3017', '>= 0.2000', '-')
+    """
+    if median is None:
+        return "-"
+    return f">= {median:.4f}" if lower else f"{median:.4f}"

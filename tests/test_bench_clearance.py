@@ -134,3 +134,15 @@ def test_default_planners_are_those_that_take_the_objective(tmp_path):
     assert code == 0
     rows = json.loads((tmp_path / "o" / "results.json").read_text())["rows"]
     assert [r["planner"] for r in rows] == ["RRTstar", "BITstar"]
+
+
+def test_summary_has_the_median_min_clearance(sweep):
+    from planners import bench
+
+    rows, _ = sweep
+    text = bench.summary(rows)
+    head, *lines = text.splitlines()
+    assert "min clearance" in head
+    mine = float(np.median([r["min_clearance"] for r in rows if r["file"] == CLEARANCE]))
+    assert f" {mine:.4f} " in lines[0] and lines[0].startswith("clearance")
+    assert lines[1].startswith("loading-dock") and " - " in lines[1]  # a car: not measured
