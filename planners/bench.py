@@ -5,11 +5,15 @@ each run isolated in its own process (a planner that segfaults or hangs costs on
 recorded as ``crashed`` or ``timeout``, never the sweep): locally a forked child of this
 process, which built each scenario's C-space once (:mod:`planners.bench_pool`, at most
 ``--workers`` at a time), a fresh process where fork is missing, or on a Dask cluster
-(``--scheduler``). Each run calls :func:`planners.plan.plan`, as ``cspace plan`` does.
+(``--scheduler``). Each run calls :func:`planners.plan.plan`, as ``cspace plan`` does, with the
+sweep's ``--objective``; its row keeps the ``min_clearance`` that plan() measures on the solved
+path after the timed solve (:mod:`planners.bench_clearance` checks the objective and words the
+summary's clearance).
 Its outputs: ``results.csv``, ``results.json`` and one OMPL benchmark log per (scenario,
 budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns them into the
 Planner Arena database) are written by :mod:`planners.bench_outputs`; the
-``error_vs_time.png`` figure is drawn here.
+``error_vs_time.png`` figure (error, clearance and success against the budget) by
+:mod:`planners.plot_bench`.
 
 The reference is the exact shortest path (:mod:`cspace.spaces.shortest`), computed once per
 scenario in the parent. It is an infimum (it touches C-obstacle boundaries), so every
