@@ -5,11 +5,15 @@ each run isolated in its own process (a planner that segfaults or hangs costs on
 recorded as ``crashed`` or ``timeout``, never the sweep): locally a forked child of this
 process, which built each scenario's C-space once (:mod:`planners.bench_pool`, at most
 ``--workers`` at a time), a fresh process where fork is missing, or on a Dask cluster
-(``--scheduler``). Each run calls :func:`planners.plan.plan`, as ``cspace plan`` does.
+(``--scheduler``). Each run calls :func:`planners.plan.plan`, as ``cspace plan`` does, with the
+sweep's ``--objective``; its row keeps the ``min_clearance`` that plan() measures on the solved
+path after the timed solve (:mod:`planners.bench_clearance` checks the objective and words the
+summary's clearance).
 Its outputs: ``results.csv``, ``results.json`` and one OMPL benchmark log per (scenario,
 budget) under ``ompl/`` (``ompl_benchmark_statistics.py ompl/*.log`` turns them into the
 Planner Arena database) are written by :mod:`planners.bench_outputs`; the
-``error_vs_time.png`` figure is drawn here.
+``error_vs_time.png`` figure (error, clearance and success against the budget) by
+:mod:`planners.plot_bench`.
 
 The reference is the exact shortest path (:mod:`cspace.spaces.shortest`), computed once per
 scenario in the parent. It is an infimum (it touches C-obstacle boundaries), so every
@@ -29,6 +33,7 @@ import threading
 import time
 
 from .errors import InputError
+from .objectives import OBJECTIVES
 # The figure and the progress bar live in their own modules (matplotlib and tqdm are
 # imported only when drawn); the bench keeps these names for its callers.
 from .plot_bench import curves, plot_error_vs_time  # noqa: F401
@@ -46,9 +51,10 @@ FIELDS = (
     "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
     "length", "length_unsimplified", "optimum", "reference", "error", "error_unsimplified",
     "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks",
-    "wall_s", "message",
+    "wall_s", "message", "min_clearance", "min_clearance_bound", "clearance_s",
 )
-TIMING_FIELDS = ("first_solution_s", "solve_s", "simplify_s", "wall_s")
+# clearance_s: measuring min_clearance, after the run's timed solve (in wall_s, not in solve_s).
+TIMING_FIELDS = ("first_solution_s", "solve_s", "simplify_s", "wall_s", "clearance_s")
 STATUSES = ("ok", "crashed", "timeout")
 _MARK = "CSPACE_BENCH_ROW "
 
@@ -63,8 +69,8 @@ def register(sub) -> None:
                                    "path, per time budget. Exit 0 done, 2 bad input, 130 interrupted "
                                    "(finished rows are written).")
     p.add_argument("scenario", nargs="+", help="scenario TOML files")
-    p.add_argument("--planners", default=",".join(DEFAULT_PLANNERS),
-                   help=f"comma-separated OMPL planners (default {','.join(DEFAULT_PLANNERS)})")
+    p.add_argument("--planners", help=f"comma-separated OMPL planners (default {','.join(DEFAULT_PLANNERS)}; "
+                                      "with --objective clearance or balanced, those of them that take it)")
     p.add_argument("--times", default=",".join(f"{t:g}" for t in DEFAULT_TIMES),
                    help="comma-separated time budgets in seconds (default 0.01,0.03,0.1,0.3,1)")
     p.add_argument("--runs", type=int, default=10, help="seeded runs per planner and budget (seeds 0..N-1)")
@@ -72,6 +78,9 @@ def register(sub) -> None:
     p.add_argument("--workers", type=int, default=1, help="runs in parallel (local processes)")
     p.add_argument("--out", default="bench_out", help="output folder (created if missing)")
     p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on")
+    p.add_argument("--objective", choices=OBJECTIVES, default="length",
+                   help="what the optimising planners (RRTstar, SORRTstar, BITstar) optimise: path length "
+                        "(default), the minimum clearance, or length weighted by clearance")
     p.add_argument("--no-plot", action="store_true", help="skip error_vs_time.png")
     from .cli_plan import add_space_options
 
@@ -133,7 +142,11 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
 def run(args) -> int:
     from .ompl_glue import OMPL_HINT, ompl_available
 
-    planners = parse_planners(args.planners)
+    from .bench_clearance import check_planners, check_scenarios, default_planners
+
+    objective = getattr(args, "objective", "length")
+    planners = parse_planners(args.planners or ",".join(default_planners(objective, DEFAULT_PLANNERS)))
+    check_planners(objective, planners)
     times = parse_times(args.times)
     if not ompl_available():
         raise InputError("bench", "--planners", f"the bench runs OMPL's planners, and OMPL is not installed "
@@ -156,14 +169,15 @@ def run(args) -> int:
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
+    check_scenarios(objective, held)
     os.makedirs(out, exist_ok=True)
     _clear_outputs(out)  # never mix two sweeps in one folder
-    tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on)
+    tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on, objective)
     t0 = time.perf_counter()
     rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
                               held=held)
     meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
-            "iterations": args.iterations, "workers": args.workers, "scheduler": args.scheduler,
+            "iterations": args.iterations, "objective": objective, "workers": args.workers, "scheduler": args.scheduler,
             "wall_s": time.perf_counter() - t0, "complete": not interrupted,
             "hard_limit": f"budget * {HARD_FACTOR:g} + {HARD_MARGIN:g} s"}
     interrupted = _write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
@@ -233,7 +247,7 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
     return out
 
 
-def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None) -> list[dict]:
+def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None, objective="length") -> list[dict]:
     """One task per (scenario, planner, budget, seed), in the deterministic row order."""
     tasks = []
     for si, sc in enumerate(scenarios):
@@ -244,7 +258,8 @@ def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None)
                                   "optimum": sc["optimum"], "reference": sc.get("reference", "optimum"),
                                   "space": sc.get("space"), "slabs": sc.get("slabs"),
                                   "planner": p, "time_budget": t, "seed": seed,
-                                  "iterations": iterations, "abort": abort_on == (p, seed)})
+                                  "iterations": iterations, "objective": objective,
+                                  "abort": abort_on == (p, seed)})
     return tasks
 
 
@@ -256,7 +271,9 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
     The run goes through :func:`planners.plan.plan`, the routine of ``cspace plan``
     (anytime planners solved in slices to time the first solution): the path is
     simplified and verified exactly, and a run is solved only if it passes.
-    ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space.
+    ``scenario`` and ``cspace`` reuse a loaded scenario and its built C-space. The row's
+    ``min_clearance`` is the one ``plan()`` measures on the solved path, after the solve
+    (so outside ``solve_s``; its time is ``clearance_s``).
     """
     from cspace.io.scenario import load_scenario
 
@@ -267,7 +284,8 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
     sc = scenario if scenario is not None else load_scenario(task["file"], space=task.get("space"))
     planner, budget, iters = task["planner"], float(task["time_budget"]), task.get("iterations")
     res = plan(sc, planner=planner, time=budget, seed=int(task["seed"]), iterations=iters,
-               cspace=cspace, slices=True, slabs=task.get("slabs") if cspace is None else None)
+               cspace=cspace, slices=True, slabs=task.get("slabs") if cspace is None else None,
+               objective=task.get("objective", "length"))
     ok = bool(res.solved)
     opt = task["optimum"]
     length = float(res.length) if ok else None
@@ -282,6 +300,9 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
         "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
         "motion_checks": int(res.checks["motions"]), "wall_s": None,
         "message": res.message, "progress": res.progress,
+        # Measured by plan() on the solved path after its solve (None: unsolved, or a car).
+        "min_clearance": res.min_clearance, "min_clearance_bound": res.min_clearance_bound,
+        "clearance_s": res.timings.get("clearance"),
     }
 
 
@@ -419,15 +440,23 @@ def _sweep_dask(tasks, scheduler, rows, bar) -> None:
 # ---------------------------------------------------------------- statistics
 
 def summary(rows: list[dict]) -> str:
-    """A table: median error and success rate at the largest budget, per scenario and planner."""
-    cs = curves(rows)
+    """A table: median error, median min clearance and success rate at the largest budget,
+    per scenario and planner."""
+    from .bench_clearance import clearance_cell
+
+    cs, clear = curves(rows), curves(rows, "min_clearance")
     bounded = {r["scenario"] for r in rows if r.get("reference") == "lower_bound"}
-    lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'success':>8}"]
+    lower = {r["scenario"] for r in rows if r.get("min_clearance_bound") == "lower"}
+    lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'min clearance':>14} "
+             f"{'success':>8}"]
     for (scen, p), c in cs.items():
         m = c["median"][-1]
         text = "-" if m is None else (f"<= {m:.4f}" if scen in bounded else f"{m:.4f}")
-        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} {c['success'][-1]:>8.0%}")
+        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} "
+                     f"{clearance_cell(clear[scen, p]['median'][-1], scen in lower):>14} {c['success'][-1]:>8.0%}")
     if bounded:
         lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
                      "bound on the error")
+    if lower:
+        lines.append(">= : an SE(2) path's min clearance is a certified lower bound")
     return "\n".join(lines)

@@ -121,7 +121,7 @@ _RUN_PROPS = (
     ("simplified solution length", "REAL", "length"), ("simplification time", "REAL", "simplify_s"),
     ("optimum", "REAL", "optimum"), ("error", "REAL", "error"), ("first solution time", "REAL", "first_solution_s"),
     ("state checks", "INTEGER", "state_checks"), ("motion checks", "INTEGER", "motion_checks"),
-    ("seed", "INTEGER", "seed"), ("wall time", "REAL", "wall_s"),
+    ("seed", "INTEGER", "seed"), ("wall time", "REAL", "wall_s"), ("min clearance", "REAL", "min_clearance"),
 )
 
 

@@ -2,7 +2,9 @@
 
 One column per scenario: on top the median error (length / exact optimum - 1) of the
 solved runs with its 25-75 % band, below the success rate, both against the time
-budget on log axes. Tick labels are chosen here, not by matplotlib's log locator,
+budget on log axes. When the runs measured their paths' clearance (every space but a
+car's), a middle row shows the median ``min_clearance`` of the solved runs (25-75 %
+band, linear axis: a clearance may be 0) against the same budgets. Tick labels are chosen here, not by matplotlib's log locator,
 whose minor labels (``6x10^-2 4x10^-2 3x10^-2``) crowd a panel spanning less than a
 decade: budgets get one tick each (thinned if many), errors get 1-2-5 ticks in plain
 numbers. The legend sits under the figure and names every planner of the sweep,
@@ -10,7 +12,8 @@ saying which never solved a run (a planner without a single point on top would
 otherwise vanish from the picture).
 
 Rows are the bench's result rows (``scenario``, ``planner``, ``time_budget``,
-``solved``, ``error``; others ignored), as ``results.json`` stores them.
+``solved``, ``error``, optionally ``min_clearance``; others ignored), as ``results.json``
+stores them.
 """
 from __future__ import annotations
 
@@ -20,13 +23,14 @@ ERROR_FLOOR = 1e-6  # errors below this are drawn at it (log axis); an exact 0 i
 MAX_TICKS = 6  # labels per axis at most: more overlap on a 3.6-inch panel
 
 
-def curves(rows: list[dict]) -> dict:
-    """Per (scenario, planner): budgets, median / 25% / 75% error over solved runs, success rate.
+def curves(rows: list[dict], field: str = "error") -> dict:
+    """Per (scenario, planner): budgets, median / 25% / 75% of ``field`` over solved runs
+    (those where it is a finite number), success rate.
 
-    >>> r = [{"scenario": "s", "planner": "P", "time_budget": 1.0, "status": "ok", "solved": True, "error": e}
-    ...      for e in (0.1, 0.2, 0.3)]
-    >>> curves(r)[("s", "P")]["median"]
-    [0.2]
+    >>> r = [{"scenario": "s", "planner": "P", "time_budget": 1.0, "status": "ok", "solved": True, "error": e,
+    ...       "min_clearance": 2 * e} for e in (0.1, 0.2, 0.3)]
+    >>> curves(r)[("s", "P")]["median"], curves(r, "min_clearance")[("s", "P")]["median"]
+    ([0.2], [0.4])
     """
     import numpy as np
 
@@ -38,7 +42,7 @@ def curves(rows: list[dict]) -> dict:
         c = {"time": [], "median": [], "q25": [], "q75": [], "success": [], "runs": []}
         for t in sorted(by_t):
             rs = by_t[t]
-            errs = [r["error"] for r in rs if r["solved"] and r["error"] is not None]
+            errs = [r[field] for r in rs if r["solved"] and _finite(r.get(field))]
             c["time"].append(t)
             c["runs"].append(len(rs))
             c["success"].append(sum(bool(r["solved"]) for r in rs) / len(rs))
@@ -48,6 +52,20 @@ def curves(rows: list[dict]) -> dict:
             c["q75"].append(q[2])
         out[key] = c
     return out
+
+
+def _finite(v) -> bool:
+    """A number to take a median of (a clearance not measured is None, one without obstacles inf)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def has_clearance(rows: list[dict]) -> bool:
+    """Whether any solved run measured its clearance (a car's runs do not): the figure's middle row.
+
+    >>> has_clearance([{"solved": True, "min_clearance": None}]), has_clearance([{"solved": True, "min_clearance": 0.0}])
+    (False, True)
+    """
+    return any(r.get("solved") and _finite(r.get("min_clearance")) for r in rows)
 
 
 def thin(values: list[float], most: int = MAX_TICKS) -> list[float]:
@@ -100,7 +118,8 @@ def _set_log_ticks(axis, ticks: list[float]) -> None:
 
 
 def figure_error_vs_time(rows: list[dict]):
-    """The Figure: per scenario, error (top) and success rate (bottom) against the budget."""
+    """The Figure: per scenario, error (top), min clearance (middle, when measured) and
+    success rate (bottom) against the budget."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -120,11 +139,16 @@ def figure_error_vs_time(rows: list[dict]):
     def style(p: str) -> dict:
         return {"color": colors[p], "marker": markers[p], "ms": size[p], "mfc": "none", "mew": 1.3, "lw": 1.4}
 
-    fig, axes = plt.subplots(2, len(scens), figsize=(3.8 * len(scens) + 0.8, 6.6), squeeze=False,
-                             sharex="col", gridspec_kw={"height_ratios": [2, 1]})
+    clear = curves(rows, "min_clearance") if has_clearance(rows) else None
+    ratios = [2, 1.5, 1] if clear else [2, 1]
+    fig, axes = plt.subplots(len(ratios), len(scens), figsize=(3.8 * len(scens) + 0.8, 6.6 + 2.4 * bool(clear)),
+                             squeeze=False, sharex="col", gridspec_kw={"height_ratios": ratios})
     budgets = sorted({r["time_budget"] for r in rows})
     for j, scen in enumerate(scens):
-        top, bot = axes[0][j], axes[1][j]
+        top, bot = axes[0][j], axes[-1][j]
+        if clear:
+            lower = any(r.get("min_clearance_bound") == "lower" for r in rows if r["scenario"] == scen)
+            _clearance_panel(axes[1][j], clear, scen, planners, style, colors, lower, first=j == 0)
         shown: list[float] = []
         for p in planners:
             c = cs.get((scen, p))
@@ -172,8 +196,44 @@ def figure_error_vs_time(rows: list[dict]):
     return fig
 
 
+def _clearance_panel(ax, clear: dict, scen: str, planners: list, style, colors: dict, lower: bool,
+                     first: bool) -> None:
+    """Median min clearance of the solved runs (25-75 % band) per planner against the budget.
+
+    Linear axis: a clearance may be 0 (a path that touches). Ticks are plain numbers, at
+    most MAX_TICKS (matplotlib's scalar formatter would move a common factor into an
+    offset label, which reads as part of the number).
+    """
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
+
+    shown = False
+    for p in planners:
+        c = clear.get((scen, p))
+        pts = [(t, m, a, b) for t, m, a, b in zip(c["time"], c["median"], c["q25"], c["q75"])
+               if m is not None] if c else []
+        if pts:
+            t, m, a, b = (list(v) for v in zip(*pts))
+            ax.plot(t, m, "-", **style(p))
+            ax.fill_between(t, a, b, color=colors[p], alpha=0.2, lw=0)
+            shown = True
+    if not shown:  # a car's scene (or no solved run): say so, no scale to read
+        ax.text(0.5, 0.5, "no clearance measured", transform=ax.transAxes, ha="center", va="center", color="0.4")
+        ax.set_yticks([])
+    else:
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=MAX_TICKS - 1, min_n_ticks=2))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:g}"))
+    if lower:  # SE(2): the measure is a certified lower bound, said where it is read
+        ax.text(0.02, 0.97, "certified lower bound", transform=ax.transAxes, ha="left", va="top", fontsize=8,
+                color="0.4")
+    ax.grid(True, which="major", alpha=0.3)
+    ax.tick_params(labelbottom=False)
+    if first:
+        ax.set_ylabel("min clearance\n(median and 25-75 %)")
+
+
 def plot_error_vs_time(rows: list[dict], path: str) -> None:
-    """Median error (25-75 % band) and success rate against the time budget, one column per scenario."""
+    """Median error (25-75 % band), median min clearance (when measured) and success rate
+    against the time budget, one column per scenario."""
     import matplotlib.pyplot as plt
 
     from .output import atomic_path

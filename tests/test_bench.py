@@ -115,6 +115,36 @@ def test_crashed_run_is_recorded_and_the_sweep_goes_on(sweeps):
     assert later and all(r["status"] == "ok" for r in later)
 
 
+# The columns of the bench before min_clearance: kept, in this order, the new ones appended.
+FIELDS_BEFORE_CLEARANCE = (
+    "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
+    "length", "length_unsimplified", "optimum", "reference", "error", "error_unsimplified",
+    "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks", "wall_s", "message",
+)
+
+
+def test_rows_carry_the_min_clearance_that_plan_reports(sweeps):
+    from planners.plan import plan
+
+    base, _ = sweeps
+    assert bench.FIELDS[:len(FIELDS_BEFORE_CLEARANCE)] == FIELDS_BEFORE_CLEARANCE
+    rows = _rows(base / "w1")
+    with open(base / "w1" / "results.csv", newline="") as fh:
+        crow = list(csv.DictReader(fh))
+    for r, c in zip(rows, crow):
+        if not r["solved"]:  # the aborted runs: nothing measured, an empty cell
+            assert r["min_clearance"] is None and c["min_clearance"] == "" and c["min_clearance_bound"] == ""
+            continue
+        assert r["min_clearance"] > 0 and r["min_clearance_bound"] == "exact"
+        assert float(c["min_clearance"]) == r["min_clearance"]  # the same double
+        assert r["clearance_s"] > 0
+        if r["planner"] in FIRST_SOLUTION:  # deterministic for a seed: plan() is the oracle
+            res = plan(BASIC, planner=r["planner"], time=r["time_budget"], seed=r["seed"])
+            assert res.solved
+            assert r["min_clearance"] == pytest.approx(res.min_clearance, rel=0, abs=1e-12)
+    assert any(r["solved"] for r in rows if r["planner"] in FIRST_SOLUTION)
+
+
 def test_hung_run_is_killed_as_timeout():
     task = bench.make_tasks([{"file": BASIC, "scenario": "basic", "optimum": 1.0}], ["RRTstar"], [5.0], 1)[0]
     t0 = time.perf_counter()

@@ -106,3 +106,30 @@ def test_written_png(tmp_path):
     out = tmp_path / "e.png"
     pb.plot_error_vs_time(rows, str(out))
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_clearance_row_when_measured_readable_and_marked():
+    """A middle row of median min clearance when the runs measured it; a car's column says it has none;
+    an SE(2) column says its numbers are lower bounds; without clearances the figure is as before."""
+    rng = np.random.default_rng(2)
+    rows = _rows(["plain", "se2", "car"], ["RRTConnect", "RRTstar"], [0.01, 0.1, 1.0], 3,
+                 lambda *a: float(rng.uniform(0.01, 0.2)))
+    for r in rows:
+        measured = r["solved"] and r["scenario"] != "car"
+        r["min_clearance"] = float(rng.uniform(0.3, 0.31)) if measured else None
+        r["min_clearance_bound"] = ("lower" if r["scenario"] == "se2" else "exact") if measured else None
+    fig = pb.figure_error_vs_time(rows)
+    _check_ticks(fig)
+    assert len(fig.axes) == 9
+    mid = fig.axes[3:6]
+    assert "clearance" in mid[0].get_ylabel()
+    assert [t.get_text() for t in mid[2].texts] == ["no clearance measured"]
+    assert [t.get_text() for t in mid[1].texts] == ["certified lower bound"]
+    assert len(_labels(mid[0].yaxis)) >= 2
+    med = pb.curves(rows, "min_clearance")[("plain", "RRTstar")]["median"]
+    line = mid[0].get_lines()[1]  # RRTstar's
+    assert list(line.get_ydata()) == med
+    plt.close(fig)
+    for r in rows:
+        r["min_clearance"] = None
+    assert len(pb.figure_error_vs_time(rows).axes) == 6
