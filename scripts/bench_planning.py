@@ -340,9 +340,10 @@ def ratio_cell(ours: dict, peer: dict, who: str):
     only returned colliding paths has no time to compare with)."""
     if _count(peer["valid"]) and _count(ours["valid"]):
         return ours["first wall ms"] / peer["first wall ms"]
+    none = [f"ours: {ours['valid']} valid"] if not _count(ours["valid"]) else []
     if not _count(peer["valid"]):
-        return f"{who}: {peer['valid']} valid ({peer['colliding']} colliding)"
-    return f"ours: {ours['valid']} valid"
+        none.append(f"{who}: {peer['valid']} valid ({peer['colliding']} colliding)")
+    return "; ".join(none)
 
 
 def prepare(names) -> list[tuple]:

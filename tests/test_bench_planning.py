@@ -115,7 +115,9 @@ def test_ratio_only_where_both_have_a_valid_run(bench):
     cell = bench.ratio_cell(ours, {"valid": "0/3", "first wall ms": None, "colliding": 3}, "coal")
     assert cell == "coal: 0/3 valid (3 colliding)"
     peer = {"valid": "2/3", "first wall ms": 5.0, "colliding": 0}
-    assert bench.ratio_cell({"valid": "0/3", "first wall ms": None, "colliding": 0}, peer, "coal") == "ours: 0/3 valid"
+    nothing = {"valid": "0/3", "first wall ms": None, "colliding": 0}
+    assert bench.ratio_cell(nothing, peer, "coal") == "ours: 0/3 valid"
+    assert bench.ratio_cell(nothing, nothing, "coal-fine") == "ours: 0/3 valid; coal-fine: 0/3 valid (0 colliding)"
 
 
 def test_a_tunnelling_run_is_not_solved(bench, write_toml):
