@@ -69,6 +69,12 @@ static inline int orient(double ax, double ay, double bx, double by, double cx, 
     return UNDECIDED;
 }
 
+/* The cell of a floored grid coordinate f, clamped to 0 .. n - 1 (f is never NaN here). */
+static inline int64_t clamp_cell(double f, int64_t n)
+{
+    return f < 0.0 ? 0 : (f > (double)(n - 1) ? n - 1 : (int64_t)f);
+}
+
 /* Does the closed segment a-b meet closed piece k? 1 yes, 0 no, UNDECIDED. */
 static int seg_piece(const Grid *g, int64_t k, double ax, double ay, double bx, double by)
 {
@@ -322,8 +328,8 @@ static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t na
         }
         double fr0 = floor((y_lo - m - g->y0) * g->ih), fr1 = floor((y_hi + m - g->y0) * g->ih);
         if (!(fr0 == fr0 && fr1 == fr1)) return PyLong_FromLong(-1); /* NaN: never on finite input */
-        int64_t r0 = fr0 < 0.0 ? 0 : (fr0 > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fr0);
-        int64_t r1 = fr1 < 0.0 ? 0 : (fr1 > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fr1);
+        int64_t r0 = clamp_cell(fr0, g->ny);
+        int64_t r1 = clamp_cell(fr1, g->ny);
         for (int64_t r = r0; r <= r1; r++) {
             int res = test_cell(g, r * g->nx + i, ax, ay, bx, by, &tested);
             if (res == 0) return PyLong_FromLong(0);
@@ -339,8 +345,8 @@ static int point_test(const Grid *g, double x, double y)
     if (!(isfinite(x) && isfinite(y))) return -1;
     if (!(g->xmin <= x && x <= g->xmax && g->ymin <= y && y <= g->ymax)) return 0;
     double fi = floor((x - g->x0) * g->iw), fj = floor((y - g->y0) * g->ih);
-    int64_t i = fi < 0.0 ? 0 : (fi > (double)(g->nx - 1) ? g->nx - 1 : (int64_t)fi);
-    int64_t j = fj < 0.0 ? 0 : (fj > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fj);
+    int64_t i = clamp_cell(fi, g->nx);
+    int64_t j = clamp_cell(fj, g->ny);
     int64_t c = j * g->nx + i;
     uint8_t s = g->state[c];
     if (s == FREE) return 1;
@@ -566,8 +572,8 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn)
         h->gen = 1;
     }
     double fi = floor((x - h->gx0) * h->giw), fj = floor((y - h->gy0) * h->gih);
-    int64_t ci = fi < 0.0 ? 0 : (fi > (double)(h->n - 1) ? h->n - 1 : (int64_t)fi);
-    int64_t cj = fj < 0.0 ? 0 : (fj > (double)(h->n - 1) ? h->n - 1 : (int64_t)fj);
+    int64_t ci = clamp_cell(fi, h->n);
+    int64_t cj = clamp_cell(fj, h->n);
     int64_t cell = cj * h->n + ci;
     int unknown = 0;
     for (int64_t t = h->starts[cell]; t < h->starts[cell + 1]; t++) {
