@@ -124,10 +124,8 @@ static int point_piece(const Grid *g, int64_t k, double x, double y)
     return unknown ? UNDECIDED : 1;
 }
 
-static void grid_free(PyObject *cap)
+static void grid_release(Grid *g)
 {
-    Grid *g = (Grid *)PyCapsule_GetPointer(cap, "cspace.spaces._fast.Grid");
-    if (!g) return;
     PyMem_Free(g->state);
     PyMem_Free(g->blocker);
     PyMem_Free(g->starts);
@@ -136,6 +134,12 @@ static void grid_free(PyObject *cap)
     PyMem_Free(g->xy);
     PyMem_Free(g->stamp);
     PyMem_Free(g);
+}
+
+static void grid_free(PyObject *cap)
+{
+    Grid *g = (Grid *)PyCapsule_GetPointer(cap, "cspace.spaces._fast.Grid");
+    if (g) grid_release(g);
 }
 
 /* A private copy of a buffer of `count` items of `size` bytes (the caller owns the arrays). */
@@ -218,20 +222,22 @@ static PyObject *py_grid(PyObject *self, PyObject *args)
     PyObject *cap = PyCapsule_New(g, "cspace.spaces._fast.Grid", grid_free);
     if (cap) return cap;
 fail:
-    PyMem_Free(g->state);
-    PyMem_Free(g->blocker);
-    PyMem_Free(g->starts);
-    PyMem_Free(g->cand);
-    PyMem_Free(g->offsets);
-    PyMem_Free(g->xy);
-    PyMem_Free(g->stamp);
-    PyMem_Free(g);
+    grid_release(g);
     return NULL;
 }
 
 static Grid *get_grid(PyObject *cap)
 {
     return (Grid *)PyCapsule_GetPointer(cap, "cspace.spaces._fast.Grid");
+}
+
+/* A fast call's argument count: 0 if it is `want`, else -1 with a TypeError showing `usage`
+   (checked before any argument is read: the handles first, then get_doubles). */
+static inline int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *usage)
+{
+    if (nargs == want) return 0;
+    PyErr_SetString(PyExc_TypeError, usage);
+    return -1;
 }
 
 static int get_doubles(PyObject *const *args, Py_ssize_t n, double *out)
@@ -295,10 +301,7 @@ static int test_cell(Grid *g, int64_t c, double ax, double ay, double bx, double
 static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[4];
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "segment(grid, ax, ay, bx, by)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 5, "segment(grid, ax, ay, bx, by)") < 0) return NULL;
     Grid *g = get_grid(args[0]);
     if (!g || get_doubles(args + 1, 4, q) < 0) return NULL;
     double ax = q[0], ay = q[1], bx = q[2], by = q[3], m = g->m;
@@ -366,10 +369,7 @@ static int point_test(const Grid *g, double x, double y)
 static PyObject *py_point(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[2];
-    if (nargs != 3) {
-        PyErr_SetString(PyExc_TypeError, "point(grid, x, y)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 3, "point(grid, x, y)") < 0) return NULL;
     Grid *g = get_grid(args[0]);
     if (!g || get_doubles(args + 1, 2, q) < 0) return NULL;
     return PyLong_FromLong(point_test(g, q[0], q[1]));
@@ -379,10 +379,7 @@ static PyObject *py_point(PyObject *self, PyObject *const *args, Py_ssize_t narg
 static PyObject *py_orient(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[6];
-    if (nargs != 6) {
-        PyErr_SetString(PyExc_TypeError, "orient(ax, ay, bx, by, cx, cy)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 6, "orient(ax, ay, bx, by, cx, cy)") < 0) return NULL;
     if (get_doubles(args, 6, q) < 0) return NULL;
     return PyLong_FromLong(orient(q[0], q[1], q[2], q[3], q[4], q[5]));
 }
@@ -534,10 +531,7 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn);
 static PyObject *py_se2_pose(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[4];
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "se2_pose(handle, x, y, c, s)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 5, "se2_pose(handle, x, y, c, s)") < 0) return NULL;
     SE2 *h = (SE2 *)PyCapsule_GetPointer(args[0], "cspace.spaces._fast.SE2");
     if (!h || get_doubles(args + 1, 4, q) < 0) return NULL;
     return PyLong_FromLong(se2_filter(h, q[0], q[1], q[2], q[3]));
@@ -549,10 +543,7 @@ static PyObject *py_se2_pose(PyObject *self, PyObject *const *args, Py_ssize_t n
 static PyObject *py_se2_slow(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[4];
-    if (nargs != 6) {
-        PyErr_SetString(PyExc_TypeError, "se2_slow(grid, handle, x, y, c, s)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 6, "se2_slow(grid, handle, x, y, c, s)") < 0) return NULL;
     Grid *g = get_grid(args[0]);
     if (!g) return NULL;
     SE2 *h = (SE2 *)PyCapsule_GetPointer(args[1], "cspace.spaces._fast.SE2");
