@@ -39,7 +39,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
 
-from bench_se2 import _si, shapely_se2_checker  # noqa: E402
+from bench_se2 import _si, shapely_se2_checker, solve_runs  # noqa: E402
 from sweep_oracle import car_sweep_check  # noqa: E402
 
 from cspace.spaces.car_curves import dubins_segments, reeds_shepp_segments  # noqa: E402
@@ -123,26 +123,16 @@ def part_m(m: int) -> list[dict]:
 
 
 def part_t(seeds: int, budget: float) -> list[dict]:
-    from planners.plan import plan
-
     seg = {"dubins": dubins_segments, "reeds-shepp": reeds_shepp_segments}
     rows = []
     for f in sorted(glob.glob(os.path.join(CAR_DIR, "*.toml"))):
         sc = load_scenario(f)
         if sc.expect == "unsolvable":
             continue
-        times, lengths, solved, bad = [], [], 0, 0
-        cs = None
-        for s in range(seeds):
-            res = plan(sc, time=budget, seed=s, cspace=cs)
-            cs = res.cspace
-            if res.solved:
-                solved += 1
-                times.append(res.timings["solve"])
-                lengths.append(res.length)
-                f_seg = seg[sc.space]
-                bad += bool(car_sweep_check(sc, res.path, lambda p, q: f_seg(p, q, sc.turning_radius),
-                                            sc.turning_radius)["collides"])
+        solved, times, lengths, bad = solve_runs(
+            sc, seeds, budget,
+            lambda path: car_sweep_check(sc, path, lambda p, q: seg[sc.space](p, q, sc.turning_radius),
+                                         sc.turning_radius)["collides"])
         rows.append({"scene": sc.name, "space": sc.space, "planner": sc.planner.get("name", "RRTConnect"),
                      "solved": solved, "seeds": seeds,
                      "median_solve_s": statistics.median(times) if times else None,

@@ -220,24 +220,32 @@ def part_m(m: int) -> list[dict]:
     return rows
 
 
-def part_t(seeds: int, budget: float) -> list[dict]:
+def solve_runs(sc, seeds: int, budget: float, collides, **plan_kw) -> tuple:
+    """``planners.plan`` on ``sc`` with seeds 0 .. seeds - 1 (the C-space built once):
+    ``(solved, solve times, lengths, paths that collides(path) judges colliding)``."""
     from planners.plan import plan
 
+    times, lengths, solved, bad = [], [], 0, 0
+    cs = None
+    for seed in range(seeds):
+        res = plan(sc, time=budget, seed=seed, cspace=cs, **plan_kw)
+        cs = res.cspace
+        if res.solved:
+            solved += 1
+            times.append(res.timings["solve"])
+            lengths.append(res.length)
+            bad += bool(collides(res.path))
+    return solved, times, lengths, bad
+
+
+def part_t(seeds: int, budget: float) -> list[dict]:
     rows = []
     for f in sorted(glob.glob(os.path.join(SE2_DIR, "*.toml"))):
         sc = load_scenario(f)
         if sc.expect == "unsolvable":
             continue
-        times, lengths, solved, bad = [], [], 0, 0
-        cs = None
-        for seed in range(seeds):
-            res = plan(sc, planner="RRTConnect", time=budget, seed=seed, cspace=cs)
-            cs = res.cspace
-            if res.solved:
-                solved += 1
-                times.append(res.timings["solve"])
-                lengths.append(res.length)
-                bad += bool(sweep_check(sc, res.path)["collides"])
+        solved, times, lengths, bad = solve_runs(sc, seeds, budget, lambda path: sweep_check(sc, path)["collides"],
+                                                 planner="RRTConnect")
         rows.append({"scene": sc.name, "solved": solved, "seeds": seeds,
                      "median_solve_s": statistics.median(times) if times else None,
                      "median_length": statistics.median(lengths) if lengths else None,
