@@ -19,6 +19,7 @@ import numpy as np
 from cspace.spaces.car_curves import curve_length, dubins_segments, knots, pose_along, reeds_shepp_segments
 
 from .space_se2 import SE2Space
+from .spaces import scaled_bounds
 
 SEGMENT_NAMES = {"L": "left", "S": "straight", "R": "right"}
 
@@ -48,13 +49,7 @@ class CarSpace(SE2Space):
         ob = ompl()[0]
         r = math.ldexp(self.radius, self.k)
         space = ob.DubinsStateSpace(r, False) if self.name == "dubins" else ob.ReedsSheppStateSpace(r)
-        b = ob.RealVectorBounds(2)
-        xmin, xmax, ymin, ymax = (math.ldexp(float(v), self.k) for v in self.cspace.bounds)
-        b.setLow(0, xmin)
-        b.setHigh(0, xmax)
-        b.setLow(1, ymin)
-        b.setHigh(1, ymax)
-        space.setBounds(b)
+        space.setBounds(scaled_bounds(ob, self.cspace.bounds, self.k))
         return space
 
     # ---------------------------------------------------------------- curves

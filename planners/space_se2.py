@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from .plan import path_length
-from .spaces import frame_exponent, verify_path
+from .spaces import frame_exponent, scaled_bounds, verify_path
 
 SO2_WEIGHT = 0.5
 
@@ -74,13 +74,7 @@ class SE2Space:
 
         ob = ompl()[0]
         space = ob.SE2StateSpace()
-        b = ob.RealVectorBounds(2)
-        xmin, xmax, ymin, ymax = (math.ldexp(float(v), self.k) for v in self.cspace.bounds)
-        b.setLow(0, xmin)
-        b.setHigh(0, xmax)
-        b.setLow(1, ymin)
-        b.setHigh(1, ymax)
-        space.setBounds(b)
+        space.setBounds(scaled_bounds(ob, self.cspace.bounds, self.k))
         space.setSubspaceWeight(1, SO2_WEIGHT)
         return space
 

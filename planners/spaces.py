@@ -48,6 +48,18 @@ def frame_exponent(bounds) -> int:
     return -math.frexp(extent)[1]
 
 
+
+def scaled_bounds(ob, bounds, k: int):
+    """The C-space's bounds (xmin, xmax, ymin, ymax) as OMPL's ``RealVectorBounds(2)`` of
+    x and y, in the frame scaled by 2^k (``ob``: OMPL's base module)."""
+    xmin, xmax, ymin, ymax = (math.ldexp(float(v), k) for v in bounds)
+    b = ob.RealVectorBounds(2)
+    b.setLow(0, xmin)
+    b.setHigh(0, xmax)
+    b.setLow(1, ymin)
+    b.setHigh(1, ymax)
+    return b
+
 class TranslationSpace:
     """A translating robot over a :class:`cspace.CSpace`: poses are (x, y).
 
@@ -84,13 +96,7 @@ class TranslationSpace:
 
         ob = ompl()[0]
         space = ob.RealVectorStateSpace(2)
-        xmin, xmax, ymin, ymax = (math.ldexp(float(v), self.k) for v in self.cspace.bounds)
-        bounds = ob.RealVectorBounds(2)
-        bounds.setLow(0, xmin)
-        bounds.setHigh(0, xmax)
-        bounds.setLow(1, ymin)
-        bounds.setHigh(1, ymax)
-        space.setBounds(bounds)
+        space.setBounds(scaled_bounds(ob, self.cspace.bounds, self.k))
         return space
 
     def set_state(self, state, pose) -> None:

@@ -39,38 +39,13 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
 
-from bench_se2 import shapely_se2_checker  # noqa: E402
+from bench_se2 import _si, shapely_se2_checker, solve_runs  # noqa: E402
 from sweep_oracle import car_sweep_check  # noqa: E402
 
 from cspace.spaces.car_curves import dubins_segments, reeds_shepp_segments  # noqa: E402
 from cspace.io.scenario import load_scenario  # noqa: E402
 
 CAR_DIR = os.path.join(ROOT, "scenarios", "car")
-
-
-def _setup(adapter, checker, validator: str):
-    """OMPL's SpaceInformation over the car's space with ``checker``; ``validator`` is
-    "ours", "discrete" (OMPL's default) or "dubins" (OMPL's DubinsMotionValidator)."""
-    from planners.ompl_glue import ompl
-
-    ob, og, ou = ompl()
-    ou.RNG.setSeed(1)
-    space = adapter.state_space()
-    ss = og.SimpleSetup(space)
-    si = ss.getSpaceInformation()
-    ss.setStateValidityChecker(checker)
-    keep = [ss, space]
-    if validator == "ours":
-        mv = adapter.motion_validator(si)
-    elif validator == "dubins":
-        mv = ob.DubinsMotionValidator(si)
-    else:
-        mv = None
-    if mv is not None:
-        si.setMotionValidator(mv)
-        keep.append(mv)
-    si.setup()
-    return si, keep
 
 
 def random_motions(sc, cs, m: int, seed: int):
@@ -101,9 +76,9 @@ def part_m(m: int) -> list[dict]:
         adapter = _adapter(sc, cs)
         motions = random_motions(sc, cs, m, seed=7)
         check = shapely_se2_checker(sc)
-        peers = {"discrete": _setup(adapter, check, "discrete")}
+        peers = {"discrete": _si(adapter, check, "discrete")}
         if sc.space == "dubins":
-            peers["dubins_mv"] = _setup(adapter, check, "dubins")
+            peers["dubins_mv"] = _si(adapter, check, "dubins")
         times = {"ours": [], **{k: [] for k in peers}}
         ok = {k: [] for k in times}
         states = {k: (v[1][1].allocState(), v[1][1].allocState()) for k, v in peers.items()}
@@ -148,26 +123,16 @@ def part_m(m: int) -> list[dict]:
 
 
 def part_t(seeds: int, budget: float) -> list[dict]:
-    from planners.plan import plan
-
     seg = {"dubins": dubins_segments, "reeds-shepp": reeds_shepp_segments}
     rows = []
     for f in sorted(glob.glob(os.path.join(CAR_DIR, "*.toml"))):
         sc = load_scenario(f)
         if sc.expect == "unsolvable":
             continue
-        times, lengths, solved, bad = [], [], 0, 0
-        cs = None
-        for s in range(seeds):
-            res = plan(sc, time=budget, seed=s, cspace=cs)
-            cs = res.cspace
-            if res.solved:
-                solved += 1
-                times.append(res.timings["solve"])
-                lengths.append(res.length)
-                f_seg = seg[sc.space]
-                bad += bool(car_sweep_check(sc, res.path, lambda p, q: f_seg(p, q, sc.turning_radius),
-                                            sc.turning_radius)["collides"])
+        solved, times, lengths, bad = solve_runs(
+            sc, seeds, budget,
+            lambda path: car_sweep_check(sc, path, lambda p, q: seg[sc.space](p, q, sc.turning_radius),
+                                         sc.turning_radius)["collides"])
         rows.append({"scene": sc.name, "space": sc.space, "planner": sc.planner.get("name", "RRTConnect"),
                      "solved": solved, "seeds": seeds,
                      "median_solve_s": statistics.median(times) if times else None,

@@ -78,7 +78,14 @@ def shapely_se2_checker(sc):
     return is_valid
 
 
-def _si(space_adapter, checker=None, motion_validator: bool = True):
+def _si(space_adapter, checker=None, validator: str = "ours"):
+    """OMPL's SpaceInformation over the adapter's state space, set up, and what must outlive it.
+
+    ``checker``: the state validity checker (default: the adapter's own). ``validator``:
+    "ours" (the adapter's certified motion validator), "discrete" (OMPL's default, states
+    sampled along the motion) or "dubins" (OMPL's ``DubinsMotionValidator``). Returns
+    ``(si, keep)``, ``keep[1]`` being the state space.
+    """
     from planners.ompl_glue import ompl
 
     ob, og, ou = ompl()
@@ -87,13 +94,20 @@ def _si(space_adapter, checker=None, motion_validator: bool = True):
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
     ss.setStateValidityChecker(checker or space_adapter.validity())
-    keep = []
-    if motion_validator:
+    keep = [ss, space]
+    if validator == "ours":
         mv = space_adapter.motion_validator(si)
+    elif validator == "dubins":
+        mv = ob.DubinsMotionValidator(si)
+    elif validator == "discrete":
+        mv = None
+    else:
+        raise ValueError(f"validator: expected 'ours', 'discrete' or 'dubins', got {validator!r}")
+    if mv is not None:
         si.setMotionValidator(mv)
         keep.append(mv)
     si.setup()
-    return si, (ss, space, keep)
+    return si, keep
 
 
 def part_v(n: int, reps: int) -> list[dict]:
@@ -167,7 +181,7 @@ def part_m(m: int) -> list[dict]:
         cs = SE2CSpace.from_scenario(sc, slabs=sc.slabs)
         motions = random_motions(sc, cs, m, seed=7)
         base_space = SE2Space(cs)
-        si, keep = _si(base_space, checker=shapely_se2_checker(sc), motion_validator=False)
+        si, keep = _si(base_space, checker=shapely_se2_checker(sc), validator="discrete")
         space = keep[1]
         s1, s2 = space.allocState(), space.allocState()
         t_ours, t_base, ours_ok, base_ok = [], [], [], []
@@ -206,24 +220,32 @@ def part_m(m: int) -> list[dict]:
     return rows
 
 
-def part_t(seeds: int, budget: float) -> list[dict]:
+def solve_runs(sc, seeds: int, budget: float, collides, **plan_kw) -> tuple:
+    """``planners.plan`` on ``sc`` with seeds 0 .. seeds - 1 (the C-space built once):
+    ``(solved, solve times, lengths, paths that collides(path) judges colliding)``."""
     from planners.plan import plan
 
+    times, lengths, solved, bad = [], [], 0, 0
+    cs = None
+    for seed in range(seeds):
+        res = plan(sc, time=budget, seed=seed, cspace=cs, **plan_kw)
+        cs = res.cspace
+        if res.solved:
+            solved += 1
+            times.append(res.timings["solve"])
+            lengths.append(res.length)
+            bad += bool(collides(res.path))
+    return solved, times, lengths, bad
+
+
+def part_t(seeds: int, budget: float) -> list[dict]:
     rows = []
     for f in sorted(glob.glob(os.path.join(SE2_DIR, "*.toml"))):
         sc = load_scenario(f)
         if sc.expect == "unsolvable":
             continue
-        times, lengths, solved, bad = [], [], 0, 0
-        cs = None
-        for seed in range(seeds):
-            res = plan(sc, planner="RRTConnect", time=budget, seed=seed, cspace=cs)
-            cs = res.cspace
-            if res.solved:
-                solved += 1
-                times.append(res.timings["solve"])
-                lengths.append(res.length)
-                bad += bool(sweep_check(sc, res.path)["collides"])
+        solved, times, lengths, bad = solve_runs(sc, seeds, budget, lambda path: sweep_check(sc, path)["collides"],
+                                                 planner="RRTConnect")
         rows.append({"scene": sc.name, "solved": solved, "seeds": seeds,
                      "median_solve_s": statistics.median(times) if times else None,
                      "median_length": statistics.median(lengths) if lengths else None,

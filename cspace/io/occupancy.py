@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .scenario import ScenarioError, read_input
+from .scenario import ScenarioError, read_input, utf8_text
 
 MODES = ("trinary", "scale", "raw")
 MAX_PIXELS = 2**26  # 64 Mi cells (8192 x 8192): a bigger map is refused, not read
@@ -127,11 +127,7 @@ def read_map_yaml(path) -> MapInfo:
     (0.05, (-1.0, 0.0, 0.0), 'trinary', 'm.pgm')
     """
     path = os.fspath(path)
-    raw = read_input(path)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
+    text = utf8_text(read_input(path), path)
     data = parse_flat_yaml(text, path)
     warnings = [f"{path}: {k}: unknown key, ignored" for k in data if k not in KEYS]
     for key in ("image", "resolution", "origin"):

@@ -33,7 +33,7 @@ import warnings
 import numpy as np
 
 from .imported import Imported, ImportOptions, _robot_and_queries
-from .scenario import ScenarioError, read_input
+from .scenario import ScenarioError, read_input, utf8_text
 
 IO_HINT = 'pip install -e ".[io]"  (or pip install pycollada)'
 PROBLEM_KEYS = {"robot", "world", "start.x", "start.y", "start.theta", "goal.x", "goal.y", "goal.theta",
@@ -53,11 +53,7 @@ def read_cfg(path) -> dict[str, dict[str, str]]:
     {'problem': {'robot': 'r.dae', 'start.x': '1'}, 'planner': {'rrt': ''}}
     """
     path = os.fspath(path)
-    raw = read_input(path)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
+    text = utf8_text(read_input(path), path)
     out: dict[str, dict[str, str]] = {}
     section = None
     for n, line in enumerate(text.splitlines(), 1):

@@ -222,10 +222,7 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
     raw = read_input(path)
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in raw[:4096]:
         raise ScenarioError(path, "file", "UTF-16 or binary, not UTF-8 text (save the file as UTF-8)")
-    try:
-        text = raw.decode("utf-8-sig")  # a byte-order mark is allowed and skipped
-    except UnicodeDecodeError as exc:
-        raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
+    text = utf8_text(raw, path)
     tomllib = toml_reader()
     try:
         data = tomllib.loads(text)
@@ -280,6 +277,24 @@ def read_input(path: str) -> bytes:
     if len(raw) > MAX_FILE_BYTES:
         raise ScenarioError(path, "file", f"is over the {MAX_FILE_BYTES >> 20} MiB limit")
     return raw
+
+
+
+def utf8_text(raw: bytes, path: str) -> str:
+    """The text of an input file's bytes: UTF-8, a byte-order mark allowed and skipped;
+    anything else is a :class:`ScenarioError` naming the first invalid byte.
+
+    >>> utf8_text(b"\\xef\\xbb\\xbfa = 1", "s.toml")
+    'a = 1'
+    >>> utf8_text(b"a\\xff", "s.toml")
+    Traceback (most recent call last):
+    ...
+    cspace.io.scenario.ScenarioError: s.toml: file: not UTF-8 text (invalid byte at offset 1)
+    """
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(path, "file", f"not UTF-8 text (invalid byte at offset {exc.start})") from None
 
 
 # The scenes the C-space supports: products of two coordinates (or of two extents)

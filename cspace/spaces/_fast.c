@@ -69,6 +69,12 @@ static inline int orient(double ax, double ay, double bx, double by, double cx, 
     return UNDECIDED;
 }
 
+/* The cell of a floored grid coordinate f, clamped to 0 .. n - 1 (f is never NaN here). */
+static inline int64_t clamp_cell(double f, int64_t n)
+{
+    return f < 0.0 ? 0 : (f > (double)(n - 1) ? n - 1 : (int64_t)f);
+}
+
 /* Does the closed segment a-b meet closed piece k? 1 yes, 0 no, UNDECIDED. */
 static int seg_piece(const Grid *g, int64_t k, double ax, double ay, double bx, double by)
 {
@@ -118,10 +124,8 @@ static int point_piece(const Grid *g, int64_t k, double x, double y)
     return unknown ? UNDECIDED : 1;
 }
 
-static void grid_free(PyObject *cap)
+static void grid_release(Grid *g)
 {
-    Grid *g = (Grid *)PyCapsule_GetPointer(cap, "cspace.spaces._fast.Grid");
-    if (!g) return;
     PyMem_Free(g->state);
     PyMem_Free(g->blocker);
     PyMem_Free(g->starts);
@@ -130,6 +134,12 @@ static void grid_free(PyObject *cap)
     PyMem_Free(g->xy);
     PyMem_Free(g->stamp);
     PyMem_Free(g);
+}
+
+static void grid_free(PyObject *cap)
+{
+    Grid *g = (Grid *)PyCapsule_GetPointer(cap, "cspace.spaces._fast.Grid");
+    if (g) grid_release(g);
 }
 
 /* A private copy of a buffer of `count` items of `size` bytes (the caller owns the arrays). */
@@ -212,20 +222,22 @@ static PyObject *py_grid(PyObject *self, PyObject *args)
     PyObject *cap = PyCapsule_New(g, "cspace.spaces._fast.Grid", grid_free);
     if (cap) return cap;
 fail:
-    PyMem_Free(g->state);
-    PyMem_Free(g->blocker);
-    PyMem_Free(g->starts);
-    PyMem_Free(g->cand);
-    PyMem_Free(g->offsets);
-    PyMem_Free(g->xy);
-    PyMem_Free(g->stamp);
-    PyMem_Free(g);
+    grid_release(g);
     return NULL;
 }
 
 static Grid *get_grid(PyObject *cap)
 {
     return (Grid *)PyCapsule_GetPointer(cap, "cspace.spaces._fast.Grid");
+}
+
+/* A fast call's argument count: 0 if it is `want`, else -1 with a TypeError showing `usage`
+   (checked before any argument is read: the handles first, then get_doubles). */
+static inline int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *usage)
+{
+    if (nargs == want) return 0;
+    PyErr_SetString(PyExc_TypeError, usage);
+    return -1;
 }
 
 static int get_doubles(PyObject *const *args, Py_ssize_t n, double *out)
@@ -289,10 +301,7 @@ static int test_cell(Grid *g, int64_t c, double ax, double ay, double bx, double
 static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[4];
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "segment(grid, ax, ay, bx, by)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 5, "segment(grid, ax, ay, bx, by)") < 0) return NULL;
     Grid *g = get_grid(args[0]);
     if (!g || get_doubles(args + 1, 4, q) < 0) return NULL;
     double ax = q[0], ay = q[1], bx = q[2], by = q[3], m = g->m;
@@ -322,8 +331,8 @@ static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t na
         }
         double fr0 = floor((y_lo - m - g->y0) * g->ih), fr1 = floor((y_hi + m - g->y0) * g->ih);
         if (!(fr0 == fr0 && fr1 == fr1)) return PyLong_FromLong(-1); /* NaN: never on finite input */
-        int64_t r0 = fr0 < 0.0 ? 0 : (fr0 > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fr0);
-        int64_t r1 = fr1 < 0.0 ? 0 : (fr1 > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fr1);
+        int64_t r0 = clamp_cell(fr0, g->ny);
+        int64_t r1 = clamp_cell(fr1, g->ny);
         for (int64_t r = r0; r <= r1; r++) {
             int res = test_cell(g, r * g->nx + i, ax, ay, bx, by, &tested);
             if (res == 0) return PyLong_FromLong(0);
@@ -339,8 +348,8 @@ static int point_test(const Grid *g, double x, double y)
     if (!(isfinite(x) && isfinite(y))) return -1;
     if (!(g->xmin <= x && x <= g->xmax && g->ymin <= y && y <= g->ymax)) return 0;
     double fi = floor((x - g->x0) * g->iw), fj = floor((y - g->y0) * g->ih);
-    int64_t i = fi < 0.0 ? 0 : (fi > (double)(g->nx - 1) ? g->nx - 1 : (int64_t)fi);
-    int64_t j = fj < 0.0 ? 0 : (fj > (double)(g->ny - 1) ? g->ny - 1 : (int64_t)fj);
+    int64_t i = clamp_cell(fi, g->nx);
+    int64_t j = clamp_cell(fj, g->ny);
     int64_t c = j * g->nx + i;
     uint8_t s = g->state[c];
     if (s == FREE) return 1;
@@ -360,10 +369,7 @@ static int point_test(const Grid *g, double x, double y)
 static PyObject *py_point(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[2];
-    if (nargs != 3) {
-        PyErr_SetString(PyExc_TypeError, "point(grid, x, y)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 3, "point(grid, x, y)") < 0) return NULL;
     Grid *g = get_grid(args[0]);
     if (!g || get_doubles(args + 1, 2, q) < 0) return NULL;
     return PyLong_FromLong(point_test(g, q[0], q[1]));
@@ -373,10 +379,7 @@ static PyObject *py_point(PyObject *self, PyObject *const *args, Py_ssize_t narg
 static PyObject *py_orient(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[6];
-    if (nargs != 6) {
-        PyErr_SetString(PyExc_TypeError, "orient(ax, ay, bx, by, cx, cy)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 6, "orient(ax, ay, bx, by, cx, cy)") < 0) return NULL;
     if (get_doubles(args, 6, q) < 0) return NULL;
     return PyLong_FromLong(orient(q[0], q[1], q[2], q[3], q[4], q[5]));
 }
@@ -528,10 +531,7 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn);
 static PyObject *py_se2_pose(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[4];
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "se2_pose(handle, x, y, c, s)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 5, "se2_pose(handle, x, y, c, s)") < 0) return NULL;
     SE2 *h = (SE2 *)PyCapsule_GetPointer(args[0], "cspace.spaces._fast.SE2");
     if (!h || get_doubles(args + 1, 4, q) < 0) return NULL;
     return PyLong_FromLong(se2_filter(h, q[0], q[1], q[2], q[3]));
@@ -543,10 +543,7 @@ static PyObject *py_se2_pose(PyObject *self, PyObject *const *args, Py_ssize_t n
 static PyObject *py_se2_slow(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[4];
-    if (nargs != 6) {
-        PyErr_SetString(PyExc_TypeError, "se2_slow(grid, handle, x, y, c, s)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 6, "se2_slow(grid, handle, x, y, c, s)") < 0) return NULL;
     Grid *g = get_grid(args[0]);
     if (!g) return NULL;
     SE2 *h = (SE2 *)PyCapsule_GetPointer(args[1], "cspace.spaces._fast.SE2");
@@ -566,8 +563,8 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn)
         h->gen = 1;
     }
     double fi = floor((x - h->gx0) * h->giw), fj = floor((y - h->gy0) * h->gih);
-    int64_t ci = fi < 0.0 ? 0 : (fi > (double)(h->n - 1) ? h->n - 1 : (int64_t)fi);
-    int64_t cj = fj < 0.0 ? 0 : (fj > (double)(h->n - 1) ? h->n - 1 : (int64_t)fj);
+    int64_t ci = clamp_cell(fi, h->n);
+    int64_t cj = clamp_cell(fj, h->n);
     int64_t cell = cj * h->n + ci;
     int unknown = 0;
     for (int64_t t = h->starts[cell]; t < h->starts[cell + 1]; t++) {

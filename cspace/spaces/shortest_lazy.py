@@ -11,11 +11,11 @@ down past a few thousand reflex corners (OMPL's env2 takes minutes).
 from __future__ import annotations
 
 import heapq
-import math
-import time
 from typing import Callable
 
 import numpy as np
+
+from .astar import astar
 
 
 def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None,
@@ -27,41 +27,22 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
     goal = pts[1]
     h = np.hypot(pts[:, 0] - goal[0], pts[:, 1] - goal[1])
     closed = np.zeros(n, dtype=bool)
-    g_best = np.full(n, np.inf)
-    parent = np.full(n, -1)
-    g_best[0] = 0.0
-    heap = [(h[0], 0.0, 0, -1)]
     tested = pushed = 0
     # Neighbour vectors of each reflex vertex, for the tangency filter.
     na = np.array([x[0] for x in nbrs]).reshape(-1, 2)
     nb = np.array([x[1] for x in nbrs]).reshape(-1, 2)
-    stopped = None
-    settled = 0
-    bound = float(h[0])
-    while heap:
-        if deadline is not None and time.perf_counter() > deadline:
-            stopped = "time limit"
-            break
-        f, gv, v, par = heapq.heappop(heap)
-        if closed[v]:
-            continue
-        if par >= 0:
-            tested += 1
-            seg = shapely.LineString([pts[par], pts[v]])
-            if not region.covers(seg) or (deg is not None and deg.blocks(pts[par], pts[v])):
-                continue
-        closed[v] = True
-        g_best[v] = gv
-        parent[v] = par
-        settled += 1
-        bound = f
-        if on_progress is not None and settled % every == 0:
-            on_progress(settled, n, bound)
-        if v == 1:
-            break
+
+    def accept(par: int, v: int) -> bool:
+        nonlocal tested
+        tested += 1
+        seg = shapely.LineString([pts[par], pts[v]])
+        return region.covers(seg) and not (deg is not None and deg.blocks(pts[par], pts[v]))
+
+    def expand(v: int, gv: float, par: int, heap: list) -> None:
+        nonlocal pushed
         cand = np.flatnonzero(~closed)
         if len(cand) == 0:
-            continue
+            return
         d = np.hypot(pts[cand, 0] - pts[v, 0], pts[cand, 1] - pts[v, 1])
         keep = _tangent_mask(pts, v, cand, na, nb)
         # Every candidate is pushed unverified: a tentative cost must not shadow a
@@ -70,17 +51,12 @@ def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = No
         for fw, gw_, w in zip((gw + h[cand[keep]]).tolist(), gw.tolist(), cand[keep].tolist()):
             heapq.heappush(heap, (fw, gw_, w, v))
         pushed += int(keep.sum())
-    if on_progress is not None:
-        on_progress(settled, n, bound)
+
+    path, length, stopped = astar(n, float(h[0]), closed, expand, accept, deadline, on_progress, every)
     counts = {"edges_tested": tested, "edges_pushed": pushed}
     if stopped:
         counts["stopped"] = stopped
-    if not closed[1]:
-        return None, math.inf, counts
-    path = [1]
-    while path[-1] != 0:
-        path.append(int(parent[path[-1]]))
-    return path[::-1], float(g_best[1]), counts
+    return path, length, counts
 
 
 def _tangent_mask(pts: np.ndarray, v: int, cand: np.ndarray, na: np.ndarray, nb: np.ndarray) -> np.ndarray:

@@ -26,10 +26,10 @@ from __future__ import annotations
 
 import heapq
 import math
-import time
 from typing import Callable
 
 from ..kernel.predicates import CCW_ERRBOUND_A, orient2d_xy
+from .astar import astar
 
 _INF = math.inf
 _TINY = CCW_ERRBOUND_A * 1e-280  # below, products may be subnormal: the exact predicate decides
@@ -255,27 +255,10 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
     if not start_tris or not goal_tris:
         raise ValueError("start or goal outside the mesh")
     closed = [False] * n
-    g_best = [_INF] * n
-    parent = [-1] * n
+    g_best = [_INF] * n  # tentative: every pushed edge is visible, so only a cheaper one is pushed again
     g_best[0] = 0.0
-    heap = [(h[0], 0.0, 0)]
-    settled = 0
-    bound = h[0]
-    stopped = None
-    while heap:
-        if deadline is not None and time.perf_counter() > deadline:
-            stopped = "time limit"
-            break
-        f, gv, v = heapq.heappop(heap)
-        if closed[v]:
-            continue
-        closed[v] = True
-        settled += 1
-        bound = f
-        if on_progress is not None and settled % every == 0:
-            on_progress(settled, n, bound)
-        if v == 1:
-            break
+
+    def expand(v: int, gv: float, par: int, heap: list) -> None:
         vx, vy = P[v]
         o = _orient_int if mesh.small_int and _small_int(vx, vy) else _orient
         if v == 0:
@@ -283,7 +266,7 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
         else:
             (ax, ay), (bx, by) = nbrs[v - 2]
             starts, wedges = mesh.fan(mesh.id[P[v]]), tangent_wedges(vx, vy, ax, ay, bx, by)
-            px, py = P[parent[v]]
+            px, py = P[par]
             wedges = taut(vx, vy, px, py, ax, ay, bx, by, wedges, o)
         seen, goal_seen, visited = visible_from(mesh, vx, vy, starts, wedges, is_node, P[1], goal_tris)
         counts["triangles_visited"] += visited
@@ -300,15 +283,9 @@ def mesh_astar(mesh, pts, nbrs: list, deadline: float | None = None,
             counts["edges_found"] += 1
             if gw < g_best[w]:
                 g_best[w] = gw
-                parent[w] = v
-                heapq.heappush(heap, (gw + h[w], gw, w))
-    if on_progress is not None:
-        on_progress(settled, n, bound)
+                heapq.heappush(heap, (gw + h[w], gw, w, v))
+
+    path, length, stopped = astar(n, h[0], closed, expand, None, deadline, on_progress, every)
     if stopped:
         counts["stopped"] = stopped
-    if not closed[1]:
-        return None, _INF, counts
-    path = [1]
-    while path[-1] != 0:
-        path.append(parent[path[-1]])
-    return path[::-1], g_best[1], counts
+    return path, length, counts
