@@ -23,6 +23,8 @@ import math
 
 import numpy as np
 
+from . import fastpath
+
 # Boxes wider than this many cells are classified row by row (GridIndex._scan_rows).
 SCAN_COLUMNS = 8
 
@@ -51,12 +53,39 @@ def _runs(rows: np.ndarray, jj: np.ndarray, lo: np.ndarray, hi: np.ndarray):
 
 
 
+def _compiled_boxes(rows, cells, nrm, c, hi, lo, weights, i0, i1, j0, j1, x_off, y_off, cw, ch, m) -> list:
+    """The compiled route of :meth:`CellClassifier._classify_many`: every cell of the boxes
+    of ``rows`` evaluated by ``_fast.classify`` (the numpy route's arithmetic, in C), in
+    chunks of at most 2^21 cells; parts ``(row, i, j, inside, mask)`` of the kept cells."""
+    out = []
+    f64, i64 = np.ascontiguousarray, lambda a: np.ascontiguousarray(a, dtype=np.int64)
+    nrm, c, hi, lo, weights = f64(nrm), f64(c), f64(hi), f64(lo), i64(weights)
+    i0, i1, j0, j1 = i64(i0), i64(i1), i64(j0), i64(j1)
+    start = 0
+    while start < len(rows):
+        stop, cap = start, 0
+        while stop < len(rows) and (stop == start or cap + cells[rows[stop]] <= 1 << 21):
+            cap += int(cells[rows[stop]])
+            stop += 1
+        chunk = i64(rows[start:stop])
+        o = [np.empty(cap, dtype=np.int64) for _ in range(3)] + [np.empty(cap, dtype=np.uint8),
+                                                                 np.empty(cap, dtype=np.int64)]
+        n = fastpath.classify_boxes(nrm, c, hi, lo, weights, chunk, i0, i1, j0, j1,
+                                    float(x_off), float(y_off), float(cw), float(ch), float(m), *o)
+        out.append((o[0][:n], o[1][:n], o[2][:n], o[3][:n].astype(bool), o[4][:n]))
+        start = stop
+    return out
+
+
 class CellClassifier:
     """The cell classification of a grid (a mixin of
     :class:`cspace.spaces.broadphase.GridIndex`): it reads the grid's frame (``x0``,
     ``y0``, ``cw``, ``ch``, ``inv_w``, ``inv_h``, ``nx``, ``ny``, the local origin ``ox``,
-    ``oy``, the certified ``margin``) and the pieces' boxes ``_lo``, ``_hi``.
+    ``oy``, the certified ``margin``) and the pieces' boxes ``_lo``, ``_hi``. With the
+    compiled fast path, boxes are evaluated in C (``compiled``; False forces numpy).
     """
+
+    compiled = True
 
     def _classify_all(self, pieces: list[np.ndarray]):
         """Every (cell, piece) pair that may meet: ``(cells, pieces, masks, inside)``,
@@ -205,6 +234,12 @@ class CellClassifier:
         # test flips is found exactly, so only the cells near the boundary are evaluated.
         narrow_box = W <= SCAN_COLUMNS
         parts = []
+        if fastpath.compiled() and self.compiled:  # every box up to 2^20 cells in C, the same doubles
+            small = (W * H > 0) & (W * H <= 1 << 20)
+            parts += _compiled_boxes(np.flatnonzero(small), W * H, nrm, c, hi, lo, weights, i0, i1, j0, j1,
+                                     x_off, y_off, cw, ch, m)
+            narrow_box = narrow_box & ~small
+            H = np.where(small, 0, H)
         dense = np.flatnonzero(narrow_box & (W * H > 0))
         if len(dense):
             counts = (W * H)[dense]

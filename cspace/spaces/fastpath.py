@@ -55,6 +55,22 @@ def grid_handle(index, packed, bounds):
         *map(float, bounds))
 
 
+def compiled() -> bool:
+    """Are the compiled routines in use now (built, not forced off, not :func:`disabled`)?
+
+    >>> compiled() == (_fast is not None)
+    True
+    """
+    return _fast is not None
+
+
+def classify_boxes(*args) -> int:
+    """``_fast.classify``: the grid build's cell classification of boxes of cells, the
+    numpy route's arithmetic in C (cspace/spaces/cellclass.py calls it when
+    :func:`compiled`)."""
+    return _fast.classify(*args)
+
+
 def segment_test(handle, pure, checks: dict):
     """The C-space's ``(ax, ay, bx, by) -> bool`` segment test: the compiled routine's
     certified answer when it has one, else ``pure`` (exact); ``pure`` itself on the pure
