@@ -272,8 +272,10 @@ class CellClassifier:
 
         The hull of a subset of a convex piece's vertices lies inside the piece, so a cell
         inside it is inside the piece; a chord's line pushed out by its sagitta (the
-        largest n . v - c over all the piece's vertices) has the whole piece on its inner
-        side, so a cell beyond it is separated from the piece. Cells between the two are
+        largest n . v - c over the vertices of the arc it cuts off; the piece being convex,
+        every other vertex lies on its inner side, up to a rounding far below the grid's
+        margin) has the whole piece on its inner side, so a cell beyond it is separated
+        from the piece. Cells between the two are
         MIXED, which only costs the narrow phase a test: a piece of 75 edges (a margin's
         rounded corners) is classified at the cost of a dozen, its band of MIXED cells
         at most half a cell wider.
@@ -300,11 +302,17 @@ class CellClassifier:
             with np.errstate(invalid="ignore", divide="ignore"):
                 nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
                 c = nrm[:, :, 0] * R[:, :, 0] + nrm[:, :, 1] * R[:, :, 1]
-                reach = nrm[:, :, None, 0] * Q[:, None, :, 0]  # n . v - c per (piece, chord, vertex)
-                reach += nrm[:, :, None, 1] * Q[:, None, :, 1]
-                reach -= c[:, :, None]
-            reach[~np.broadcast_to(valid[:, None, :], reach.shape)] = -np.inf
-            sag = np.maximum(reach.max(axis=2), 0.0)  # NaN (a degenerate chord) stays NaN: never separates
+                # Each vertex against the chord whose arc holds it (the last kept slot at
+                # or before it; slot 0 is always kept): n . v - c, its largest per chord.
+                cid = np.cumsum(keep, axis=1) - 1
+                nv = np.take_along_axis(nrm, cid[:, :, None], axis=1)
+                reach = nv[:, :, 0] * Q[:, :, 0]
+                reach += nv[:, :, 1] * Q[:, :, 1]
+                reach -= np.take_along_axis(c, cid, axis=1)
+            sag = np.full((K, C), -np.inf)
+            rr, vv = np.nonzero(valid)
+            np.maximum.at(sag, (rr, cid[rr, vv]), reach[rr, vv])  # NaN (a degenerate chord) stays NaN: never separates
+            sag = np.maximum(sag, 0.0)
             sag[~ok] = 0.0
             # Chords cutting off too much: add the middle vertex of the arc each spans.
             a = order
