@@ -70,3 +70,26 @@ def test_column_predicates_take_plain_scalars_in_doubt():
     assert int(orient2d_cols(0.1, 0.1, 0.3, 0.3, 0.7, 0.7)) == orient2d_xy(0.1, 0.1, 0.3, 0.3, 0.7, 0.7)
     d = 2.0**-30
     assert int(cross_diff_cols(0.0, 0.0, 1e6, 1.0, 0.0, 0.0, 2e6, 2.0 + d)) == 1
+
+
+# The whole double range: subnormals, huge magnitudes, signed zeros, exact ties.
+wide = st.one_of(st.floats(allow_nan=False, allow_infinity=False, width=64),
+                 st.sampled_from([0.0, -0.0, 5e-324, -5e-324, 2.0**-1022, 2.0**1023, -2.0**1023]))
+
+
+@settings(max_examples=600, deadline=None)
+@given(st.lists(st.one_of(wide, coords), min_size=8, max_size=8))
+def test_exact_fallback_equals_rationals(v):
+    # The fallback scales every double to one power-of-two denominator and works in
+    # Python ints: the same sign as Fractions, on any finite doubles.
+    assert cross_diff_exact(*v) == exact(*v)
+
+
+def test_exact_fallback_refuses_non_finite():
+    import pytest
+
+    from cspace.kernel.predicates import NonFiniteError
+
+    for bad in (float("nan"), float("inf"), -float("inf")):
+        with pytest.raises(NonFiniteError):
+            cross_diff_exact(0.0, 0.0, 1.0, bad, 0.0, 0.0, 1.0, 1.0)

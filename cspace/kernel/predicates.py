@@ -171,11 +171,16 @@ def cross_diff_exact(ax, ay, bx, by, cx, cy, dx, dy) -> int:
     >>> cross_diff_exact(0.0, 0.0, 1e6, 1.0, 5.0, 5.0, 5.0 + 2e6, 7.0)
     0
     """
-    F = Fraction
+    # Each double is n / 2^k exactly (as_integer_ratio); over the largest 2^k they are all
+    # integers, so the determinant, scaled by a positive square, is an exact Python int
+    # (no gcd per operation, as Fractions would take).
     try:
-        det = (F(bx) - F(ax)) * (F(dy) - F(cy)) - (F(by) - F(ay)) * (F(dx) - F(cx))
-    except (ValueError, OverflowError):  # Fraction(nan), Fraction(inf)
+        ratios = [float(v).as_integer_ratio() for v in (ax, ay, bx, by, cx, cy, dx, dy)]
+    except (ValueError, OverflowError):  # nan, inf
         raise NonFiniteError() from None
+    den = max(d for _, d in ratios)
+    AX, AY, BX, BY, CX, CY, DX, DY = (n * (den // d) for n, d in ratios)
+    det = (BX - AX) * (DY - CY) - (BY - AY) * (DX - CX)
     return (det > 0) - (det < 0)
 
 
