@@ -404,3 +404,94 @@ def test_plot_marks_the_closest_approach():
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+# ------------------------------------------------------------------ the pruning bound of path_clearance
+
+def _random_convex(rng, center, radius, k):
+    from cspace import convex_hull
+
+    ang = np.sort(rng.uniform(0, 2 * np.pi, k))
+    pts = np.column_stack([np.cos(ang), np.sin(ang)]) * radius * rng.uniform(0.3, 1.0, (k, 1)) + center
+    return convex_hull(pts)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_segment_polygon_distance_matches_shapely(seed):
+    from cspace.spaces.clearance import _segment_polygon_distance
+
+    rng = np.random.default_rng(seed)
+    polys = [_random_convex(rng, rng.uniform(0, 10, 2), rng.uniform(0.2, 3), int(rng.integers(3, 9))) for _ in range(60)]
+    polys = [p for p in polys if len(p) >= 3]
+    E = max(len(p) for p in polys)
+    P = np.array([np.vstack([p, np.repeat(p[:1], E - len(p), axis=0)]) for p in polys])
+    a = rng.uniform(-2, 12, (len(polys), 2))
+    b = np.where(rng.random((len(polys), 1)) < 0.2, a, rng.uniform(-2, 12, (len(polys), 2)))  # some points
+    got = _segment_polygon_distance(a, b, P, np.array([len(p) for p in polys]))
+    truth = [shapely.Polygon(p).distance(shapely.LineString([x, y]) if (x != y).any() else shapely.Point(x))
+             for p, x, y in zip(polys, a, b)]
+    assert np.allclose(got, truth, rtol=1e-12, atol=1e-12)
+    assert (got == 0).any() and (got > 0).any()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_tighter_bounds_change_nothing_but_the_work(seed, monkeypatch):
+    # path_clearance with the segment-to-C-obstacle bounds equals the box-bound search
+    # (same distance, place and segment), on random robots, obstacles and paths, some
+    # of them touching; and it runs GJK on fewer pairs.
+    import cspace.spaces.clearance as cl
+
+    rng = np.random.default_rng(seed)
+    obstacles = [_random_convex(rng, rng.uniform(0, 20, 2), rng.uniform(0.5, 3), int(rng.integers(3, 9))) for _ in range(25)]
+    robot = [_random_convex(rng, (0.0, 0.0), 0.6, 5), _random_convex(rng, (0.3, 0.0), 0.4, 4)] if seed % 3 else []
+    path = rng.uniform(0, 20, (int(rng.integers(2, 40)), 2))
+    if seed % 2:  # a path along an obstacle's edge: many nearly equal distances, a touch
+        o = obstacles[0]
+        path = np.vstack([path[:3], o, path[-2:]])
+    calls = []
+    real = cl.gjk_distance
+    monkeypatch.setattr(cl, "gjk_distance", lambda *x: calls.append(1) or real(*x))
+    fast = cl.path_clearance(path, robot, obstacles)
+    n_fast = len(calls)
+    monkeypatch.setattr(cl, "_tighter_bounds", lambda lbs, *rest: lbs)
+    monkeypatch.setattr(cl, "TIE", 0.0)
+    calls.clear()
+    slow = cl.path_clearance(path, robot, obstacles)  # every pair the box bounds cannot rule out
+    scale = max(np.abs(path).max(), max(np.abs(o).max() for o in obstacles))
+    assert slow.distance <= fast.distance <= slow.distance + 2.0**-44 * scale
+    assert (fast.distance == 0.0) == (slow.distance == 0.0)
+    assert n_fast <= len(calls)
+    # and the answer is the swept robot's distance (shapely)
+    assert fast.distance == pytest.approx(swept_clearance(path, robot, obstacles), rel=1e-9, abs=1e-12)
+
+
+def test_tighter_bounds_prune_a_margin_path():
+    # An exact path with a margin hugs the inflated obstacles along many short segments at
+    # nearly the same distance: the box bounds leave GJK hundreds of pairs, the tight ones few.
+    import os
+
+    import cspace.spaces.clearance as cl
+    from conftest import SCENARIOS
+    from planners.plan import plan
+
+    res = plan(os.path.join(SCENARIOS, "clearance.toml"), planner="exact")
+    assert res.solved and len(res.path) > 20
+    sc = res.scenario_data
+    cs = CSpace.from_scenario(sc)
+    calls = []
+    real = cl.gjk_distance
+    cl_gjk = lambda *x: calls.append(1) or real(*x)  # noqa: E731
+    mp = pytest.MonkeyPatch()
+    mp.setattr(cl, "gjk_distance", cl_gjk)
+    try:
+        fast = cl.path_clearance(res.path, cs.robot_pieces, cs.obstacle_pieces)
+        n_fast = len(calls)
+        mp.setattr(cl, "_tighter_bounds", lambda lbs, *rest: lbs)
+        mp.setattr(cl, "TIE", 0.0)
+        calls.clear()
+        slow = cl.path_clearance(res.path, cs.robot_pieces, cs.obstacle_pieces)
+    finally:
+        mp.undo()
+    assert fast.distance == res.min_clearance
+    assert fast.distance == pytest.approx(slow.distance, rel=1e-12)
+    assert n_fast * 3 <= len(calls), (n_fast, len(calls))

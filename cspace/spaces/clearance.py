@@ -23,8 +23,11 @@ the distance of the robot at some pose met on the way (an upper bound: then it c
 rise further, as when the path touches): the bound is then within about
 r · angle_step of the true clearance (r the robot's radius), and never above it.
 
-Distances are GJK's, float (relative error about 1e-15); contact is decided exactly
-(0.0 means the swept robot touches an obstacle).
+Distances are GJK's, float (error about 2^-50 of the coordinates' scale); the search
+skips pairs that cannot be nearer than the best found by more than 2^-44 of that scale
+(their bounds: the float distance from the segment to O ⊕ (−R)), so the result is within
+that of the least GJK distance; contact is decided exactly (0.0 means the swept robot
+touches an obstacle).
 """
 from __future__ import annotations
 
@@ -38,6 +41,10 @@ from ..kernel.gjk import gjk_distance
 
 ANGLE_STEP = 1e-3  # SE(2): radians of turn below which a sub-motion is not split further
 MAX_SPLITS = 20000  # SE(2): sub-motions evaluated at most (then the bound found so far is kept)
+# Translation: the search stops at pairs whose lower bound is within TIE x the coordinate scale
+# of the best distance found (see path_clearance).
+TIE = 2.0**-44
+GJK_FIRST = 16  # pairs measured on box bounds before the rest get tight ones
 
 
 class PathClearance(NamedTuple):
@@ -189,8 +196,16 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
         cand_row.append(row + s0)
         cand_k.append(k)
     lbs, rows, ks = np.concatenate(cand_lb), np.concatenate(cand_row), np.concatenate(cand_k)
-    for t in np.argsort(lbs, kind="stable").tolist():
-        if lbs[t] >= best:
+    # Pairs whose lower bound is within TIE x the scene's coordinate scale of the best
+    # distance found are not measured (GJK's own error is about 2^-50 x that scale). A path
+    # with a margin runs at one distance, to rounding, along many segments, where box
+    # bounds leave GJK hundreds of pairs: after GJK_FIRST pairs, the rest get tight bounds.
+    slack = TIE * max(float(np.abs(pts).max()), max(float(np.abs(p).max()) for p in obs.pieces))
+    queue, pos, measured = np.argsort(lbs, kind="stable").tolist(), 0, 0
+    while pos < len(queue):
+        t = queue[pos]
+        pos += 1
+        if lbs[t] >= best - slack:
             break
         row, k = int(rows[t]), int(ks[t])
         i, j = divmod(row, nr)
@@ -202,11 +217,90 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
             best, arg = d.distance, (i, j, k, d.point_b)
             if best == 0.0:
                 break
+        measured += 1
+        if measured == GJK_FIRST:
+            rest = np.array(queue[pos:], dtype=np.int64)
+            rest = rest[lbs[rest] < best - slack]
+            lbs = lbs.copy()
+            lbs[rest] = _tighter_bounds(lbs[rest], rows[rest], ks[rest], a, b, rob, obs)
+            queue, pos = rest[np.argsort(lbs[rest], kind="stable")].tolist(), 0
     if arg is None:
         return PathClearance(math.inf, (), (), -1, "exact")
     i, j, k, w = arg
     where = _closest_position(segs[i], rob[j], obs.pieces[k])
     return PathClearance(float(best), where, tuple(float(v) for v in w), i, "exact")
+
+
+def _tighter_bounds(lbs, rows, ks, a, b, rob, obs) -> np.ndarray:
+    """The box bounds ``lbs`` of the candidate (sweep, obstacle piece) pairs raised to the
+    float distance from the sweep's segment to O ⊕ (−R) (the translating piece R meets O
+    where its reference point meets that sum), less a tolerance 10^7 times the rounding
+    of that distance (2^-46 x the coordinate scale): still lower bounds, tight enough that
+    GJK runs on few pairs. Scenes
+    far from unit scale (products could underflow or overflow) keep the box bounds."""
+    from ..kernel.minkowski import reflect
+    from ..kernel.pairsums import pairwise_sums
+
+    if not len(rows):
+        return lbs
+    nr = len(rob)
+    i, j = rows // nr, rows % nr
+    key = ks * nr + j
+    uniq, inv = np.unique(key, return_inverse=True)
+    polys: list = [None] * len(uniq)
+    for jj in range(nr):  # the C-obstacles the candidates need, batched per robot piece
+        sel = np.flatnonzero(uniq % nr == jj)
+        if not len(sel):
+            continue
+        obst = [obs.pieces[k] for k in (uniq[sel] // nr).tolist()]
+        r = rob[jj]
+        sums = obst if len(r) == 1 and not r.any() else pairwise_sums(obst, [reflect(r)])
+        for t, poly in zip(sel.tolist(), sums):
+            polys[t] = poly
+    sizes = np.array([len(p) for p in polys])
+    E = int(sizes.max())
+    P = np.zeros((len(polys), E, 2))
+    for t, poly in enumerate(polys):
+        P[t, : len(poly)] = poly
+        P[t, len(poly):] = poly[0]  # padding repeats a vertex: zero-length edges change nothing
+    scale = max(float(np.abs(P).max()), float(np.abs(a).max()), float(np.abs(b).max()))
+    if not (1e-100 < scale < 1e100):
+        return lbs
+    d = _segment_polygon_distance(a[i], b[i], P[inv], sizes[inv])
+    tol = 2.0**-46 * (scale + np.where(np.isfinite(d), d, 0.0))
+    return np.where(np.isfinite(d), np.fmax(lbs, d - tol), lbs)
+
+
+def _segment_polygon_distance(a, b, P, n) -> np.ndarray:
+    """Float distance from each segment a[t]-b[t] to the closed convex CCW polygon P[t]
+    (padded to a common length by repeating its first vertex; ``n[t]`` real vertices):
+    0 when an end lies inside or the segment crosses an edge, else the least of the
+    ends' distances to the edges and the vertices' distances to the segment."""
+    Q = np.roll(P, -1, axis=1)
+    ex, ey = Q[..., 0] - P[..., 0], Q[..., 1] - P[..., 1]
+
+    def side(px, py):  # edge e x (p - P_e), per edge
+        return ex * (py[:, None] - P[..., 1]) - ey * (px[:, None] - P[..., 0])
+
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        sa, sb = side(a[:, 0], a[:, 1]), side(b[:, 0], b[:, 1])
+        inside = (sa >= 0).all(axis=1) | (sb >= 0).all(axis=1)
+        ux, uy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+        o1 = ux[:, None] * (P[..., 1] - a[:, 1, None]) - uy[:, None] * (P[..., 0] - a[:, 0, None])
+        o2 = ux[:, None] * (Q[..., 1] - a[:, 1, None]) - uy[:, None] * (Q[..., 0] - a[:, 0, None])
+        cross = ((o1 * o2 <= 0) & (sa * sb <= 0) & ((ex != 0) | (ey != 0))).any(axis=1)
+        d = np.minimum(_point_segment(a[:, None, :], P, Q), _point_segment(b[:, None, :], P, Q)).min(axis=1)
+        d = np.minimum(d, _point_segment(P, a[:, None, :], b[:, None, :]).min(axis=1))
+    return np.where(inside | cross, 0.0, d)
+
+
+def _point_segment(p, s0, s1) -> np.ndarray:
+    """Distances from points p to segments s0-s1 (broadcast over the leading axes)."""
+    dx, dy = s1[..., 0] - s0[..., 0], s1[..., 1] - s0[..., 1]
+    px, py = p[..., 0] - s0[..., 0], p[..., 1] - s0[..., 1]
+    ll = dx * dx + dy * dy
+    t = np.clip(np.where(ll > 0, (px * dx + py * dy) / np.where(ll > 0, ll, 1.0), 0.0), 0.0, 1.0)
+    return np.hypot(px - t * dx, py - t * dy)
 
 
 def _reach(lo: np.ndarray, hi: np.ndarray, obs: Nearest) -> np.ndarray:
