@@ -31,7 +31,8 @@ from ..kernel.pieces import PieceSet
 from .inputs import query_points
 from ..kernel.polygon import piece_boxes
 from ..kernel.predicates import orient2d_many
-from ..io.scenario import MAX_MAGNITUDE, MIN_EXTENT, Scenario, load_scenario
+from ..io.scenario import load_scenario
+from ..io.schema import MAX_MAGNITUDE, MIN_EXTENT, Scenario
 
 
 @dataclass
@@ -57,7 +58,7 @@ PAIR_BATCH_CELLS = 1 << 20
 
 def _check_range(bounds: tuple, shapes: list) -> None:
     """ValueError unless the scene lies in the range the C-space supports (its
-    classification multiplies two coordinates): see :data:`cspace.io.scenario.MAX_MAGNITUDE`."""
+    classification multiplies two coordinates): see :data:`cspace.io.schema.MAX_MAGNITUDE`."""
     xmin, xmax, ymin, ymax = bounds
     if not (xmin < xmax and ymin < ymax):
         raise ValueError(f"CSpace: bounds {bounds} are empty (need xmin < xmax and ymin < ymax)")
