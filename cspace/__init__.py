@@ -27,7 +27,7 @@ _NAMES = {
     "pairwise_sums": "kernel.pairsums",
     "convolution_cycles": "kernel.convolution", "convex_sums_with": "kernel.convolution",
     "minkowski_pieces": "kernel.nonconvex", "minkowski_sum_nonconvex": "kernel.nonconvex",
-    "CSpace": "spaces.cspace", "decompose_obstacles": "spaces.cspace", "decompose_robot": "spaces.cspace",
+    "CSpace": "spaces.cspace", "decompose_obstacles": "spaces.cspace_build", "decompose_robot": "spaces.cspace_build",
     "rotate": "kernel.slab", "rotate_piece": "kernel.slab", "wrap_angle": "kernel.slab", "slab_hull": "kernel.slab", "slab_inner": "kernel.slab",
     "slab_pad": "kernel.slab", "slab_of": "kernel.slab", "slab_range": "kernel.slab", "inscribed_radius": "kernel.slab",
     "inscribed_polygon": "kernel.slab", "default_slabs": "kernel.slab", "robot_radius": "kernel.slab",

@@ -31,7 +31,8 @@ import numpy as np
 
 from . import fastpath
 from .broadphase import GridIndex
-from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
+from .cspace import CSpace
+from .cspace_build import _check_range, decompose_obstacles, decompose_robot
 from ..kernel.minkowski import minkowski_sum, reflect
 from ..kernel.polygon import point_in_convex
 from ..io.scenario import load_scenario
