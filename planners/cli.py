@@ -37,12 +37,12 @@ HELP = {
 
 
 def clip(text: str, limit: int) -> str:
-    """:func:`cspace.io.scenario.clip`, imported when needed (it pulls in numpy).
+    """:func:`cspace.io.messages.clip`, imported when needed (it pulls in numpy).
 
     >>> clip("abc", 10)
     'abc'
     """
-    from cspace.io.scenario import clip as _clip
+    from cspace.io.messages import clip as _clip
 
     return _clip(text, limit)
 

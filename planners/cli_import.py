@@ -87,7 +87,7 @@ def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
 
 def read_robot(path: str) -> dict:
     """The ``[robot]`` table of a TOML file (a robot file, or any scenario)."""
-    from cspace.io.scenario import read_input, toml_reader
+    from cspace.io.files import read_input, toml_reader
 
     tomllib = toml_reader()
     raw = read_input(path)
@@ -102,8 +102,9 @@ def read_robot(path: str) -> dict:
 
 
 def run(args) -> int:
+    from cspace.io.files import check_input
     from cspace.io.imported import import_file, is_import, to_toml
-    from cspace.io.scenario import check_input, scenario_from_dict
+    from cspace.io.validate import scenario_from_dict
 
     from .output import check_output, write_text
 

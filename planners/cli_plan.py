@@ -59,7 +59,7 @@ def integer(s: str) -> int:
 
 
 def run(args) -> int:
-    from cspace.io.scenario import check_input
+    from cspace.io.files import check_input
 
     from .errors import InputError
 

@@ -25,7 +25,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from cspace.io.scenario import check_input, load_scenario
+    from cspace.io.files import check_input
+    from cspace.io.scenario import load_scenario
 
     from .errors import InputError
 

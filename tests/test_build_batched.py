@@ -10,7 +10,7 @@ import pytest
 
 from conftest import SCENARIOS
 from cspace import CSpace, minkowski_sum, reflect
-from cspace.spaces.cspace import _contained_pieces, pair_sums
+from cspace.spaces.cspace_build import _contained_pieces, pair_sums
 from cspace.kernel.pieces import PieceSet
 from cspace.kernel.predicates import orient2d_many
 

@@ -15,7 +15,7 @@ import shapely
 
 from cspace import load_scenario
 from cspace.spaces.cspace import CSpace
-from cspace.io.scenario import CollisionProbe
+from cspace.io.probe import CollisionProbe
 
 from conftest import OMPL_SCENES, SCENARIOS
 

@@ -187,11 +187,11 @@ def test_messages_name_the_key_and_what_to_do(write_toml, extra, field, message)
 
 def test_the_known_keys_are_one_set_to_extend(write_toml, monkeypatch):
     # A new top-level section (say `velocity`) is one entry in TOP_LEVEL_KEYS; suggestions follow it.
-    from cspace.io import scenario
+    from cspace.io import validate
     path = write_toml("velocty = 0.5\n" + BASE)
     with pytest.raises(ScenarioError, match="expected one of"):
         load_scenario(path)
-    monkeypatch.setattr(scenario, "TOP_LEVEL_KEYS", scenario.TOP_LEVEL_KEYS | {"velocity"})
+    monkeypatch.setattr(validate, "TOP_LEVEL_KEYS", validate.TOP_LEVEL_KEYS | {"velocity"})
     with pytest.raises(ScenarioError, match=r"velocty: unknown field \(did you mean velocity\?\)"):
         load_scenario(path)
     # `clearance` was added that way (issue 21).

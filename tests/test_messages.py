@@ -11,7 +11,8 @@ import warnings
 
 import pytest
 
-from cspace.io.scenario import ScenarioError, clip, load_scenario, show
+from cspace.io.messages import clip, show
+from cspace.io.scenario import ScenarioError, load_scenario
 from planners.cli import main
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

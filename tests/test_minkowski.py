@@ -142,7 +142,7 @@ def test_large_vectorised_path_matches_exact():
     S = minkowski_sum(P, Q)
     assert strictly_convex(S)
     # The exact reference without the quadratic blow-up: the scalar exact merge on the same input.
-    from cspace.kernel.minkowski import _clean_small, _merge2_small
+    from cspace.kernel.minkowski_scalar import _clean_small, _merge2_small
     ref, exact = _merge2_small(_clean_small(P.tolist()), _clean_small(Q.tolist()))
     assert exact and S.ravel().tolist() == ref
 
@@ -204,7 +204,7 @@ def test_erosion_is_not_the_sum_with_the_reflection():
 
 def _scalar_reference(*polys):
     """The scalar exact merge on the same operands: same rounding semantics, other code path."""
-    from cspace.kernel.minkowski import _certify_small, _clean_small, _merge_small
+    from cspace.kernel.minkowski_scalar import _certify_small, _clean_small, _merge_small
 
     return _certify_small(_merge_small([_clean_small(np.asarray(p, float).tolist()) for p in polys]))
 

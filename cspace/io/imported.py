@@ -2,7 +2,7 @@
 OMPL.app problem files (``.cfg``).
 
 An import builds the same dict a scenario TOML parses to, so one validator
-(:func:`cspace.io.scenario.scenario_from_dict`) checks both, and :func:`to_toml` writes
+(:func:`cspace.io.validate.scenario_from_dict`) checks both, and :func:`to_toml` writes
 it out as a scenario file. What the map does not say (the robot, the start and goal
 of a map) comes from :class:`ImportOptions`; what the import changed (cells filled,
 vertices simplified, the largest error, anything dropped) is in the report.
@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .scenario import ScenarioError, scenario_from_dict
+from .messages import ScenarioError
+from .validate import scenario_from_dict
 
 MAP_SUFFIXES = (".yaml", ".yml")
 CFG_SUFFIXES = (".cfg",)
@@ -90,7 +91,7 @@ def import_file(path, options: ImportOptions | None = None) -> Imported:
 
 def load_imported(path, space: str | None = None, options: ImportOptions | None = None,
                   turning_radius: float | None = None):
-    """:func:`import_file`, then validated into a :class:`cspace.io.scenario.Scenario`.
+    """:func:`import_file`, then validated into a :class:`cspace.io.schema.Scenario`.
 
     >>> import os
     >>> root = os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "maps")

@@ -37,7 +37,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .scenario import ScenarioError, read_input, utf8_text
+from .files import read_input, utf8_text
+from .messages import ScenarioError
 
 MODES = ("trinary", "scale", "raw")
 MAX_PIXELS = 2**26  # 64 Mi cells (8192 x 8192): a bigger map is refused, not read

@@ -33,7 +33,8 @@ import warnings
 import numpy as np
 
 from .imported import Imported, ImportOptions, _robot_and_queries
-from .scenario import ScenarioError, read_input, utf8_text
+from .files import read_input, utf8_text
+from .messages import ScenarioError
 
 IO_HINT = 'pip install -e ".[io]"  (or pip install pycollada)'
 PROBLEM_KEYS = {"robot", "world", "start.x", "start.y", "start.theta", "goal.x", "goal.y", "goal.theta",
@@ -98,7 +99,7 @@ def read_mesh(cfg_path: str, key: str, name: str):
     >>> read_mesh("p.cfg", "world", "no_such_mesh.dae")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    cspace.io.scenario.ScenarioError: p.cfg: world: mesh file no_such_mesh.dae not found (looked in ...)
+    cspace.io.messages.ScenarioError: p.cfg: world: mesh file no_such_mesh.dae not found (looked in ...)
     """
     mesh = name if os.path.isabs(name) else os.path.join(os.path.dirname(os.path.abspath(cfg_path)), name)
     if not os.path.exists(mesh):
@@ -180,7 +181,7 @@ def import_cfg(path: str, options: ImportOptions) -> Imported:
     >>> import_cfg(f, ImportOptions())  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    cspace.io.scenario.ScenarioError: ...p.cfg: world: missing (the mesh file of the robot and of the world)
+    cspace.io.messages.ScenarioError: ...p.cfg: world: missing (the mesh file of the robot and of the world)
     """
     from .meshes import footprint, polygons
 

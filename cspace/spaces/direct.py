@@ -106,7 +106,8 @@ class DirectChecker:
         False
         """
         from ..kernel.decompose import convex_decompose  # a convex shape comes back whole
-        from ..io.scenario import Scenario, load_scenario
+        from ..io.scenario import load_scenario
+        from ..io.schema import Scenario
 
         sc = scenario if isinstance(scenario, Scenario) else load_scenario(os.fspath(scenario))
         obstacles = [p for o in sc.obstacles for p in convex_decompose(o.polygon, o.holes)]

@@ -31,10 +31,12 @@ import numpy as np
 
 from . import fastpath
 from .broadphase import GridIndex
-from .cspace import CSpace, _check_range, decompose_obstacles, decompose_robot
+from .cspace import CSpace
+from .cspace_build import _check_range, decompose_obstacles, decompose_robot
 from ..kernel.minkowski import minkowski_sum, reflect
 from ..kernel.polygon import point_in_convex
-from ..io.scenario import Scenario, load_scenario
+from ..io.scenario import load_scenario
+from ..io.schema import Scenario
 from .car_motion import CarMotions
 from .se2_motion import SE2Motions, interpolate  # noqa: F401  (interpolate: part of this module's API)
 from ..kernel.slab import (ANGLE_SLACK, TWO_PI, _edges, _typical_gap, default_slabs, robot_radius, rotate_piece,

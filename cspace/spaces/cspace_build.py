@@ -1,0 +1,195 @@
+"""The C-space's build stages, shared by :class:`cspace.spaces.cspace.CSpace` and the SE(2)
+C-space: the supported range, convex decomposition of obstacles and robot, the batched
+pairwise Minkowski sums (obstacle piece ⊕ reflected robot piece), the exact containment
+test that prunes pieces, and the :class:`Stage` record each stage leaves in the report.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..kernel.polygon import piece_boxes
+from ..kernel.predicates import orient2d_many
+from ..io.schema import MAX_MAGNITUDE, MIN_EXTENT
+
+
+@dataclass
+class Stage:
+    """One build stage: whether it ran, what it counted and what it cost."""
+
+    name: str
+    ran: bool
+    seconds: float = 0.0
+    counts: dict = field(default_factory=dict)
+    note: str = ""
+
+    def as_dict(self) -> dict:
+        return {"stage": self.name, "ran": self.ran, "seconds": self.seconds, **self.counts, "note": self.note}
+
+
+# Minkowski sums of pieces of at most PAIR_BATCH_EDGES vertices are batched, about
+# PAIR_BATCH_CELLS (obstacle edge, robot edge) comparisons per batch.
+PAIR_BATCH_EDGES = 128  # a robot piece with a margin's rounded corners (~75 edges) is still batched
+PAIR_BATCH_CELLS = 1 << 20
+
+
+def _check_range(bounds: tuple, shapes: list) -> None:
+    """ValueError unless the scene lies in the range the C-space supports (its
+    classification multiplies two coordinates): see :data:`cspace.io.schema.MAX_MAGNITUDE`."""
+    xmin, xmax, ymin, ymax = bounds
+    if not (xmin < xmax and ymin < ymax):
+        raise ValueError(f"CSpace: bounds {bounds} are empty (need xmin < xmax and ymin < ymax)")
+    pts = [p for p in shapes if len(p)]
+    big = max([abs(v) for v in bounds] + ([float(np.abs(np.concatenate(pts)).max())] if pts else []))
+    if not big <= MAX_MAGNITUDE:
+        raise ValueError(f"CSpace: a coordinate of magnitude {big:.3g} is beyond the supported 2^400")
+    if max(xmax - xmin, ymax - ymin) < MIN_EXTENT:
+        raise ValueError(f"CSpace: the bounds' extent {max(xmax - xmin, ymax - ymin):.3g} is below the supported 2^-400")
+
+
+def decompose_obstacles(obstacles: list[np.ndarray], holes: list[list[np.ndarray]] | None = None,
+                        of: list[int] | None = None,
+                        convex: list[bool] | None = None) -> tuple[list[np.ndarray], np.ndarray, int]:
+    """Convex pieces of the obstacles: (pieces, owning obstacle of each piece, obstacles split).
+
+    Convex obstacles without holes are kept as they are; the others go through
+    :func:`cspace.kernel.decompose.convex_decompose`. ``of[k]``, if given, is the input obstacle
+    shell k came from (a MultiPolygon gives several shells); ``convex[k]``, if given, is
+    the loader's exact :func:`cspace.kernel.polygon.is_convex` of shell k (not computed again).
+    Shared by :class:`CSpace` and the SE(2) C-space, which decomposes once for all its slabs.
+
+    >>> p, owner, split = decompose_obstacles([np.array([[0., 0], [2, 0], [2, 2], [0, 2]])])
+    >>> len(p), owner.tolist(), split
+    (1, [0], 0)
+    """
+    from ..kernel.polygon import is_convex
+
+    holes = holes or [[] for _ in obstacles]
+    pieces, owner, split = [], [], 0
+    for k, (poly, hs) in enumerate(zip(obstacles, holes)):
+        i = k if of is None else of[k]
+        if not hs and (convex[k] if convex is not None else is_convex(poly)):
+            parts = [np.asarray(poly, dtype=np.float64)]
+        else:
+            from ..kernel.decompose import convex_decompose
+
+            parts = convex_decompose(poly, hs)
+            split += 1
+        pieces += parts
+        owner += [i] * len(parts)
+    return pieces, np.array(owner, dtype=np.int64), split
+
+
+def decompose_robot(robot: list[np.ndarray], is_disk: bool = False) -> tuple[list[np.ndarray], int]:
+    """Convex pieces of the robot parts: (pieces, parts split). A disk's polygon is convex.
+
+    >>> p, split = decompose_robot([np.array([[0., 0], [2, 0], [2, 2], [1, 1], [0, 2]])])
+    >>> len(p) > 1, split
+    (True, 1)
+    """
+    from ..kernel.polygon import is_convex
+
+    pieces, split = [], 0
+    for part in robot:
+        if is_disk or is_convex(part):
+            pieces.append(np.asarray(part, dtype=np.float64))
+        else:
+            from ..kernel.decompose import convex_decompose
+
+            pieces += convex_decompose(part)
+            split += 1
+    return pieces, split
+
+
+def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
+    """Convex pieces lying inside another piece (exact containment test): removed -> container.
+
+    Candidate pairs come from bounding-box containment; a convex piece P lies in a
+    convex piece Q iff every vertex of P is on or left of every edge of Q. Of two
+    identical pieces only the later one is removed.
+    """
+    n = len(pieces)
+    if n < 2:
+        return {}
+    lo, hi = piece_boxes(pieces)
+    order = np.argsort(lo[:, 0], kind="stable")
+    removed: dict[int, int] = {}
+    # Pairs (q, p), p != q, whose box lies inside q's box (closed), each q's in the order of
+    # ``order``. A piece inside q has its first vertex in q: an STRtree of the pieces
+    # proposes the pieces holding each first vertex (near-linear, where boxes of long
+    # thin pieces overlap by the thousand), the exact box comparisons and the exact
+    # vertex test below decide. (Pieces of fewer than 3 vertices: boxes covering boxes.)
+    import shapely
+
+    sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
+    if (sizes >= 3).all():
+        rings = shapely.linearrings(np.concatenate(pieces), indices=np.repeat(np.arange(n), sizes))
+        firsts = shapely.points(np.array([p[0] for p in pieces]))
+        # The pieces are the (prepared) query geometries, the points the tree: a piece of
+        # 10^5 vertices is indexed once, not walked once per point near it.
+        qs, ps = shapely.STRtree(firsts).query(shapely.polygons(rings), predicate="intersects")
+    else:
+        boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
+        qs, ps = shapely.STRtree(boxes).query(boxes, predicate="covers")
+    inside = (ps != qs) & (lo[ps, 0] >= lo[qs, 0]) & (hi[ps, 0] <= hi[qs, 0]) & (lo[ps, 1] >= lo[qs, 1]) & \
+        (hi[ps, 1] <= hi[qs, 1])
+    qs, ps = qs[inside], ps[inside]
+    rank = np.empty(n, dtype=np.int64)
+    rank[order] = np.arange(n)
+    by = np.lexsort((rank[ps], qs))
+    qs, ps = qs[by], ps[by]
+    cut = np.flatnonzero(np.diff(qs)) + 1
+    for q, cand in zip(qs[np.r_[0, cut]].tolist() if len(qs) else [], np.split(ps, cut) if len(qs) else []):
+        if q in removed:
+            continue
+        Q = pieces[q]
+        s, e = Q, np.roll(Q, -1, axis=0)
+        for p in cand.tolist():
+            if p in removed:
+                continue
+            P = pieces[p]
+            if P.shape == Q.shape and p < q and np.array_equal(P, Q):
+                continue  # identical: keep the earlier one, drop q when it is visited as p
+            sides = orient2d_many(s[None, :, :], e[None, :, :], P[:, None, :])
+            if (sides >= 0).all():
+                removed[p] = q
+    return removed
+
+
+def pair_sums(obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray]) -> list[np.ndarray]:
+    """``[minkowski_sum(p, r) for p in obstacle_pieces for r in robot_pieces]``: pairs of
+    small pieces in batches (:func:`cspace.kernel.pairsums.pairwise_sums`, equal array for
+    array), large ones one by one (a batch compares every edge with every edge).
+
+    >>> sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1]])
+    >>> [s.tolist() for s in pair_sums([sq], [sq - 1])]
+    [[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]]
+    """
+    from ..kernel.minkowski import minkowski_sum
+    from ..kernel.pairsums import pairwise_sums
+
+    nr = len(robot_pieces)
+    out: list = [None] * (len(obstacle_pieces) * nr)
+    small_r = [j for j, r in enumerate(robot_pieces) if len(r) <= PAIR_BATCH_EDGES]
+    small_o = [i for i, p in enumerate(obstacle_pieces) if len(p) <= PAIR_BATCH_EDGES]
+    if small_r and small_o:
+        rb = [robot_pieces[j] for j in small_r]
+        redges = sum(len(r) for r in rb)
+        start = 0
+        while start < len(small_o):  # chunks of about PAIR_BATCH_CELLS edge comparisons
+            stop, used = start, 0
+            while stop < len(small_o) and (stop == start or (used + len(obstacle_pieces[small_o[stop]])) * redges
+                                           <= PAIR_BATCH_CELLS):
+                used += len(obstacle_pieces[small_o[stop]])
+                stop += 1
+            chunk = small_o[start:stop]
+            sums = pairwise_sums([obstacle_pieces[c] for c in chunk], rb)
+            for a, c in enumerate(chunk):
+                for b, j in enumerate(small_r):
+                    out[c * nr + j] = sums[a * len(rb) + b]
+            start = stop
+    for k in range(len(out)):
+        if out[k] is None:
+            out[k] = minkowski_sum(obstacle_pieces[k // nr], robot_pieces[k % nr])
+    return out
