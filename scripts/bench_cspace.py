@@ -422,10 +422,15 @@ def scenario_files() -> list[pathlib.Path]:
     return sorted((ROOT / "scenarios").glob("*.toml")) + sorted((ROOT / "scenarios" / "ompl").glob("*.toml"))
 
 
-def stage_row(path) -> dict:
-    """The ``report()`` of one scenario's C-space, flattened to one row."""
-    cs = CSpace.from_scenario(path)
-    rep = cs.report()
+def stage_row(path, reps: int = 1) -> dict:
+    """The ``report()`` of one scenario's C-space, flattened to one row; with ``reps`` > 1
+    the scenario is loaded and built ``reps`` times, each stage's seconds (and the build's)
+    the median of the builds."""
+    reports = [CSpace.from_scenario(path).report() for _ in range(max(1, reps))]
+    rep = reports[0]
+    for k, s in enumerate(rep["stages"]):
+        s["seconds"] = statistics.median(r["stages"][k]["seconds"] for r in reports)
+    rep["build_seconds"] = statistics.median(r["build_seconds"] for r in reports)
     row = {"scenario": str(pathlib.Path(path).relative_to(ROOT)) if pathlib.Path(path).is_absolute()
            else str(path), "pieces": rep["pieces"], "robot_pieces": rep["robot_pieces"],
            "obstacle_pieces": rep["obstacle_pieces"], "build_s": rep["build_seconds"],
@@ -444,8 +449,15 @@ def stage_row(path) -> dict:
 STAGES = ("load", "decompose_obstacles", "decompose_robot", "minkowski", "prune", "index")
 
 
-def part_c() -> list[dict]:
-    return [stage_row(p) for p in scenario_files()]
+def part_c(reps: int = 9) -> list[dict]:
+    return [stage_row(p, reps) for p in scenario_files()]
+
+
+def index_share(row: dict) -> float | None:
+    """The grid index's share of the build's stages (load excluded), None without an index."""
+    st = {s["stage"]: s["seconds"] for s in row["stages"] if s["ran"]}
+    total = sum(v for k, v in st.items() if k != "load")
+    return st["index"] / total if "index" in st and total > 0 else None
 
 
 def print_c(rows: list[dict]) -> None:
@@ -454,7 +466,7 @@ def print_c(rows: list[dict]) -> None:
              "minkowski": "sums", "prune": "prune", "index": "index"}
     head = "".join(f"{short[s]:>9}" for s in STAGES)
     print(f"{'scenario':>28} {'obs.pcs':>7} {'rob.pcs':>7} {'before':>7} {'out':>5} {'in':>5} {'after':>6}{head} "
-          f"{'total':>9}")
+          f"{'total':>9} {'index %':>8}")
     notes = {}
     for r in rows:
         st = {s["stage"]: s for s in r["stages"]}
@@ -467,10 +479,18 @@ def print_c(rows: list[dict]) -> None:
             else:
                 cells += f"{'-':>9}"
                 notes.setdefault(st[s]["note"], []).append(pathlib.Path(r["scenario"]).stem)
+        share = index_share(r)
         print(f"{r['scenario']:>28} {r['obstacle_pieces']:>7} {r['robot_pieces']:>7} {r['before']:>7} "
-              f"{r['outside']:>5} {r['inside']:>5} {r['after']:>6}{cells} {r['build_s'] * 1e3:>9.2f}")
+              f"{r['outside']:>5} {r['inside']:>5} {r['after']:>6}{cells} {r['build_s'] * 1e3:>9.2f} "
+              f"{'-' if share is None else f'{100 * share:.0f}':>8}")
     for note, who in notes.items():
         print(f"  skipped ({note}): {', '.join(sorted(set(who)))}")
+    shares = [(index_share(r), r["scenario"]) for r in rows if index_share(r) is not None]
+    if shares:
+        worst = max(shares)
+        print(f"index share of the build (median of each stage over the builds; load excluded): median "
+              f"{100 * statistics.median(s for s, _ in shares):.0f} %, max {100 * worst[0]:.0f} % ({worst[1]}); "
+              f"at most 50 % on {sum(s <= 0.5 for s, _ in shares)} of {len(shares)} scenes")
 
 
 # ------------------------------------------------------------------ main
@@ -493,7 +513,7 @@ def main(argv=None) -> int:
         out["B"] = part_b(5 if args.quick else 21)
         print_b(out["B"])
     if "C" in parts:
-        out["C"] = part_c()
+        out["C"] = part_c(3 if args.quick else 9)
         print_c(out["C"])
     if args.out_json:
         with open(args.out_json, "w") as f:

@@ -103,6 +103,12 @@ def test_stage_rows(bench):
     assert row["after"] == row["before"] - row["outside"] - row["inside"] == row["pieces"]
     point = bench.stage_row(bench.ROOT / "scenarios" / "ompl" / "empty.toml")
     assert "minkowski" in point["skipped"] and point["pieces"] == 0
+    # medians over builds, and the index's share of the stages (load excluded)
+    three = bench.stage_row(bench.ROOT / "scenarios" / "basic.toml", reps=3)
+    st = {s["stage"]: s["seconds"] for s in three["stages"] if s["ran"]}
+    share = bench.index_share(three)
+    assert share == st["index"] / sum(v for k, v in st.items() if k != "load") and 0 < share < 1
+    assert bench.index_share({"stages": [{"stage": "load", "ran": True, "seconds": 1.0}]}) is None
 
 
 @pytest.mark.parametrize("name", ["combs.toml", "random_polygons.toml", "u_robot.toml"])
