@@ -12,7 +12,7 @@ import warnings
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import cspace as C
@@ -204,6 +204,7 @@ def test_non_finite_coordinates_are_a_clear_value_error(name, bad):
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.tuples(st.integers(-50, 50), st.integers(-50, 50)), min_size=3, max_size=12, unique=True),
        st.sampled_from([1.0, 2.0**-600, 2.0**600, 1e-7]), st.floats(-1e8, 1e8))
+@example(pts=[(0, 1), (1, 2), (-1, 0)], scale=2.0**600, offset=2.2250738585e-313)  # GEOS's reason overflowed
 def test_orientation_is_the_sign_of_the_exact_area(pts, scale, offset):
     # Oracle: the shoelace sum in Fractions. Star-shaped (sorted by angle about the
     # centroid), so the polygon is simple; scaled and offset in floats, so the area is
