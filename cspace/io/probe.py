@@ -36,23 +36,6 @@ class CollisionProbe:
         return int(hits.min()) if len(hits) else None
 
 
-def _plain_list(pts) -> bool:
-    """Whether ``pts`` is a non-empty ``[[x, y], ...]`` of plain floats and ints (no bool,
-    no string): the loader's batched route; the values are checked after conversion.
-
-    >>> _plain_list([[0, 1.5], [2, 3]]), _plain_list([[0, True]]), _plain_list([[0, 1, 2]])
-    (True, False, False)
-    """
-    if type(pts) is not list or not pts:
-        return False
-    for p in pts:
-        if type(p) is not list or len(p) != 2:
-            return False
-        x, y = p
-        if (type(x) is not float and type(x) is not int) or (type(y) is not float and type(y) is not int):
-            return False
-    return True
-
 
 def _shapely_obstacles(obstacles: list) -> list:
     """``[ob.to_shapely() for ob in obstacles]``, polygons without holes made in batches of
