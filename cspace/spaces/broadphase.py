@@ -84,7 +84,7 @@ class GridIndex(CellClassifier):
             # 256 x 256 classified 2-4x longer for no faster query: a MIXED cell costs
             # the compiled narrow phase less than the Python call around it, and a
             # segment walks fewer cells.
-            cells = int(min(max(CELLS_PER_PIECE * n, MIN_CELLS), 1 << 20))
+            cells = int(min(max(CELLS_PER_PIECE * n, MIN_CELLS), 1 << 20)) if n else 1  # no piece: one FREE cell
             # Large, overlapping pieces (comb sums) would each cover a big share of that
             # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
             cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist())

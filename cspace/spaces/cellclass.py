@@ -264,7 +264,7 @@ class CellClassifier:
         return pid, jj * self.nx + ii, inside, masks
 
     def _chords(self, Q: np.ndarray, sizes: np.ndarray):
-        """Wide pieces (padded vertices ``Q``, counts ``sizes``) as chord polygons: four
+        """Wide pieces (padded vertices ``Q``, counts ``sizes``) as chord polygons: eight
         vertices and both ends of every edge longer than a cell, then, while a
         chord's sagitta exceeds a quarter of a cell, the vertex halfway along the arc it
         cuts off. Returns the chord polygons (padded), their vertex counts, and each
@@ -281,42 +281,45 @@ class CellClassifier:
         at most half a cell wider.
         """
         K, E, _ = Q.shape
+        ar = np.arange(K)[:, None]  # row index for gathers (cheaper than take_along_axis)
         slot = np.arange(E)
         valid = slot[None, :] < sizes[:, None]
         nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
-        e = np.take_along_axis(Q, nxt[:, :, None], axis=1) - Q
+        e = Q[ar, nxt] - Q
         long = valid & (np.abs(e[:, :, 0]) + np.abs(e[:, :, 1]) > self.cw + self.ch)
         prev = (slot[None, :] - 1) % sizes[:, None]
-        quarter = slot[None, :] % np.maximum(sizes[:, None] // 4, 1) == 0  # four vertices to start from
-        keep = valid & (long | np.take_along_axis(long, prev, axis=1) | quarter)
+        eighth = slot[None, :] % np.maximum(sizes[:, None] // 8, 1) == 0  # eight vertices to start from
+        keep = valid & (long | long[ar, prev] | eighth)
         limit = 0.25 * min(self.cw, self.ch)
+        rr, vv = np.nonzero(valid)  # row-major: (piece, vertex) pairs, each piece's in order
         while True:
             n = keep.sum(axis=1)
             C = int(n.max())
             order = np.argsort(~keep, axis=1, kind="stable")[:, :C]  # kept slots first, in order
-            R = np.take_along_axis(Q, order[:, :, None], axis=1)
-            ok = np.arange(C)[None, :] < n[:, None]
-            rn = np.where(np.arange(C)[None, :] + 1 < n[:, None], np.arange(C)[None, :] + 1, 0)
-            d = np.take_along_axis(R, rn[:, :, None], axis=1) - R
+            R = Q[ar, order]
+            cc = np.arange(C)[None, :]
+            ok = cc < n[:, None]
+            rn = np.where(cc + 1 < n[:, None], cc + 1, 0)
+            d = R[ar, rn] - R
             nrm = np.stack([d[:, :, 1], -d[:, :, 0]], axis=2)
             with np.errstate(invalid="ignore", divide="ignore"):
                 nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
                 c = nrm[:, :, 0] * R[:, :, 0] + nrm[:, :, 1] * R[:, :, 1]
                 # Each vertex against the chord whose arc holds it (the last kept slot at
                 # or before it; slot 0 is always kept): n . v - c, its largest per chord.
-                cid = np.cumsum(keep, axis=1) - 1
-                nv = np.take_along_axis(nrm, cid[:, :, None], axis=1)
-                reach = nv[:, :, 0] * Q[:, :, 0]
-                reach += nv[:, :, 1] * Q[:, :, 1]
-                reach -= np.take_along_axis(c, cid, axis=1)
-            sag = np.full((K, C), -np.inf)
-            rr, vv = np.nonzero(valid)
-            np.maximum.at(sag, (rr, cid[rr, vv]), reach[rr, vv])  # NaN (a degenerate chord) stays NaN: never separates
-            sag = np.maximum(sag, 0.0)
+                cid = (np.cumsum(keep, axis=1) - 1)[rr, vv]
+                reach = nrm[rr, cid, 0] * Q[rr, vv, 0]
+                reach += nrm[rr, cid, 1] * Q[rr, vv, 1]
+                reach -= c[rr, cid]
+            key = rr * C + cid  # non-decreasing: one run per chord
+            first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+            sag = np.full(K * C, -np.inf)
+            sag[key[first]] = np.maximum.reduceat(reach, first)  # NaN (a degenerate chord) stays NaN
+            sag = np.maximum(sag.reshape(K, C), 0.0)
             sag[~ok] = 0.0
             # Chords cutting off too much: add the middle vertex of the arc each spans.
             a = order
-            b = np.take_along_axis(order, rn, axis=1)
+            b = order[ar, rn]
             span = (b - a) % sizes[:, None]
             bad = ok & (sag > limit) & (span > 1)
             if not bad.any():
