@@ -271,3 +271,23 @@ def test_compiled_classification_on_random_pieces(seed):
     finally:
         mp.undo()
     assert _grids_equal(c, n)
+
+
+@needs_c
+def test_compiled_path_builds_no_pure_only_structures():
+    # A scene pays only for the stages it needs: with the compiled walk, the pure segment
+    # walk's coarse grid, its summed-area table and the pieces' scalar lists are never built
+    # by point and segment queries that C decides; the pure path builds them on first use.
+    cs = CSpace.from_scenario(os.path.join(os.path.dirname(__file__), "..", "scenarios", "random_polygons.toml"))
+    rng = np.random.default_rng(0)
+    xmin, xmax, ymin, ymax = cs.bounds
+    pts = rng.uniform([xmin, ymin], [xmax, ymax], (400, 2))
+    for (ax, ay), (bx, by) in zip(pts[:-1], pts[1:]):
+        cs.segment_free((ax, ay), (bx, by))
+        cs.is_free((ax, ay))
+    assert cs._coarse is None and cs.index._sat_rows is None
+    with fastpath.disabled():
+        pure = CSpace.from_scenario(os.path.join(os.path.dirname(__file__), "..", "scenarios", "random_polygons.toml"))
+    for (ax, ay), (bx, by) in zip(pts[:-1], pts[1:]):
+        assert pure.segment_free((ax, ay), (bx, by)) == cs.segment_free((ax, ay), (bx, by))
+    assert pure._coarse is not None and pure.coarse.nx * pure.coarse.ny <= pure.index.nx * pure.index.ny
