@@ -70,8 +70,11 @@ def run(args) -> int:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
-    if args.clearance is not None and not (0 <= args.clearance < float("inf")):
-        raise InputError(src, "--clearance", f"must be a finite distance >= 0, got {args.clearance}")
+    if args.clearance is not None:
+        from cspace.io.fields import clearance_fault
+
+        if fault := clearance_fault(args.clearance):
+            raise InputError(src, "--clearance", fault)
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError(src, "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     from .ompl_glue import MAX_TIME, SEED_LIMIT, planner_name

@@ -30,8 +30,11 @@ def run(args) -> int:
 
     from .errors import InputError
 
-    if args.clearance is not None and not (0 <= args.clearance < float("inf")):
-        raise InputError(args.scenario, "--clearance", f"must be a finite distance >= 0, got {args.clearance}")
+    if args.clearance is not None:
+        from cspace.io.fields import clearance_fault
+
+        if fault := clearance_fault(args.clearance):
+            raise InputError(args.scenario, "--clearance", fault)
     check_input(args.scenario)
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[args.scenario]) if args.plot is not None else None
     if args.json is not None:

@@ -293,9 +293,11 @@ def _with_clearance(sc: Scenario, clearance) -> Scenario:
     """The scenario with the margin D of ``plan(clearance=D)`` (the file's when None)."""
     if clearance is None:
         return sc
-    if isinstance(clearance, bool) or not isinstance(clearance, (int, float)) or not math.isfinite(clearance) \
-            or clearance < 0:
-        raise ScenarioError("plan()", "clearance", f"must be a finite distance >= 0, got {clearance!r}")
+    from cspace.io.fields import clearance_fault
+
+    fault = clearance_fault(clearance)
+    if fault:
+        raise ScenarioError("plan()", "clearance", fault)
     if float(clearance) == sc.clearance:
         return sc
     import dataclasses

@@ -495,3 +495,35 @@ def test_tighter_bounds_prune_a_margin_path():
     assert fast.distance == res.min_clearance
     assert fast.distance == pytest.approx(slow.distance, rel=1e-12)
     assert n_fast * 3 <= len(calls), (n_fast, len(calls))
+
+
+@pytest.mark.parametrize("value, fault", [
+    ("1e308", "--clearance: 1e+308 is beyond the supported magnitude 2^400"),
+    ("-1", "--clearance: must be a finite distance >= 0"),
+    ("nan", "--clearance: must be a finite distance >= 0"),
+])
+@pytest.mark.parametrize("command", ["plan", "show"])
+def test_bad_clearance_options_are_one_line_exit_2(command, value, fault, tmp_path):
+    # --clearance 1e308 built a margin beyond the supported coordinates and ended as an
+    # internal error (exit 3); every bad value is one line naming the option, exit 2.
+    import os
+    import subprocess
+    import sys
+
+    from conftest import SCENARIOS
+
+    out = subprocess.run([sys.executable, "-m", "planners", command, os.path.join(SCENARIOS, "basic.toml"),
+                          f"--clearance={value}"], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and fault in lines[0] and "Traceback" not in out.stderr
+
+
+def test_plan_api_refuses_a_huge_clearance():
+    import os
+
+    from conftest import SCENARIOS
+    from planners.plan import plan
+
+    with pytest.raises(ScenarioError, match=r"clearance: 1e\+308 is beyond the supported magnitude"):
+        plan(os.path.join(SCENARIOS, "basic.toml"), clearance=1e308)

@@ -15,6 +15,29 @@ from .messages import ScenarioError, short, show, unknown_field_message
 from .schema import MAX_MAGNITUDE, MAX_SEED, Query
 
 
+def clearance_fault(value) -> str | None:
+    """Why ``value`` cannot be a safety margin D, None when it can: a real number, finite,
+    >= 0, within the supported magnitude 2^400. The one rule of ``--clearance`` (plan,
+    show) and ``plan(clearance=...)``; the scenario's ``clearance`` field says the same.
+
+    >>> clearance_fault(0.5), clearance_fault(-1.0)
+    (None, 'must be a finite distance >= 0, got -1.0')
+    >>> clearance_fault(1e300)
+    '1e+300 is beyond the supported magnitude 2^400 (about 2.6e+120)'
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f"must be a finite distance >= 0, got {value!r}"
+    try:
+        d = float(value)
+    except OverflowError:
+        return f"{show(value)} is too large for a double"
+    if not (math.isfinite(d) and d >= 0):
+        return f"must be a finite distance >= 0, got {value!r}"
+    if d > MAX_MAGNITUDE:
+        return f"{show(value)} is beyond the supported magnitude 2^400 (about {MAX_MAGNITUDE:.2g})"
+    return None
+
+
 class FieldChecks:
     """Field-by-field checks; each failure names the file and the field."""
 
