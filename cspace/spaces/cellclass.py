@@ -14,7 +14,7 @@ Pieces are classified together in padded (piece, cell, edge) blocks; boxes wider
 SCAN_COLUMNS cells row by row, where each edge's tests flip once along a row (found
 exactly by bisection on the same float expression, started from the column solved in
 reals). Pieces of more than MASK_EDGES edges go through their chord polygons
-(:meth:`CellClassifier._chords`) and have their masks computed per cell on demand
+(:func:`cspace.kernel.chords.chord_polygons`) and have their masks computed per cell on demand
 (:meth:`CellClassifier.edge_mask`).
 """
 from __future__ import annotations
@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 
+from ..kernel.chords import chord_polygons
 from . import fastpath
 
 # Boxes wider than this many cells are classified row by row (GridIndex._scan_rows).
@@ -165,7 +166,8 @@ class CellClassifier:
         Edges are padded to the widest piece with a dummy edge (zero normal, offset
         +inf) that every cell lies strictly inside and no cell is separated by.
         Pieces wider than MASK_EDGES are classified through their chord polygons
-        (:meth:`_chords`): conservatively, and with WIDE_MASK as their masks.
+        (:func:`cspace.kernel.chords.chord_polygons`): conservatively, and with WIDE_MASK as their
+        masks.
         """
         m = self.margin
         sizes = np.array([len(pieces[k]) for k in ks], dtype=np.int64)
@@ -179,7 +181,7 @@ class CellClassifier:
         wide = sizes > MASK_EDGES
         sag = None
         if wide.all():
-            Q, sizes, sag = self._chords(Q, sizes)
+            Q, sizes, sag = chord_polygons(Q, sizes, self.cw + self.ch, 0.25 * min(self.cw, self.ch))
             E = Q.shape[1]
         slot = np.arange(E)
         valid = slot[None, :] < sizes[:, None]
@@ -262,71 +264,6 @@ class CellClassifier:
         if wide.any():
             masks = np.where(wide[row], np.int64(WIDE_MASK), masks)
         return pid, jj * self.nx + ii, inside, masks
-
-    def _chords(self, Q: np.ndarray, sizes: np.ndarray):
-        """Wide pieces (padded vertices ``Q``, counts ``sizes``) as chord polygons: eight
-        vertices and both ends of every edge longer than a cell, then, while a
-        chord's sagitta exceeds a quarter of a cell, the vertex halfway along the arc it
-        cuts off. Returns the chord polygons (padded), their vertex counts, and each
-        chord's sagitta.
-
-        The hull of a subset of a convex piece's vertices lies inside the piece, so a cell
-        inside it is inside the piece; a chord's line pushed out by its sagitta (the
-        largest n . v - c over the vertices of the arc it cuts off; the piece being convex,
-        every other vertex lies on its inner side, up to a rounding far below the grid's
-        margin) has the whole piece on its inner side, so a cell beyond it is separated
-        from the piece. Cells between the two are
-        MIXED, which only costs the narrow phase a test: a piece of 75 edges (a margin's
-        rounded corners) is classified at the cost of a dozen, its band of MIXED cells
-        at most half a cell wider.
-        """
-        K, E, _ = Q.shape
-        ar = np.arange(K)[:, None]  # row index for gathers (cheaper than take_along_axis)
-        slot = np.arange(E)
-        valid = slot[None, :] < sizes[:, None]
-        nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
-        e = Q[ar, nxt] - Q
-        long = valid & (np.abs(e[:, :, 0]) + np.abs(e[:, :, 1]) > self.cw + self.ch)
-        prev = (slot[None, :] - 1) % sizes[:, None]
-        eighth = slot[None, :] % np.maximum(sizes[:, None] // 8, 1) == 0  # eight vertices to start from
-        keep = valid & (long | long[ar, prev] | eighth)
-        limit = 0.25 * min(self.cw, self.ch)
-        rr, vv = np.nonzero(valid)  # row-major: (piece, vertex) pairs, each piece's in order
-        while True:
-            n = keep.sum(axis=1)
-            C = int(n.max())
-            order = np.argsort(~keep, axis=1, kind="stable")[:, :C]  # kept slots first, in order
-            R = Q[ar, order]
-            cc = np.arange(C)[None, :]
-            ok = cc < n[:, None]
-            rn = np.where(cc + 1 < n[:, None], cc + 1, 0)
-            d = R[ar, rn] - R
-            nrm = np.stack([d[:, :, 1], -d[:, :, 0]], axis=2)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
-                c = nrm[:, :, 0] * R[:, :, 0] + nrm[:, :, 1] * R[:, :, 1]
-                # Each vertex against the chord whose arc holds it (the last kept slot at
-                # or before it; slot 0 is always kept): n . v - c, its largest per chord.
-                cid = (np.cumsum(keep, axis=1) - 1)[rr, vv]
-                reach = nrm[rr, cid, 0] * Q[rr, vv, 0]
-                reach += nrm[rr, cid, 1] * Q[rr, vv, 1]
-                reach -= c[rr, cid]
-            key = rr * C + cid  # non-decreasing: one run per chord
-            first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-            sag = np.full(K * C, -np.inf)
-            sag[key[first]] = np.maximum.reduceat(reach, first)  # NaN (a degenerate chord) stays NaN
-            sag = np.maximum(sag.reshape(K, C), 0.0)
-            sag[~ok] = 0.0
-            # Chords cutting off too much: add the middle vertex of the arc each spans.
-            a = order
-            b = order[ar, rn]
-            span = (b - a) % sizes[:, None]
-            bad = ok & (sag > limit) & (span > 1)
-            if not bad.any():
-                return R, n.astype(np.int64), sag
-            rows, cols = np.nonzero(bad)
-            mid = (a[rows, cols] + span[rows, cols] // 2) % sizes[rows]
-            keep[rows, mid] = True
 
     def _scan_rows(self, pieces, i0, i1, j0, H, nrm, c, hi, lo, evaluate) -> list:
         """:meth:`_classify_many`'s cells of wide boxes, row by row, the same answers.
