@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from cspace import CSpace
@@ -56,6 +56,7 @@ coord = st.one_of(st.integers(-1, 13).map(float), st.integers(-2, 26).map(lambda
 @needs_c
 @settings(max_examples=400, deadline=None)
 @given(st.integers(0, 11), coord, coord, coord, coord)
+@example(seed=0, ax=0.0, ay=0.0, bx=2.2250738585e-313, by=1.0)  # a slope that overflowed: "free", wrongly
 def test_segment_matches_pure(seed, ax, ay, bx, by):
     cs = scene(seed)
     want = cs._segment_pure(ax, ay, bx, by)
@@ -291,3 +292,26 @@ def test_compiled_path_builds_no_pure_only_structures():
     for (ax, ay), (bx, by) in zip(pts[:-1], pts[1:]):
         assert pure.segment_free((ax, ay), (bx, by)) == cs.segment_free((ax, ay), (bx, by))
     assert pure._coarse is not None and pure.coarse.nx * pure.coarse.ny <= pure.index.nx * pure.index.ny
+
+
+@needs_c
+def test_nearly_vertical_segments_never_come_out_free_wrongly():
+    # A segment whose x-extent is subnormal (or tiny) has a slope that overflows; the
+    # compiled walk then clipped each column's rows to nothing and answered "free"
+    # without testing a piece (found by hypothesis on a segment touching a triangle's
+    # edge). Now it walks the column's whole y-range: never a false "free".
+    checked = 0
+    for seed in range(12):
+        cs = scene(seed)
+        for x in [float(v) for v in range(13)] + [0.5, 6.25]:
+            for dx in (5e-324, 2.2250738585e-313, 1e-300, 1e-200, 1e-30):
+                for y0, y1 in ((0.0, 1.0), (0.5, 3.0), (1.0, 11.0), (2.0, 2.5), (0.0, 12.0)):
+                    if x + dx > 12.0:
+                        continue
+                    want = cs._segment_pure(x, y0, x + dx, y1)
+                    r = fastpath._fast.segment(cs._fast, x, y0, x + dx, y1)
+                    if r >= 0:
+                        assert (r != 0) == want, (seed, x, dx, y0, y1)
+                    assert cs.segment_free((x, y0), (x + dx, y1)) == want
+                    checked += 1
+    assert checked > 1000

@@ -297,7 +297,9 @@ static int test_cell(Grid *g, int64_t c, double ax, double ay, double bx, double
    (1e-9 x extent + 64 eps x the largest coordinate) exceeds by far the rounding of
    every quantity here (column edges x0 + i cw, the slope, y at a column edge: each a
    few eps of the coordinates or of the extent), and of the cell location of the
-   build's classification, so every cell holding a point of the segment is walked. */
+   build's classification, so every cell holding a point of the segment is walked.
+   Where y at a column edge is not finite (the slope overflowed), the column gets the
+   segment's whole y-range. */
 static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     double q[4];
@@ -325,9 +327,14 @@ static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t na
         double y_lo = ylo, y_hi = yhi;
         if (bx != ax) {
             double ya = ay + (lo - ax) * slope, yb = ay + (hi - ax) * slope;
-            double a = ya < yb ? ya : yb, b = ya < yb ? yb : ya;
-            if (a > y_lo) y_lo = a;
-            if (b < y_hi) y_hi = b;
+            /* A nearly vertical segment's slope can overflow (dx subnormal): 0 * inf is NaN,
+               and the clipped range would walk no cell at all. Then the segment's whole
+               y-range is walked, which is always a cover. */
+            if (isfinite(ya) && isfinite(yb)) {
+                double a = ya < yb ? ya : yb, b = ya < yb ? yb : ya;
+                if (a > y_lo) y_lo = a;
+                if (b < y_hi) y_hi = b;
+            }
         }
         double fr0 = floor((y_lo - m - g->y0) * g->ih), fr1 = floor((y_hi + m - g->y0) * g->ih);
         if (!(fr0 == fr0 && fr1 == fr1)) return PyLong_FromLong(-1); /* NaN: never on finite input */

@@ -261,43 +261,6 @@ class GridIndex(CellClassifier):
             stack.append((px, py, mx, my))
         return blockers, cands
 
-    def cells_on_segment(self, ax: float, ay: float, bx: float, by: float) -> np.ndarray:
-        """Every cell the closed segment a-b may meet (a conservative supercover).
-
-        For each grid column the segment crosses, the rows spanned by the segment's
-        y-range inside that column, widened by the margin, are taken.
-        """
-        m = self.margin
-        xlo, xhi = min(ax, bx), max(ax, bx)
-        i0 = max(math.floor((xlo - m - self.x0) * self.inv_w), 0)
-        i1 = min(math.floor((xhi + m - self.x0) * self.inv_w), self.nx - 1)
-        if i1 < i0:
-            return np.zeros(0, dtype=np.int64)
-        cols = np.arange(i0, i1 + 1)
-        # x-interval of each column, widened by the margin, intersected with the
-        # segment's x-range. Widening makes the y-range below grow by m |slope|,
-        # which dominates the rounding of the column boundary times the slope, so
-        # even near-vertical segments keep a conservative row range.
-        lo = np.maximum(self.x0 + cols * self.cw - m, xlo)
-        hi = np.minimum(self.x0 + (cols + 1) * self.cw + m, xhi)
-        ylo_seg, yhi_seg = min(ay, by), max(ay, by)
-        if bx != ax:
-            t = (ay - by) / (ax - bx)
-            ylo_x, yhi_x = ay + (lo - ax) * t, ay + (hi - ax) * t
-            y_lo = np.maximum(np.minimum(ylo_x, yhi_x), ylo_seg)
-            y_hi = np.minimum(np.maximum(ylo_x, yhi_x), yhi_seg)
-        else:
-            y_lo = np.full(cols.size, ylo_seg)
-            y_hi = np.full(cols.size, yhi_seg)
-        r0 = np.clip(np.floor((y_lo - m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
-        r1 = np.clip(np.floor((y_hi + m - self.y0) * self.inv_h).astype(np.int64), 0, self.ny - 1)
-        counts = r1 - r0 + 1
-        total = int(counts.sum())
-        col_rep = np.repeat(cols, counts)
-        offs = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
-        rows = np.repeat(r0, counts) + offs
-        return rows * self.nx + col_rep
-
     def stats(self) -> dict:
         """Cell counts by class, for reports."""
         return {
