@@ -427,7 +427,7 @@ def test_segment_polygon_distance_matches_shapely(seed):
     P = np.array([np.vstack([p, np.repeat(p[:1], E - len(p), axis=0)]) for p in polys])
     a = rng.uniform(-2, 12, (len(polys), 2))
     b = np.where(rng.random((len(polys), 1)) < 0.2, a, rng.uniform(-2, 12, (len(polys), 2)))  # some points
-    got = _segment_polygon_distance(a, b, P, np.array([len(p) for p in polys]))
+    got = _segment_polygon_distance(a, b, P)
     truth = [shapely.Polygon(p).distance(shapely.LineString([x, y]) if (x != y).any() else shapely.Point(x))
              for p, x, y in zip(polys, a, b)]
     assert np.allclose(got, truth, rtol=1e-12, atol=1e-12)

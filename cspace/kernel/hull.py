@@ -69,10 +69,9 @@ def ring_hulls(points: np.ndarray, sizes) -> list[np.ndarray]:
     Each ring is peeled: every vertex that does not turn strictly left (exact) between
     its live neighbours is dropped, until none is left; what remains turns strictly
     left everywhere, and if its edges turn around once it is a convex polygon with
-    vertices among the points. It is
-    the hull when every dropped point lies in it (checked exactly against each of its
-    edges); a ring where that fails, or that peels to fewer than 3 vertices, gets
-    :func:`convex_hull` instead. So the answer is :func:`convex_hull`'s, array for array.
+    vertices among the points. It is the hull when every dropped point lies in it
+    (checked exactly against each of its edges); a ring where that fails, or that peels
+    to fewer than 3 vertices, gets :func:`convex_hull` instead. So the answer is :func:`convex_hull`'s, array for array.
 
     >>> sq = [[0., 0], [1, 0], [1, 1], [0, 1]]
     >>> [h.tolist() for h in ring_hulls(np.array(sq + [[2., 0], [3, 0], [3, 1], [2.5, 0.5], [2, 1]]), [4, 5])]
@@ -96,13 +95,14 @@ def ring_hulls(points: np.ndarray, sizes) -> list[np.ndarray]:
     live = np.bincount(ring[alive], minlength=len(sizes))
     ok = live >= 3
     idx = np.flatnonzero(alive)
-    nxt = idx[ring_neighbours(live)[1]]
+    before, after = ring_neighbours(live)
+    nxt = idx[after]
     # Strict left turns everywhere make a convex polygon only if the edges turn around
     # once (a pentagram turns left everywhere, twice around): the edge directions then
     # change half-plane (exact signs of float differences) exactly twice.
     d = p[nxt] - p[idx]
     half = lower_half(d[:, 0], d[:, 1])
-    change = half != half[ring_neighbours(live)[0]]
+    change = half != half[before]
     ok &= np.bincount(ring[idx][change], minlength=len(sizes)) == 2
     # Every dropped point against every edge of its ring's peeled polygon: on or left.
     gone = np.flatnonzero(~alive & ok[ring])

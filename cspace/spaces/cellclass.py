@@ -353,7 +353,7 @@ class CellClassifier:
     def _classify(self, p: np.ndarray, with_masks: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cells that closed convex ``p`` may meet, which of them lie inside ``p``, and for
         each the bit mask of the edges whose line passes within the margin of it (Python
-        ints beyond 62 edges; WIDE_MASK for every cell without ``with_masks``)."""
+        ints beyond MASK_EDGES edges; WIDE_MASK for every cell without ``with_masks``)."""
         m = self.margin
         i0 = math.floor((p[:, 0].min() - m - self.x0) * self.inv_w)
         i1 = math.floor((p[:, 0].max() + m - self.x0) * self.inv_w)
@@ -369,9 +369,9 @@ class CellClassifier:
         inside = np.empty(ii.size, dtype=bool)
         separated = np.empty(ii.size, dtype=bool)
         # Bit e stands for the edge ending at vertex e (q[e-1] -> q[e]); the half-planes
-        # are for q[e] -> q[e+1], i.e. bit e+1. Up to 62 edges the masks are int64,
+        # are for q[e] -> q[e+1], i.e. bit e+1. Up to MASK_EDGES edges the masks are int64,
         # beyond that Python ints (an object array).
-        wide = len(p) > 62
+        wide = len(p) > MASK_EDGES
         masks = (np.full(ii.size, WIDE_MASK, dtype=np.int64) if not with_masks
                  else np.empty(ii.size, dtype=object if wide else np.int64))
         weights = None if wide else np.left_shift(np.int64(1), (np.arange(len(p)) + 1) % len(p))

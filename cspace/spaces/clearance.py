@@ -234,10 +234,10 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
 def _tighter_bounds(lbs, rows, ks, a, b, rob, obs) -> np.ndarray:
     """The box bounds ``lbs`` of the candidate (sweep, obstacle piece) pairs raised to the
     float distance from the sweep's segment to O ⊕ (−R) (the translating piece R meets O
-    where its reference point meets that sum), less a tolerance 10^7 times the rounding
-    of that distance (2^-46 x the coordinate scale): still lower bounds, tight enough that
-    GJK runs on few pairs. Scenes
-    far from unit scale (products could underflow or overflow) keep the box bounds."""
+    where its reference point meets that sum), less a tolerance of 2^-46 x the coordinate
+    scale (some 30 times that distance's rounding): still lower bounds, tight enough that
+    GJK runs on few pairs. Scenes far from unit scale (products could underflow or
+    overflow) keep the box bounds."""
     from ..kernel.minkowski import reflect
     from ..kernel.pairsums import pairwise_sums
 
@@ -266,14 +266,14 @@ def _tighter_bounds(lbs, rows, ks, a, b, rob, obs) -> np.ndarray:
     scale = max(float(np.abs(P).max()), float(np.abs(a).max()), float(np.abs(b).max()))
     if not (1e-100 < scale < 1e100):
         return lbs
-    d = _segment_polygon_distance(a[i], b[i], P[inv], sizes[inv])
+    d = _segment_polygon_distance(a[i], b[i], P[inv])
     tol = 2.0**-46 * (scale + np.where(np.isfinite(d), d, 0.0))
     return np.where(np.isfinite(d), np.fmax(lbs, d - tol), lbs)
 
 
-def _segment_polygon_distance(a, b, P, n) -> np.ndarray:
+def _segment_polygon_distance(a, b, P) -> np.ndarray:
     """Float distance from each segment a[t]-b[t] to the closed convex CCW polygon P[t]
-    (padded to a common length by repeating its first vertex; ``n[t]`` real vertices):
+    (padded to a common length by repeating its first vertex: zero-length edges):
     0 when an end lies inside or the segment crosses an edge, else the least of the
     ends' distances to the edges and the vertices' distances to the segment."""
     Q = np.roll(P, -1, axis=1)
