@@ -10,6 +10,7 @@ import shapely
 
 from cspace.spaces.cspace import CSpace
 from cspace.kernel.disk import disk_polygon, disk_sides
+from cspace.kernel.margin import MARGIN_PHASE
 from cspace.io.scenario import ScenarioError, scenario_from_dict
 
 TOL = 0.05  # disk_tolerance of the random scenes: an 11-gon margin (few vertices for the oracle)
@@ -111,7 +112,7 @@ def test_exact_with_margin_matches_an_independent_visibility_graph(seed):
     sc = scenario_from_dict(data)
     res = plan(sc, planner="exact")
     d = data["clearance"]
-    margin = disk_polygon((0.0, 0.0), d, sides=disk_sides(d, TOL * d))
+    margin = disk_polygon((0.0, 0.0), d, sides=disk_sides(d, TOL * d), phase=MARGIN_PHASE)
     robot = np.array(data["robot"]["polygon"], dtype=np.float64) if "robot" in data else None
     obstacles = [np.array(o["polygon"], dtype=np.float64) for o in data["obstacles"]]
     ref = oracle_shortest(oracle_cobstacles(obstacles, robot, margin), sc.bounds, sc.start, sc.goal)
@@ -527,3 +528,42 @@ def test_plan_api_refuses_a_huge_clearance():
 
     with pytest.raises(ScenarioError, match=r"clearance: 1e\+308 is beyond the supported magnitude"):
         plan(os.path.join(SCENARIOS, "basic.toml"), clearance=1e308)
+
+
+@pytest.mark.parametrize("d, tol", [(0.3, 1e-3), (1.0, 1e-2), (2.5, 1e-4), (1e-3, 1e-3)])
+def test_margin_polygon_contains_the_disk_within_its_error(d, tol):
+    """The turned margin polygon is still the circumscribed regular polygon: every edge's line
+    at least D from the centre (exact: the line's signed distance, computed in Fractions,
+    squared), every vertex within the documented error of the disk (shapely)."""
+    from fractions import Fraction
+
+    from cspace.kernel.margin import margin_error, margin_shapes
+
+    (m,) = margin_shapes(d, disk_tolerance=tol)
+    n = len(m)
+    assert n == disk_sides(d, tol * d)
+    for k in range(n):
+        (ax, ay), (bx, by) = map(lambda v: map(Fraction, v), (m[k], m[(k + 1) % n]))
+        cross = ax * by - ay * bx  # twice the triangle (0, a, b): the line's distance times |b - a|
+        assert cross > 0 and cross * cross >= Fraction(d) ** 2 * ((bx - ax) ** 2 + (by - ay) ** 2)
+    assert shapely.Polygon(m).hausdorff_distance(shapely.Point(0, 0).buffer(d, 4096)) <= margin_error(d, tol) + 1e-6 * d
+
+
+@pytest.mark.parametrize("sides", [8, 31, 64, 71, 72, 200])
+def test_margin_edges_are_parallel_to_no_axis_and_no_disk_edge(sides):
+    """Why the margin is turned: its edges meet neither the axis-parallel edges of boxes nor the
+    edges of a disk of the same side count at a near-tie (each such tie is an exact comparison,
+    and its rounded sum vertex a hull repair, in every pair sum)."""
+    from cspace.kernel.margin import margin_shapes
+
+    d = 0.7
+    ang = lambda p: np.arctan2(*(np.roll(p, -1, axis=0) - p)[:, ::-1].T)
+    (m,) = margin_shapes(d, disk_tolerance=1.0 / math.cos(math.pi / sides) - 1.0 + 1e-12)
+    assert len(m) == sides
+    # Without the turn, the same-count disk's edges are parallel to the margin's (to rounding).
+    assert np.abs(np.sort(ang(m)) - np.sort(ang(disk_polygon((0.0, 0.0), d, sides=sides)))).max() > 1e-3 / sides
+    disk = disk_polygon((3.0, -2.0), 1.3, sides=len(m))
+    step = 2 * math.pi / len(m)
+    for other in (ang(disk), np.array([0.0, math.pi / 2, math.pi, -math.pi / 2])):
+        gap = np.abs((ang(m)[:, None] - other[None, :] + math.pi) % (2 * math.pi) - math.pi)
+        assert gap.min() > 1e-3 * step  # a tie would be within rounding, some 1e-15

@@ -37,11 +37,13 @@ def disk_sides(radius: float, max_error: float | None = None) -> int:
     return int(min(max(n, MIN_SIDES), MAX_SIDES))
 
 
-def disk_polygon(center, radius: float, max_error: float | None = None, sides: int | None = None) -> np.ndarray:
+def disk_polygon(center, radius: float, max_error: float | None = None, sides: int | None = None,
+                 phase: float = 0.0) -> np.ndarray:
     """CCW regular polygon that contains the disk, within ``max_error`` of it.
 
     The first vertex is the lowest one. Vertex radius is inflated by a few ulps so
-    that rounding can never cut into the disk.
+    that rounding can never cut into the disk. ``phase`` turns the polygon about the
+    centre by that fraction of a side's angle (0: an edge at the bottom).
 
     >>> p = disk_polygon((0, 0), 1.0, sides=4)
     >>> bool(np.all(np.hypot(p[:, 0], p[:, 1]) >= 2 ** 0.5))
@@ -52,6 +54,8 @@ def disk_polygon(center, radius: float, max_error: float | None = None, sides: i
     # Start half a step after straight down so that an edge, not a vertex, is lowest
     # for even n; then rotate the cycle so the lowest vertex comes first.
     ang = -math.pi / 2 + math.pi / n + 2.0 * math.pi * np.arange(n) / n
+    if phase:
+        ang = ang + 2.0 * math.pi * phase / n
     cx, cy = float(center[0]), float(center[1])
     pts = np.column_stack([cx + circum * np.cos(ang), cy + circum * np.sin(ang)])
     i = int(np.lexsort((pts[:, 0], pts[:, 1]))[0])

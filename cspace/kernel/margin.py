@@ -11,6 +11,14 @@ ahead than aside, say). Each convex robot piece is summed with the margin in the
 k-way merge as the obstacle piece (``obstacle ⊕ −piece ⊕ −margin``), so a margin adds
 edges to each sum but no extra pass.
 
+The disk polygon is turned by MARGIN_PHASE (the golden section) of a side's angle.
+Turned or not it is the circumscribed regular polygon; turned, none of its edges is
+parallel, even to rounding, to an axis (boxes, grid maps) or to an edge of a disk
+polygon with its side count (every disk of one tolerance has the same count). A
+near-parallel pair of edges is an exact comparison in each sum's merge, and its
+rounded sum vertex often a non-convex turn that the exact hull must repair: on
+disks_cluttered.toml, unturned, that repair was most of the margin's build time.
+
 A disk margin is rotation-invariant up to its polygon; in SE(2) the margin is summed
 with each body-frame robot piece, so an anisotropic margin turns with the robot.
 """
@@ -19,6 +27,8 @@ from __future__ import annotations
 import numpy as np
 
 from .disk import DEFAULT_RELATIVE_ERROR, disk_polygon, disk_sides
+
+MARGIN_PHASE = 0.3819660112501051  # (3 - sqrt 5) / 2 of a side: see the module docstring
 
 
 def margin_shapes(clearance: float = 0.0, polygon=None, disk_tolerance: float = DEFAULT_RELATIVE_ERROR,
@@ -40,7 +50,7 @@ def margin_shapes(clearance: float = 0.0, polygon=None, disk_tolerance: float = 
     if not d >= 0.0 or d != d or d == float("inf"):
         raise ValueError(f"margin_shapes: clearance must be a finite number >= 0, got {clearance!r}")
     if d > 0.0:
-        out.append(disk_polygon((0.0, 0.0), d, sides=disk_sides(d, disk_tolerance * d)))
+        out.append(disk_polygon((0.0, 0.0), d, sides=disk_sides(d, disk_tolerance * d), phase=MARGIN_PHASE))
     if polygon is not None:
         p = np.asarray(polygon, dtype=np.float64).reshape(-1, 2)
         if theta:
