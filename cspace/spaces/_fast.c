@@ -681,6 +681,8 @@ done:
     return count < 0 ? NULL : PyLong_FromSsize_t(count);
 }
 
+PyObject *fast_pair_sums(PyObject *self, PyObject *args); /* _merge.c */
+
 static PyMethodDef methods[] = {
     {"grid", py_grid, METH_VARARGS, "Copy a grid index and its packed pieces; returns a handle."},
     {"segment", (PyCFunction)(void (*)(void))py_segment, METH_FASTCALL,
@@ -691,6 +693,8 @@ static PyMethodDef methods[] = {
      "orient(ax, ay, bx, by, cx, cy): the float filter's sign of orient2d, 2 if undecided."},
     {"classify", py_classify, METH_VARARGS,
      "classify(...): the grid build's cell classification of boxes of cells (see cellclass.py)."},
+    {"pair_sums", fast_pair_sums, METH_VARARGS,
+     "pair_sums(a_xy, a_off, b_xy, b_off, out_xy, out_count): the C-space build's pair sums (see _merge.c)."},
     {"se2", py_se2, METH_VARARGS, "Copy the SE(2) pose filter's data; returns a handle."},
     {"se2_pose", (PyCFunction)(void (*)(void))py_se2_pose, METH_FASTCALL,
      "se2_pose(handle, x, y, c, s): 1 free, 0 not free, -1 undecided (the exact test's float filter)."},

@@ -158,9 +158,11 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
 
 
 def pair_sums(obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray]) -> list[np.ndarray]:
-    """``[minkowski_sum(p, r) for p in obstacle_pieces for r in robot_pieces]``: pairs of
-    small pieces in batches (:func:`cspace.kernel.pairsums.pairwise_sums`, equal array for
-    array), large ones one by one (a batch compares every edge with every edge).
+    """``[minkowski_sum(p, r) for p in obstacle_pieces for r in robot_pieces]``, equal array
+    for array. Compiled: one certified merge per pair in C (:func:`cspace.spaces.fastpath.pair_sums`),
+    the pairs it cannot certify by ``minkowski_sum``. Pure: pairs of small pieces in batches
+    (:func:`cspace.kernel.pairsums.pairwise_sums`), large ones one by one (a batch compares
+    every edge with every edge).
 
     >>> sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1]])
     >>> [s.tolist() for s in pair_sums([sq], [sq - 1])]
@@ -168,9 +170,15 @@ def pair_sums(obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray])
     """
     from ..kernel.minkowski import minkowski_sum
     from ..kernel.pairsums import pairwise_sums
+    from . import fastpath
 
     nr = len(robot_pieces)
-    out: list = [None] * (len(obstacle_pieces) * nr)
+    out = fastpath.pair_sums(obstacle_pieces, robot_pieces)  # compiled: None where not certified
+    if out is not None:
+        for k in (k for k, s in enumerate(out) if s is None):
+            out[k] = minkowski_sum(obstacle_pieces[k // nr], robot_pieces[k % nr])
+        return out
+    out = [None] * (len(obstacle_pieces) * nr)
     small_r = [j for j, r in enumerate(robot_pieces) if len(r) <= PAIR_BATCH_EDGES]
     small_o = [i for i, p in enumerate(obstacle_pieces) if len(p) <= PAIR_BATCH_EDGES]
     if small_r and small_o:

@@ -71,6 +71,32 @@ def classify_boxes(*args) -> int:
     return _fast.classify(*args)
 
 
+def pair_sums(pa: list, pb: list) -> list | None:
+    """``[minkowski_sum(a, b) for a in pa for b in pb]`` by ``_fast.pair_sums`` (cspace/spaces/_merge.c:
+    one certified angular merge per pair), None for each pair it cannot certify (the
+    caller computes those on the pure path); None on the pure path.
+
+    >>> import numpy as np
+    >>> sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1]])
+    >>> out = pair_sums([sq], [sq - 1])
+    >>> out is None or out[0].tolist() == [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+    True
+    """
+    if _fast is None:
+        return None
+    a_off = np.zeros(len(pa) + 1, dtype=np.int64)
+    b_off = np.zeros(len(pb) + 1, dtype=np.int64)
+    np.cumsum([len(p) for p in pa], out=a_off[1:])
+    np.cumsum([len(p) for p in pb], out=b_off[1:])
+    a_xy = np.ascontiguousarray(np.concatenate(pa) if pa else np.zeros((0, 2)), dtype=np.float64)
+    b_xy = np.ascontiguousarray(np.concatenate(pb) if pb else np.zeros((0, 2)), dtype=np.float64)
+    out = np.empty((int(a_off[-1]) * len(pb) + int(b_off[-1]) * len(pa), 2))
+    count = np.empty(len(pa) * len(pb), dtype=np.int64)
+    _fast.pair_sums(a_xy, a_off, b_xy, b_off, out, count)
+    ends = np.cumsum(np.maximum(count, 0)).tolist()
+    return [out[e - c:e] if c > 0 else None for c, e in zip(count.tolist(), ends)]
+
+
 def segment_test(handle, pure, checks: dict):
     """The C-space's ``(ax, ay, bx, by) -> bool`` segment test: the compiled routine's
     certified answer when it has one, else ``pure`` (exact); ``pure`` itself on the pure

@@ -1,0 +1,202 @@
+/* The compiled fast path of the C-space build's pair sums (part of cspace.spaces._fast).
+
+   pair_sums(): every Minkowski sum A_i ⊕ B_j of two lists of convex pieces, as
+   cspace/kernel/pairsums.py computes it, one angular merge per pair, O(|A_i| + |B_j|).
+   Each piece is CCW from its lowest (then leftmost) vertex, so its edges come in
+   angular order; the merge walks both edge lists and at each step takes the edge of
+   smaller angle (half-plane first, then the sign of the cross product; equal
+   directions are fused: one vertex). Every output vertex is A_i[k] + B_j[l] rounded
+   once, as in the Python merges.
+
+   It certifies, it never guesses. A pair is written only when:
+   - both pieces are canonical (strictly convex by certified left turns, lowest then
+     leftmost first, edge halves upper...lower once), as PackedPieces.ok requires;
+   - every angular comparison is certified: Shewchuk's stage-A filter, the exact zero
+     when a factor of each product is an exact zero, or all six operations of the
+     cross product exact (TwoSum, Dekker's TwoProduct), as error_free_cross_sign;
+   - its sums were exact (Fast2Sum test), or its rounded output turns left at every
+     vertex by a certified sign.
+   Any other pair gets count -1 and the caller computes it with minkowski_sum (the
+   pure path, exact, equal array for array). So both paths give the same arrays.
+*/
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+
+#if defined(__clang__)
+#pragma clang fp contract(off)
+#elif !defined(__GNUC__)
+#pragma STDC FP_CONTRACT OFF
+#endif /* GCC: -ffp-contract=off, from setup.py */
+
+#define M_EPS (1.0 / 9007199254740992.0) /* 2^-53 */
+#define M_ERRBOUND_A ((3.0 + 16.0 * M_EPS) * M_EPS)
+#define M_UNDERFLOW_GUARD 1e-280
+#define M_UNDECIDED 2
+#define M_SPLIT 134217729.0 /* 2^27 + 1 */
+
+/* Knuth's TwoSum error of s = fl(a + b). */
+static inline double sum_err(double a, double b, double s)
+{
+    double bv = s - a, av = s - bv;
+    return (a - av) + (b - bv);
+}
+
+/* Dekker's TwoProduct error of p = fl(a * b). */
+static inline double prod_err(double a, double b, double p)
+{
+    double t = M_SPLIT * a, ah = t - (t - a), al = a - ah;
+    t = M_SPLIT * b;
+    double bh = t - (t - b), bl = b - bh;
+    return ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+}
+
+/* Certified sign of (b - a) x (d - c): +1, -1, 0, or M_UNDECIDED (cross_diff_cols's stages). */
+static int cross_sign(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy)
+{
+    double ux = bx - ax, uy = by - ay, vx = dx - cx, vy = dy - cy;
+    double left = ux * vy, right = uy * vx;
+    double det = left - right, detsum = fabs(left) + fabs(right);
+    if (detsum > M_UNDERFLOW_GUARD && detsum < HUGE_VAL) {
+        double bound = M_ERRBOUND_A * detsum;
+        if (det > bound) return 1;
+        if (-det > bound) return -1;
+    }
+    if (detsum == 0.0 && (ux == 0.0 || vy == 0.0) && (uy == 0.0 || vx == 0.0)) return 0;
+    /* Every difference and product exact (far from under- and overflow): one rounding keeps the sign. */
+    if (!(isfinite(ux) && isfinite(uy) && isfinite(vx) && isfinite(vy))) return M_UNDECIDED;
+    if (!((fabs(left) > 0x1p-900 || ux == 0.0 || vy == 0.0) && fabs(left) < 0x1p1000)) return M_UNDECIDED;
+    if (!((fabs(right) > 0x1p-900 || uy == 0.0 || vx == 0.0) && fabs(right) < 0x1p1000)) return M_UNDECIDED;
+    if (sum_err(bx, -ax, ux) != 0.0 || sum_err(by, -ay, uy) != 0.0 || sum_err(dx, -cx, vx) != 0.0
+        || sum_err(dy, -cy, vy) != 0.0 || prod_err(ux, vy, left) != 0.0 || prod_err(uy, vx, right) != 0.0)
+        return M_UNDECIDED;
+    return (det > 0.0) - (det < 0.0);
+}
+
+/* Is the edge direction (dx, dy) in the lower half [pi, 2 pi)? (lower_half) */
+static inline int lower(double dx, double dy)
+{
+    return dy < 0.0 || (dy == 0.0 && dx <= 0.0);
+}
+
+/* Is piece p (n vertices, x y interleaved) canonical, certified? */
+static int canonical(const double *p, int64_t n)
+{
+    if (n < 3) return 0;
+    double x0 = p[0], y0 = p[1];
+    int prev_half = -1;
+    for (int64_t k = 0; k < n; k++) {
+        int64_t a = (k + n - 1) % n, b = (k + 1) % n;
+        double x = p[2 * k], y = p[2 * k + 1];
+        if (y < y0 || (y == y0 && x < x0)) return 0; /* not lowest-then-leftmost first */
+        /* orient2d(prev, v, next) = (prev - next) x (v - next) */
+        if (cross_sign(p[2 * b], p[2 * b + 1], p[2 * a], p[2 * a + 1], p[2 * b], p[2 * b + 1], x, y) != 1) return 0;
+        int half = lower(p[2 * b] - x, p[2 * b + 1] - y);
+        if (half < prev_half) return 0; /* the halves read upper...lower once */
+        prev_half = half;
+    }
+    return 1;
+}
+
+/* The merge of canonical A (na) and B (nb) into out; returns the vertex count, or -1 if a
+   comparison or a rounded turn is not certified. */
+static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, double *out)
+{
+    int64_t k = 0, l = 0, n = 0;
+    int inexact = 0;
+    while (k < na || l < nb) {
+        const double *va = A + 2 * (k % na), *vb = B + 2 * (l % nb);
+        double sx = va[0] + vb[0], sy = va[1] + vb[1];
+        if (sx - va[0] != vb[0] || sx - vb[0] != va[0] || sy - va[1] != vb[1] || sy - vb[1] != va[1]) inexact = 1;
+        out[2 * n] = sx, out[2 * n + 1] = sy;
+        n++;
+        if (k == na) {
+            l++;
+            continue;
+        }
+        if (l == nb) {
+            k++;
+            continue;
+        }
+        const double *a1 = A + 2 * ((k + 1) % na), *b1 = B + 2 * ((l + 1) % nb);
+        int ha = lower(a1[0] - va[0], a1[1] - va[1]), hb = lower(b1[0] - vb[0], b1[1] - vb[1]);
+        int c = ha != hb ? (ha < hb ? 1 : -1) : cross_sign(va[0], va[1], a1[0], a1[1], vb[0], vb[1], b1[0], b1[1]);
+        if (c == M_UNDECIDED) return -1;
+        if (c >= 0) k++; /* a first (b turns CCW from a), or the same direction: fused */
+        if (c <= 0) l++;
+    }
+    if (inexact) { /* rounded: accepted only if every turn is certainly left */
+        for (int64_t v = 0; v < n; v++) {
+            const double *p = out + 2 * ((v + n - 1) % n), *q = out + 2 * v, *r = out + 2 * ((v + 1) % n);
+            if (cross_sign(r[0], r[1], p[0], p[1], r[0], r[1], q[0], q[1]) != 1) return -1;
+        }
+    }
+    return n;
+}
+
+/* pair_sums(a_xy, a_off, b_xy, b_off, out_xy, out_count) -> vertices written
+
+   a_xy, b_xy: float64 vertices (x y interleaved) of the pieces, piece i from a_off[i] to
+   a_off[i + 1]; out_xy: float64, room for the sum over pairs of |A_i| + |B_j| vertices;
+   out_count: int64, one per pair (i, j) in the order i * len(B) + j: the pair's vertex
+   count, its vertices following the previous pair's, or -1 (not certified: the caller
+   computes it). */
+PyObject *fast_pair_sums(PyObject *self, PyObject *args)
+{
+    PyObject *o[6];
+    if (!PyArg_ParseTuple(args, "OOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5])) return NULL;
+    Py_buffer b[6];
+    int got = 0;
+    Py_ssize_t written = -1;
+    for (; got < 6; got++) {
+        int flags = got >= 4 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
+        if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
+    }
+    const double *axy = b[0].buf, *bxy = b[2].buf;
+    const int64_t *aoff = b[1].buf, *boff = b[3].buf;
+    double *out = b[4].buf;
+    int64_t *count = b[5].buf;
+    Py_ssize_t nA = b[1].len / 8 - 1, nB = b[3].len / 8 - 1, cap = b[4].len / 16;
+    if (nA < 0 || nB < 0 || b[5].len != 8 * nA * nB || aoff[0] != 0 || boff[0] != 0
+        || 16 * aoff[nA] != b[0].len || 16 * boff[nB] != b[2].len) {
+        PyErr_SetString(PyExc_ValueError, "_fast.pair_sums: inconsistent array sizes");
+        goto done;
+    }
+    for (Py_ssize_t i = 0; i < nA; i++)
+        if (aoff[i + 1] < aoff[i]) goto bad_offsets;
+    for (Py_ssize_t j = 0; j < nB; j++)
+        if (boff[j + 1] < boff[j]) goto bad_offsets;
+    char *okb = PyMem_Malloc(nB ? nB : 1);
+    if (!okb) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t j = 0; j < nB; j++) okb[j] = (char)canonical(bxy + 2 * boff[j], boff[j + 1] - boff[j]);
+    Py_ssize_t n = 0;
+    for (Py_ssize_t i = 0; i < nA; i++) {
+        int64_t na = aoff[i + 1] - aoff[i];
+        int oka = canonical(axy + 2 * aoff[i], na);
+        for (Py_ssize_t j = 0; j < nB; j++) {
+            int64_t nb = boff[j + 1] - boff[j], got_n = -1;
+            if (oka && okb[j]) {
+                if (n + na + nb > cap) {
+                    PyMem_Free(okb);
+                    PyErr_SetString(PyExc_ValueError, "_fast.pair_sums: out_xy too small");
+                    goto done;
+                }
+                got_n = merge(axy + 2 * aoff[i], na, bxy + 2 * boff[j], nb, out + 2 * n);
+            }
+            count[i * nB + j] = got_n;
+            if (got_n > 0) n += got_n;
+        }
+    }
+    PyMem_Free(okb);
+    written = n;
+    goto done;
+bad_offsets:
+    PyErr_SetString(PyExc_ValueError, "_fast.pair_sums: offsets must not decrease");
+done:
+    for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
+    return written < 0 ? NULL : PyLong_FromSsize_t(written);
+}
