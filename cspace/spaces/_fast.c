@@ -682,6 +682,7 @@ done:
 }
 
 PyObject *fast_pair_sums(PyObject *self, PyObject *args); /* _merge.c */
+PyObject *fast_chords(PyObject *self, PyObject *args);    /* _chords.c */
 
 static PyMethodDef methods[] = {
     {"grid", py_grid, METH_VARARGS, "Copy a grid index and its packed pieces; returns a handle."},
@@ -695,6 +696,8 @@ static PyMethodDef methods[] = {
      "classify(...): the grid build's cell classification of boxes of cells (see cellclass.py)."},
     {"pair_sums", fast_pair_sums, METH_VARARGS,
      "pair_sums(a_xy, a_off, b_xy, b_off, out_xy, out_count): the C-space build's pair sums (see _merge.c)."},
+    {"chords", fast_chords, METH_VARARGS,
+     "chords(Q, sizes, long_edge, tolerance, out_R, out_n, out_sag): the grid build's chord polygons (_chords.c)."},
     {"se2", py_se2, METH_VARARGS, "Copy the SE(2) pose filter's data; returns a handle."},
     {"se2_pose", (PyCFunction)(void (*)(void))py_se2_pose, METH_FASTCALL,
      "se2_pose(handle, x, y, c, s): 1 free, 0 not free, -1 undecided (the exact test's float filter)."},

@@ -14,7 +14,7 @@ Pieces are classified together in padded (piece, cell, edge) blocks; boxes wider
 SCAN_COLUMNS cells row by row, where each edge's tests flip once along a row (found
 exactly by bisection on the same float expression, started from the column solved in
 reals). Pieces of more than MASK_EDGES edges go through their chord polygons
-(:func:`cspace.kernel.chords.chord_polygons`) and have their masks computed per cell on demand
+(:func:`cspace.kernel.chords.chord_polygons`, in C on the compiled path: the same doubles) and have their masks computed per cell on demand
 (:meth:`CellClassifier.edge_mask`).
 """
 from __future__ import annotations
@@ -181,7 +181,8 @@ class CellClassifier:
         wide = sizes > MASK_EDGES
         sag = None
         if wide.all():
-            Q, sizes, sag = chord_polygons(Q, sizes, self.cw + self.ch, 0.25 * min(self.cw, self.ch))
+            chords = fastpath.chord_polygons if fastpath.compiled() and self.compiled else chord_polygons
+            Q, sizes, sag = chords(Q, sizes, self.cw + self.ch, 0.25 * min(self.cw, self.ch))
             E = Q.shape[1]
         slot = np.arange(E)
         valid = slot[None, :] < sizes[:, None]

@@ -97,6 +97,24 @@ def pair_sums(pa: list, pb: list) -> list | None:
     return [out[e - c:e] if c > 0 else None for c, e in zip(count.tolist(), ends)]
 
 
+def chord_polygons(Q: np.ndarray, sizes: np.ndarray, long_edge: float, tolerance: float):
+    """:func:`cspace.kernel.chords.chord_polygons` by ``_fast.chords`` (cspace/spaces/_chords.c: the
+    same float operations, piece by piece), the same chord polygons, counts and sagittas.
+
+    >>> sq = np.array([[[0., 0], [1, 0], [1, 1], [0, 1]]])
+    >>> R, n, sag = chord_polygons(sq, np.array([4]), long_edge=0.5, tolerance=0.1)
+    >>> int(n[0]), sag[0].tolist()
+    (4, [0.0, 0.0, 0.0, 0.0])
+    """
+    Q = np.ascontiguousarray(Q, dtype=np.float64)
+    R = Q.copy()  # rows shorter than the longest keep their own vertices as padding
+    n = np.empty(len(Q), dtype=np.int64)
+    sag = np.empty(Q.shape[:2])
+    _fast.chords(Q, np.ascontiguousarray(sizes, dtype=np.int64), float(long_edge), float(tolerance), R, n, sag)
+    C = int(n.max()) if len(n) else 0
+    return R[:, :C], n, sag[:, :C]
+
+
 def segment_test(handle, pure, checks: dict):
     """The C-space's ``(ax, ay, bx, by) -> bool`` segment test: the compiled routine's
     certified answer when it has one, else ``pure`` (exact); ``pure`` itself on the pure

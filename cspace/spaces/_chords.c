@@ -1,0 +1,121 @@
+/* The compiled chord polygons of the grid build (part of cspace.spaces._fast).
+
+   chords(): cspace/kernel/chords.py's chord_polygons, piece by piece, with the same
+   float operations in the same order, so the same chord polygons and sagittas (the
+   numpy route refines all pieces together, but a piece whose chords all pass stops
+   changing, so refining each piece on its own until it passes gives the same result).
+   A piece's chord polygon starts from eight of its vertices and both ends of every
+   edge longer than long_edge (L1); while a chord's sagitta (the largest n . v - c over
+   the vertices of the arc it cuts off) exceeds the tolerance and the arc has more than
+   one edge, the arc's middle vertex is added. No decision here needs certifying: the
+   grid's classification uses the sagittas as the numpy route does.
+*/
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#if defined(__clang__)
+#pragma clang fp contract(off)
+#elif !defined(__GNUC__)
+#pragma STDC FP_CONTRACT OFF
+#endif /* GCC: -ffp-contract=off, from setup.py */
+
+/* One piece: q (s vertices), keep (s flags, the start set) -> out (n vertices), sag (n); returns n. */
+static int64_t chord_piece(const double *q, int64_t s, char *keep, double limit, int64_t *idx, double *out,
+                           double *sag)
+{
+    for (;;) {
+        int64_t n = 0;
+        for (int64_t v = 0; v < s; v++)
+            if (keep[v]) idx[n++] = v;
+        int added = 0;
+        for (int64_t c = 0; c < n; c++) {
+            int64_t a = idx[c], b = idx[c + 1 < n ? c + 1 : 0];
+            double dx = q[2 * b] - q[2 * a], dy = q[2 * b + 1] - q[2 * a + 1];
+            double h = hypot(dy, -dx);
+            double nx = dy / h, ny = -dx / h;
+            double cc = nx * q[2 * a] + ny * q[2 * a + 1];
+            /* the arc of chord c: its own vertex up to the next kept one (the last: to the end) */
+            int64_t stop = c + 1 < n ? b : s;
+            double m = -HUGE_VAL;
+            for (int64_t v = a; v < stop; v++) {
+                double r = nx * q[2 * v];
+                r += ny * q[2 * v + 1];
+                r -= cc;
+                m = (isnan(m) || isnan(r)) ? NAN : (r > m ? r : m); /* NaN propagates, as np.maximum */
+            }
+            sag[c] = isnan(m) ? m : (m > 0.0 ? m : 0.0);
+            int64_t span = ((b - a) % s + s) % s;
+            if (sag[c] > limit && span > 1) {
+                keep[(a + span / 2) % s] = 1;
+                added = 1;
+            }
+        }
+        if (!added) {
+            for (int64_t c = 0; c < n; c++) out[2 * c] = q[2 * idx[c]], out[2 * c + 1] = q[2 * idx[c] + 1];
+            return n;
+        }
+    }
+}
+
+/* chords(Q, sizes, long_edge, tolerance, out_R, out_n, out_sag) -> None
+
+   Q: float64 K x E x 2 padded vertices; sizes: int64 K; out_R: float64 K x E x 2 (row k's
+   first out_n[k] vertices are its chord polygon, the rest is left as it was); out_n:
+   int64 K; out_sag: float64 K x E (row k's first out_n[k] entries; the rest set to 0). */
+PyObject *fast_chords(PyObject *self, PyObject *args)
+{
+    PyObject *o[5];
+    double long_edge, limit;
+    if (!PyArg_ParseTuple(args, "OOddOOO", &o[0], &o[1], &long_edge, &limit, &o[2], &o[3], &o[4])) return NULL;
+    Py_buffer b[5];
+    int got = 0, ok = 0;
+    char *keep = NULL;
+    int64_t *idx = NULL;
+    for (; got < 5; got++) {
+        int flags = got >= 2 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
+        if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
+    }
+    const double *Q = b[0].buf;
+    const int64_t *sizes = b[1].buf;
+    double *R = b[2].buf, *sag = b[4].buf;
+    int64_t *nout = b[3].buf;
+    Py_ssize_t K = b[1].len / 8, E = K ? b[0].len / 16 / K : 0;
+    if (b[0].len != 16 * K * E || b[2].len != b[0].len || b[3].len != 8 * K || b[4].len != 8 * K * E) {
+        PyErr_SetString(PyExc_ValueError, "_fast.chords: inconsistent array sizes");
+        goto done;
+    }
+    keep = PyMem_Malloc(E ? E : 1);
+    idx = PyMem_Malloc(8 * (E ? E : 1));
+    if (!keep || !idx) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t k = 0; k < K; k++) {
+        int64_t s = sizes[k];
+        const double *q = Q + 2 * k * E;
+        if (s < 1 || s > E) {
+            PyErr_SetString(PyExc_ValueError, "_fast.chords: a size out of range");
+            goto done;
+        }
+        int64_t step = s / 8 > 1 ? s / 8 : 1;
+        for (int64_t v = 0; v < s; v++) { /* the start set: eight vertices, both ends of long edges */
+            int64_t w = v + 1 < s ? v + 1 : 0, u = (v + s - 1) % s, u1 = v;
+            int lv = fabs(q[2 * w] - q[2 * v]) + fabs(q[2 * w + 1] - q[2 * v + 1]) > long_edge;
+            int lu = fabs(q[2 * u1] - q[2 * u]) + fabs(q[2 * u1 + 1] - q[2 * u + 1]) > long_edge;
+            keep[v] = (char)(lv || lu || v % step == 0);
+        }
+        double *sg = sag + k * E;
+        for (Py_ssize_t c = 0; c < E; c++) sg[c] = 0.0;
+        nout[k] = chord_piece(q, s, keep, limit, idx, R + 2 * k * E, sg);
+    }
+    ok = 1;
+done:
+    PyMem_Free(keep);
+    PyMem_Free(idx);
+    for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
+    if (!ok) return NULL;
+    Py_RETURN_NONE;
+}
