@@ -46,6 +46,20 @@ def test_compiled_pair_sums_equal_minkowski_sum(lists, scale):
 
 
 @compiled
+def test_rounded_sums_that_need_their_hull():
+    """A box robot with a margin, summed with boxes (theta.toml's pairs): the robot ⊕ margin's
+    bottom edge is off the horizontal by rounding, so a rounded sum vertex falls exactly on
+    the line of its neighbours (76 merged vertices, 75 in the hull). The C merge certifies
+    that turn (an exact zero) and repairs the ring with the exact hull, as minkowski_sum
+    does; the same arrays."""
+    rect = np.array([[-1.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-1.5, 0.2]])
+    robot = [reflect(p) for p in inflated_pieces([rect], margin_shapes(0.12))]
+    boxes = [np.array([[5.0, 0.0], [7.0, 0.0], [7.0, 5.4], [5.0, 5.4]]), np.array([[0.1, 0.3], [3.3, 0.3], [3.3, 0.7], [0.1, 0.7]])]
+    assert check(boxes, robot, min_certified=1.0) == 2
+    assert [len(minkowski_sum(b, robot[0])) for b in boxes] == [75, 75]
+
+
+@compiled
 def test_degenerate_non_canonical_and_non_finite_pieces_are_left_to_the_pure_path():
     seg = np.array([[0.0, 0.0], [1.0, 1.0]])
     cw = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]])
@@ -97,3 +111,9 @@ def test_bundled_builds_equal_the_pure_path(path):
         assert len(fast.pieces) == len(pure.pieces)
         assert all(np.array_equal(a, b) for a, b in zip(fast.pieces, pure.pieces))
         assert fast.piece_pairs == pure.piece_pairs
+        # ... and the C route carried every pair: its rounded sums are certified, or their
+        # exact hull is (theta.toml's robot is turned off the axes by rounding: its sums with
+        # the boxes have exactly collinear rounded vertices, repaired in C).
+        if fast.robot_pieces or fast.margin:
+            neg = [reflect(r) for r in inflated_pieces(fast.robot_pieces, fast.margin)]
+            assert all(g is not None for g in fastpath.pair_sums(fast.obstacle_pieces, neg))

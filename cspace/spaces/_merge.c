@@ -15,7 +15,9 @@
      when a factor of each product is an exact zero, or all six operations of the
      cross product exact (TwoSum, Dekker's TwoProduct), as error_free_cross_sign;
    - its sums were exact (Fast2Sum test), or its rounded output turns left at every
-     vertex by a certified sign.
+     vertex by a certified sign, or every such turn is certified and the exact hull of
+     the rounded vertices (the repair minkowski_sum makes: Andrew's monotone chain) is
+     found with certified turns.
    Any other pair gets count -1 and the caller computes it with minkowski_sum (the
    pure path, exact, equal array for array). So both paths give the same arrays.
 */
@@ -23,6 +25,8 @@
 #include <Python.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
 
 #if defined(__clang__)
 #pragma clang fp contract(off)
@@ -99,8 +103,72 @@ static int canonical(const double *p, int64_t n)
     return 1;
 }
 
+static int lex_less(const double *p, const double *q)
+{
+    return p[0] < q[0] || (p[0] == q[0] && p[1] < q[1]);
+}
+
+static int lex_cmp(const void *a, const void *b)
+{
+    const double *p = a, *q = b;
+    return lex_less(p, q) ? -1 : (lex_less(q, p) ? 1 : 0);
+}
+
+/* One monotone chain over the sorted points pts (n), appended to out (len *m): only strict
+   left turns kept (certified); 0 if a turn is not certified. */
+static int chain(const double *pts, int64_t n, int64_t step, double *out, int64_t *m)
+{
+    int64_t len = 0;
+    for (int64_t t = 0; t < n; t++) {
+        const double *p = pts + 2 * (step > 0 ? t : n - 1 - t);
+        while (len >= 2) {
+            const double *a = out + 2 * (len - 2), *b = out + 2 * (len - 1);
+            int s = cross_sign(p[0], p[1], a[0], a[1], p[0], p[1], b[0], b[1]); /* orient2d(a, b, p) */
+            if (s == M_UNDECIDED) return 0;
+            if (s > 0) break;
+            len--;
+        }
+        out[2 * len] = p[0], out[2 * len + 1] = p[1];
+        len++;
+    }
+    *m = len;
+    return 1;
+}
+
+/* The exact convex hull of the n points in out, in place, CCW from the lowest (then leftmost)
+   vertex, as cspace.kernel.hull.convex_hull gives it; -1 if a turn is not certified, the
+   hull is degenerate, or a coordinate is -0.0 (Python's dedup could keep either zero). */
+static int64_t hull_in_place(double *out, int64_t n)
+{
+    for (int64_t v = 0; v < 2 * n; v++)
+        if (out[v] == 0.0 && signbit(out[v])) return -1;
+    double *pts = PyMem_Malloc(sizeof(double) * 2 * (3 * n + 2));
+    if (!pts) return -1;
+    memcpy(pts, out, sizeof(double) * 2 * n);
+    qsort(pts, (size_t)n, 2 * sizeof(double), lex_cmp);
+    int64_t u = 0; /* sorted and without repeats */
+    for (int64_t t = 0; t < n; t++)
+        if (u == 0 || pts[2 * t] != pts[2 * (u - 1)] || pts[2 * t + 1] != pts[2 * (u - 1) + 1])
+            pts[2 * u] = pts[2 * t], pts[2 * u + 1] = pts[2 * t + 1], u++;
+    double *lower = pts + 2 * n, *upper = pts + 4 * n + 2;
+    int64_t nl = 0, nu = 0, h = -1;
+    if (u >= 3 && chain(pts, u, 1, lower, &nl) && chain(pts, u, -1, upper, &nu) && nl + nu - 2 >= 3) {
+        h = 0;
+        for (int64_t t = 0; t < nl - 1; t++) out[2 * h] = lower[2 * t], out[2 * h + 1] = lower[2 * t + 1], h++;
+        for (int64_t t = 0; t < nu - 1; t++) out[2 * h] = upper[2 * t], out[2 * h + 1] = upper[2 * t + 1], h++;
+        int64_t lo = 0; /* lowest, then leftmost, first */
+        for (int64_t t = 1; t < h; t++)
+            if (out[2 * t + 1] < out[2 * lo + 1] || (out[2 * t + 1] == out[2 * lo + 1] && out[2 * t] < out[2 * lo])) lo = t;
+        for (int64_t t = 0; t < h; t++) pts[2 * t] = out[2 * ((lo + t) % h)], pts[2 * t + 1] = out[2 * ((lo + t) % h) + 1];
+        memcpy(out, pts, sizeof(double) * 2 * h);
+    }
+    PyMem_Free(pts);
+    return h;
+}
+
 /* The merge of canonical A (na) and B (nb) into out; returns the vertex count, or -1 if a
-   comparison or a rounded turn is not certified. */
+   comparison or a rounded turn is not certified. Rounded vertices that do not turn left
+   everywhere are replaced by their exact hull (minkowski_sum's repair). */
 static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, double *out)
 {
     int64_t k = 0, l = 0, n = 0;
@@ -126,11 +194,15 @@ static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, d
         if (c >= 0) k++; /* a first (b turns CCW from a), or the same direction: fused */
         if (c <= 0) l++;
     }
-    if (inexact) { /* rounded: accepted only if every turn is certainly left */
+    if (inexact) { /* rounded: accepted if every turn is certainly left, else the exact hull */
+        int repair = 0;
         for (int64_t v = 0; v < n; v++) {
             const double *p = out + 2 * ((v + n - 1) % n), *q = out + 2 * v, *r = out + 2 * ((v + 1) % n);
-            if (cross_sign(r[0], r[1], p[0], p[1], r[0], r[1], q[0], q[1]) != 1) return -1;
+            int s = cross_sign(r[0], r[1], p[0], p[1], r[0], r[1], q[0], q[1]);
+            if (s == M_UNDECIDED) return -1;
+            repair |= s != 1;
         }
+        if (repair) return hull_in_place(out, n);
     }
     return n;
 }
