@@ -117,3 +117,20 @@ def test_bundled_builds_equal_the_pure_path(path):
         if fast.robot_pieces or fast.margin:
             neg = [reflect(r) for r in inflated_pieces(fast.robot_pieces, fast.margin)]
             assert all(g is not None for g in fastpath.pair_sums(fast.obstacle_pieces, neg))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_inflated_equals_inflated_pieces(seed):
+    """The build's inflated robot pieces (pair sums, compiled when built) equal the kernel's
+    k-way merges, array for array: one margin operand, two, none; a point robot."""
+    from cspace.kernel.hull import convex_hull
+    from cspace.spaces.cspace_build import inflated
+
+    rng = np.random.default_rng(seed)
+    robot = [convex_hull(rng.normal(0, 1, (int(rng.integers(3, 9)), 2))) for _ in range(3)]
+    aniso = [[-1.0, -0.3], [2.0, -0.3], [2.0, 0.4], [-1.0, 0.4]]
+    for margin in (margin_shapes(float(rng.uniform(0.01, 1))), margin_shapes(0.0, aniso),
+                   margin_shapes(0.3, aniso), []):
+        for rob in (robot, []):
+            got, want = inflated(rob, margin), inflated_pieces(rob, margin)
+            assert len(got) == len(want) and all(np.array_equal(a, b) for a, b in zip(got, want))

@@ -35,7 +35,8 @@ from ..kernel.polygon import piece_boxes
 from ..io.scenario import load_scenario
 from ..io.schema import Scenario
 # decompose_obstacles and decompose_robot are public here too (``cspace`` lists them).
-from .cspace_build import Stage, _check_range, _contained_pieces, decompose_obstacles, decompose_robot, pair_sums
+from .cspace_build import (Stage, _check_range, _contained_pieces, decompose_obstacles, decompose_robot, inflated,
+                           pair_sums)
 from .cspace_points import PointQueries
 from .cspace_segments import SegmentQueries
 
@@ -168,10 +169,9 @@ class CSpace(PointQueries, SegmentQueries):
             n = len(self.obstacle_pieces)
             self._raw_pairs = [(i, -1) for i in range(n)]
             return list(self.obstacle_pieces), self.obstacle_of
-        from ..kernel.margin import inflated_pieces
         from ..kernel.minkowski import reflect
 
-        neg = [reflect(r) for r in inflated_pieces(self.robot_pieces, self.margin)]
+        neg = [reflect(r) for r in inflated(self.robot_pieces, self.margin)]
         out = pair_sums(self.obstacle_pieces, neg)
         nr = len(neg)
         owner = np.repeat(np.asarray(self.obstacle_of, dtype=np.int64), nr)

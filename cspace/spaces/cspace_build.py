@@ -201,3 +201,19 @@ def pair_sums(obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray])
         if out[k] is None:
             out[k] = minkowski_sum(obstacle_pieces[k // nr], robot_pieces[k % nr])
     return out
+
+
+def inflated(robot_pieces: list[np.ndarray], margin: list[np.ndarray]) -> list[np.ndarray]:
+    """:func:`cspace.kernel.margin.inflated_pieces`, equal array for array: with one margin
+    operand (a clearance's disk polygon, or a ``[margin]`` polygon alone) each robot piece's
+    sum is a pair sum, so :func:`pair_sums` computes them (in C on the compiled path).
+
+    >>> sq = np.array([[-1., -1], [1, -1], [1, 1], [-1, 1]])
+    >>> inflated([sq], [sq])[0].tolist()
+    [[-2.0, -2.0], [2.0, -2.0], [2.0, 2.0], [-2.0, 2.0]]
+    """
+    from ..kernel.margin import inflated_pieces
+
+    if len(margin) == 1 and robot_pieces:
+        return pair_sums([np.asarray(r, dtype=np.float64) for r in robot_pieces], [np.asarray(margin[0], dtype=np.float64)])
+    return inflated_pieces(robot_pieces, margin)

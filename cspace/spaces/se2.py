@@ -32,7 +32,7 @@ import numpy as np
 from . import fastpath
 from .broadphase import GridIndex
 from .cspace import CSpace
-from .cspace_build import _check_range, decompose_obstacles, decompose_robot
+from .cspace_build import _check_range, decompose_obstacles, decompose_robot, inflated
 from ..kernel.minkowski import minkowski_sum, reflect
 from ..kernel.polygon import point_in_convex
 from ..io.scenario import load_scenario
@@ -75,9 +75,7 @@ class SE2CSpace(SE2Motions, CarMotions):
         self.margin = [np.asarray(m, dtype=np.float64) for m in (margin or [])]
         self.body_pieces = self.robot_pieces  # the robot itself, for clearance measures
         if self.margin:
-            from ..kernel.margin import inflated_pieces
-
-            self.robot_pieces = inflated_pieces(self.robot_pieces, self.margin)
+            self.robot_pieces = inflated(self.robot_pieces, self.margin)
         self.grid_cells = grid_cells
         xmin, xmax, ymin, ymax = self.bounds
         self.extent = max(xmax - xmin, ymax - ymin)
