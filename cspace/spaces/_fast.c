@@ -681,7 +681,8 @@ done:
     return count < 0 ? NULL : PyLong_FromSsize_t(count);
 }
 
-PyObject *fast_pair_sums(PyObject *self, PyObject *args); /* _merge.c */
+PyObject *fast_pair_sums(PyObject *self, PyObject *args); /* _build.c */
+PyObject *fast_contained(PyObject *self, PyObject *args); /* _build.c */
 PyObject *fast_chords(PyObject *self, PyObject *args);    /* _chords.c */
 
 static PyMethodDef methods[] = {
@@ -695,7 +696,9 @@ static PyMethodDef methods[] = {
     {"classify", py_classify, METH_VARARGS,
      "classify(...): the grid build's cell classification of boxes of cells (see cellclass.py)."},
     {"pair_sums", fast_pair_sums, METH_VARARGS,
-     "pair_sums(a_xy, a_off, b_xy, b_off, out_xy, out_count): the C-space build's pair sums (see _merge.c)."},
+     "pair_sums(a_xy, a_off, b_xy, b_off, out_xy, out_count): the C-space build's pair sums (see _build.c)."},
+    {"contained", fast_contained, METH_VARARGS,
+     "contained(xy, off, qs, ps, out): the prune's containment test of candidate pairs (_build.c)."},
     {"chords", fast_chords, METH_VARARGS,
      "chords(Q, sizes, long_edge, tolerance, out_R, out_n, out_sag): the grid build's chord polygons (_chords.c)."},
     {"se2", py_se2, METH_VARARGS, "Copy the SE(2) pose filter's data; returns a handle."},

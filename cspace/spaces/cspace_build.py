@@ -140,19 +140,27 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
     by = np.lexsort((rank[ps], qs))
     qs, ps = qs[by], ps[by]
     cut = np.flatnonzero(np.diff(qs)) + 1
+    from . import fastpath
+
+    # Compiled: every candidate's answer at once (-1 where not certified: the exact test below).
+    known = fastpath.contained(pieces, qs, ps) if len(qs) else None
+    known = known.tolist() if known is not None else [-1] * len(qs)
+    t = 0
     for q, cand in zip(qs[np.r_[0, cut]].tolist() if len(qs) else [], np.split(ps, cut) if len(qs) else []):
+        t0, t = t, t + len(cand)
         if q in removed:
             continue
         Q = pieces[q]
         s, e = Q, np.roll(Q, -1, axis=0)
-        for p in cand.tolist():
+        for p, answer in zip(cand.tolist(), known[t0:t]):
             if p in removed:
                 continue
             P = pieces[p]
             if P.shape == Q.shape and p < q and np.array_equal(P, Q):
                 continue  # identical: keep the earlier one, drop q when it is visited as p
-            sides = orient2d_many(s[None, :, :], e[None, :, :], P[:, None, :])
-            if (sides >= 0).all():
+            if answer < 0:
+                answer = (orient2d_many(s[None, :, :], e[None, :, :], P[:, None, :]) >= 0).all()
+            if answer:
                 removed[p] = q
     return removed
 

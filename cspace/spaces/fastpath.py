@@ -72,7 +72,7 @@ def classify_boxes(*args) -> int:
 
 
 def pair_sums(pa: list, pb: list) -> list | None:
-    """``[minkowski_sum(a, b) for a in pa for b in pb]`` by ``_fast.pair_sums`` (cspace/spaces/_merge.c:
+    """``[minkowski_sum(a, b) for a in pa for b in pb]`` by ``_fast.pair_sums`` (cspace/spaces/_build.c:
     one certified angular merge per pair), None for each pair it cannot certify (the
     caller computes those on the pure path); None on the pure path.
 
@@ -95,6 +95,26 @@ def pair_sums(pa: list, pb: list) -> list | None:
     _fast.pair_sums(a_xy, a_off, b_xy, b_off, out, count)
     ends = np.cumsum(np.maximum(count, 0)).tolist()
     return [out[e - c:e] if c > 0 else None for c, e in zip(count.tolist(), ends)]
+
+
+def contained(pieces: list, qs: np.ndarray, ps: np.ndarray) -> np.ndarray | None:
+    """Per candidate pair (q, p): is piece p inside convex piece q? ``_fast.contained``
+    (cspace/spaces/_build.c): 1 yes, 0 no, -1 not certified (the caller decides); None on
+    the pure path.
+
+    >>> sq, small = np.array([[0., 0], [4, 0], [4, 4], [0, 4]]), np.array([[1., 1], [2, 1], [1, 2]])
+    >>> r = contained([sq, small], np.array([0, 1]), np.array([1, 0]))
+    >>> r is None or r.tolist() == [1, 0]
+    True
+    """
+    if _fast is None:
+        return None
+    off = np.zeros(len(pieces) + 1, dtype=np.int64)
+    np.cumsum([len(p) for p in pieces], out=off[1:])
+    xy = np.ascontiguousarray(np.concatenate(pieces) if pieces else np.zeros((0, 2)), dtype=np.float64)
+    out = np.empty(len(qs), dtype=np.int8)
+    _fast.contained(xy, off, np.ascontiguousarray(qs, dtype=np.int64), np.ascontiguousarray(ps, dtype=np.int64), out)
+    return out
 
 
 def chord_polygons(Q: np.ndarray, sizes: np.ndarray, long_edge: float, tolerance: float):

@@ -1,4 +1,9 @@
-/* The compiled fast path of the C-space build's pair sums (part of cspace.spaces._fast).
+/* The compiled fast path of the C-space build (part of cspace.spaces._fast): its pair sums
+   and the prune's containment test.
+
+   contained(): for candidate pairs (q, p) of convex pieces, is P inside Q? (every vertex
+   of P on or left of every edge of Q, cspace_build._contained_pieces's test): 1 yes,
+   0 no (a vertex certainly right of an edge), -1 not certified (the caller decides).
 
    pair_sums(): every Minkowski sum A_i ⊕ B_j of two lists of convex pieces, as
    cspace/kernel/pairsums.py computes it, one angular merge per pair, O(|A_i| + |B_j|).
@@ -271,4 +276,63 @@ bad_offsets:
 done:
     for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
     return written < 0 ? NULL : PyLong_FromSsize_t(written);
+}
+
+/* contained(xy, off, qs, ps, out) -> None
+
+   xy: float64 vertices of the pieces (x y interleaved), piece k from off[k] to off[k + 1];
+   qs, ps: int64 candidate pairs; out: int8, per pair 1 (P inside Q), 0 (not), -1 (not
+   certified). Signs are orient2d(s, e, v) = (s - v) x (e - v) for each edge s -> e of Q
+   and vertex v of P, certified as in cross_sign. */
+PyObject *fast_contained(PyObject *self, PyObject *args)
+{
+    PyObject *o[5];
+    if (!PyArg_ParseTuple(args, "OOOOO", &o[0], &o[1], &o[2], &o[3], &o[4])) return NULL;
+    Py_buffer b[5];
+    int got = 0, ok = 0;
+    for (; got < 5; got++) {
+        int flags = got == 4 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
+        if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
+    }
+    const double *xy = b[0].buf;
+    const int64_t *off = b[1].buf, *qs = b[2].buf, *ps = b[3].buf;
+    int8_t *out = b[4].buf;
+    Py_ssize_t n = b[1].len / 8 - 1, m = b[2].len / 8;
+    if (n < 0 || b[3].len != 8 * m || b[4].len != m || off[0] != 0 || 16 * off[n] != b[0].len) {
+        PyErr_SetString(PyExc_ValueError, "_fast.contained: inconsistent array sizes");
+        goto done;
+    }
+    for (Py_ssize_t k = 0; k < n; k++)
+        if (off[k + 1] < off[k]) {
+            PyErr_SetString(PyExc_ValueError, "_fast.contained: offsets must not decrease");
+            goto done;
+        }
+    for (Py_ssize_t t = 0; t < m; t++) {
+        if (qs[t] < 0 || qs[t] >= n || ps[t] < 0 || ps[t] >= n) {
+            PyErr_SetString(PyExc_ValueError, "_fast.contained: a piece index out of range");
+            goto done;
+        }
+        const double *Q = xy + 2 * off[qs[t]], *P = xy + 2 * off[ps[t]];
+        int64_t nq = off[qs[t] + 1] - off[qs[t]], np_ = off[ps[t] + 1] - off[ps[t]];
+        int answer = 1;
+        for (int64_t v = 0; v < np_ && answer != 0; v++) {
+            double vx = P[2 * v], vy = P[2 * v + 1];
+            for (int64_t i = 0; i < nq; i++) {
+                const double *s = Q + 2 * i, *e = Q + 2 * (i + 1 < nq ? i + 1 : 0);
+                int sg = cross_sign(vx, vy, s[0], s[1], vx, vy, e[0], e[1]);
+                if (sg == M_UNDECIDED) {
+                    answer = -1;
+                } else if (sg < 0) {
+                    answer = 0;
+                    break;
+                }
+            }
+        }
+        out[t] = (int8_t)answer;
+    }
+    ok = 1;
+done:
+    for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
+    if (!ok) return NULL;
+    Py_RETURN_NONE;
 }
