@@ -1,4 +1,4 @@
-"""Build hook for the optional compiled fast path (cspace/spaces/_fast.c, _build.c, _chords.c); everything else is in pyproject.toml.
+"""Build hook for the optional compiled fast path (cspace/spaces/_fast.c, _build.c, _chords.c, _gjk.c); everything else is in pyproject.toml.
 
 ``optional=True``: on a machine without a C compiler (or where the build fails) the
 install goes on and cspace runs its pure-Python path, with the same answers.
@@ -9,4 +9,4 @@ from setuptools import Extension, setup
 
 # Each product rounded once, as the float filter's error bound assumes: no FMA contraction.
 args = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off"]
-setup(ext_modules=[Extension("cspace.spaces._fast", ["cspace/spaces/_fast.c", "cspace/spaces/_build.c", "cspace/spaces/_chords.c"], optional=True, extra_compile_args=args)])
+setup(ext_modules=[Extension("cspace.spaces._fast", ["cspace/spaces/_fast.c", "cspace/spaces/_build.c", "cspace/spaces/_chords.c", "cspace/spaces/_gjk.c"], optional=True, extra_compile_args=args)])

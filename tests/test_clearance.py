@@ -451,7 +451,7 @@ def test_tighter_bounds_change_nothing_but_the_work(seed, monkeypatch):
         path = np.vstack([path[:3], o, path[-2:]])
     calls = []
     real = cl.gjk_distance
-    monkeypatch.setattr(cl, "gjk_distance", lambda *x: calls.append(1) or real(*x))
+    monkeypatch.setattr(cl, "gjk_distance", lambda *x, **k: calls.append(1) or real(*x, **k))
     fast = cl.path_clearance(path, robot, obstacles)
     n_fast = len(calls)
     monkeypatch.setattr(cl, "_tighter_bounds", lambda lbs, *rest: lbs)
@@ -481,7 +481,7 @@ def test_tighter_bounds_prune_a_margin_path():
     cs = CSpace.from_scenario(sc)
     calls = []
     real = cl.gjk_distance
-    cl_gjk = lambda *x: calls.append(1) or real(*x)  # noqa: E731
+    cl_gjk = lambda *x, **k: calls.append(1) or real(*x, **k)  # noqa: E731
     mp = pytest.MonkeyPatch()
     mp.setattr(cl, "gjk_distance", cl_gjk)
     try:

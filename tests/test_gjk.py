@@ -110,7 +110,7 @@ def test_degenerate_corpus_never_nan():
 
 
 def test_relation_skips_hull_only_for_strictly_convex_ccw_input():
-    from cspace.kernel.gjk import _as_hull
+    from cspace.kernel.gjk_exact import _as_hull
 
     t = np.arange(5) * 2 * np.pi / 5
     pent = np.round(np.c_[np.cos(t), np.sin(t)] * 1000)

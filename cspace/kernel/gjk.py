@@ -18,19 +18,23 @@ Robustness, per the known failure modes of published GJK code:
   no 0/0, no NaN;
 - where the float distance is within its error bound of zero, the relation
   (separated / touching / overlapping) is decided exactly: the separating axis test
-  over the sets' hull edges in rational arithmetic.
+  over the sets' hull edges in rational arithmetic (:mod:`cspace.kernel.gjk_exact`,
+  whose :func:`exact_relation` is re-exported here).
+
+The loop has an optional compiled twin (``gjk`` in cspace/spaces/_fast.c, injected as
+``gjk_distance(..., loop=)``) doing the same float operations in the same order: the
+same answers, bit for bit; the pure loop is its fallback and oracle.
 """
 from __future__ import annotations
 
 import math
-from fractions import Fraction
 from itertools import chain
 from typing import NamedTuple
 
 import numpy as np
 
+from .gjk_exact import _contact_relation, _exact_distance, exact_relation  # noqa: F401  (re-exported)
 from .polygon import as_array
-from .predicates import orient2d_cols, orient2d_xy
 from .scaling import SAFE_MAX, SAFE_MIN, scaled_copies
 
 MAX_ITERATIONS = 64
@@ -50,11 +54,15 @@ class Distance(NamedTuple):
     status: str
 
 
-def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
+def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS, *, loop=None) -> Distance:
     """Distance and closest points of convex sets A and B (vertex arrays; points and segments too).
 
     ``max_iterations`` caps the loop (the default is never reached on separated or
-    overlapping pairs; a capped answer is an upper bound on the distance).
+    overlapping pairs; a capped answer is an upper bound on the distance). ``loop``: a
+    compiled GJK loop (:func:`cspace.spaces.fastpath.gjk_loop`), called as ``loop(a, b,
+    max_iterations)`` on the float64 vertex arrays; it returns :func:`_loop`'s result on
+    the local frame, bit for bit, plus the frame's extent, or None (a coordinate not
+    finite). Pairs it cannot take, and ``loop=None``, run the pure loop: same answers.
 
     >>> d = gjk_distance([[0, 0], [1, 0], [1, 1], [0, 1]], [[3, 0], [4, 0], [4, 1], [3, 1]])
     >>> d.distance, d.status
@@ -62,26 +70,33 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
     >>> gjk_distance([[0, 0], [1, 0], [1, 1], [0, 1]], [[1, 0], [2, 0], [2, 1], [1, 1]]).status
     'touching'
     """
-    a = as_array(A, nonempty=True)
-    b = as_array(B, nonempty=True)
-    origin = a[0].copy()
-    ox, oy = origin.tolist()
+    a = as_array(A, copy=False, nonempty=True)  # only read: no copy
+    b = as_array(B, copy=False, nonempty=True)
+    ox, oy = a[0].tolist()
+    if loop is not None and (raw := loop(a, b, max_iterations)) is not None and SAFE_MIN <= raw[7] < SAFE_MAX:
+        return _answer(a, b, ox, oy, raw[7], _outcome(*raw))
     if len(a) + len(b) <= 80:  # Python floats (an overflow is inf, silently): cheaper when small
         al = [(x - ox, y - oy) for x, y in a.tolist()]
         bl = [(x - ox, y - oy) for x, y in b.tolist()]
         extent = _scale(al, bl)
     else:
         with np.errstate(over="ignore", invalid="ignore"):
-            la, lb = a - origin, b - origin
+            la, lb = a - a[0], b - a[0]
             extent = max(float(np.abs(la).max()), float(np.abs(lb).max())) or 1.0  # as _scale
         al, bl = la.tolist(), lb.tolist()
     if not SAFE_MIN <= extent < SAFE_MAX and (rescaled := scaled_copies([a, b], extent)):
         k, (sa, sb) = rescaled  # products would under- or overflow: the same sets at 2^k scale
-        d = gjk_distance(sa, sb, max_iterations)
+        d = gjk_distance(sa, sb, max_iterations, loop=loop)
         with np.errstate(over="ignore"):  # a distance beyond the double range is inf
             return Distance(float(np.ldexp(d.distance, -k)), np.ldexp(d.point_a, -k), np.ldexp(d.point_b, -k),
                             d.iterations, d.status)
-    dist, pa, pb, it, inside, simplex = _gjk(al, bl, max_iterations)
+    return _answer(a, b, ox, oy, extent, _gjk(al, bl, max_iterations))
+
+
+def _answer(a: np.ndarray, b: np.ndarray, ox: float, oy: float, extent: float, result) -> Distance:
+    """The Distance from :func:`_gjk`'s result (local frame, origin (ox, oy) = a[0]): the
+    exact relation where the float distance is within its error band of zero."""
+    dist, pa, pb, it, inside, simplex = result
     if inside == "deep":
         p = np.array((pa[0] + ox, pa[1] + oy))
         return Distance(0.0, p, p.copy(), it, "overlapping")
@@ -91,7 +106,7 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS) -> Distance:
             p = np.array((pa[0] + ox, pa[1] + oy))
             return Distance(0.0, p, p.copy(), it, status)
         if inside:  # float said overlap but exact says apart: a sliver gap, measure it exactly
-            dist, pa, pb = _exact_distance(a, b, origin)
+            dist, pa, pb = _exact_distance(a, b, a[0])
     return Distance(float(dist), np.array((pa[0] + ox, pa[1] + oy)), np.array((pb[0] + ox, pb[1] + oy)),
                     it, "separated")
 
@@ -122,10 +137,15 @@ def _support(pts: list, dx: float, dy: float) -> int:
 
 
 def _gjk(al: list, bl: list, max_iterations: int = MAX_ITERATIONS):
-    """The GJK loop in the local frame.
+    """GJK in the local frame: (distance, pa, pb, iterations, origin_inside, simplex); the
+    simplex's vertices carry the indices (ia, ib) of the supporting vertices of A and B."""
+    raw = _loop(al, bl, max_iterations)
+    return _outcome(*raw, _scale(al, bl) if raw[5] else 1.0)
 
-    Returns (distance, pa, pb, iterations, origin_inside, simplex); the simplex's
-    vertices carry the indices (ia, ib) of the supporting vertices of A and B."""
+
+def _loop(al: list, bl: list, max_iterations: int):
+    """The GJK loop (compiled as ``gjk`` in cspace/spaces/_fast.c, operation for operation):
+    (pax, pay, pbx, pby, iterations, origin_inside, simplex), the closest points of A and B."""
     # Simplex vertices: (ia, ib, wx, wy) with w = a[ia] - b[ib]; weights lam.
     simplex = [(0, 0, al[0][0] - bl[0][0], al[0][1] - bl[0][1])]
     lam = [1.0]
@@ -154,9 +174,14 @@ def _gjk(al: list, bl: list, max_iterations: int = MAX_ITERATIONS):
     # Closest points: the same weights on the simplex's vertices of A and of B.
     pax, pay = _combine(lam, [al[s[0]] for s in simplex], 0, 1)
     pbx, pby = _combine(lam, [bl[s[1]] for s in simplex], 0, 1)
+    return pax, pay, pbx, pby, it, inside, simplex
+
+
+def _outcome(pax: float, pay: float, pbx: float, pby: float, it: int, inside: bool, simplex, extent: float):
+    """:func:`_gjk`'s result from the loop's (pure or compiled); ``extent`` as :func:`_scale`."""
     if inside:
         # Certain overlap when the origin is deep inside the simplex (beyond any rounding).
-        deep = len(simplex) == 3 and _depth_in_triangle(simplex) > EXACT_BAND * _scale(al, bl)
+        deep = len(simplex) == 3 and _depth_in_triangle(simplex) > EXACT_BAND * extent
         return 0.0, (pax, pay), (pax, pay), it, "deep" if deep else True, simplex
     return math.hypot(pax - pbx, pay - pby), (pax, pay), (pbx, pby), it, False, simplex
 
@@ -252,196 +277,6 @@ def _depth_in_triangle(simplex: list) -> float:
     return best
 
 
-def _contact_relation(A: list, B: list, simplex: list) -> str | None:
-    """The exact relation proved by one line near GJK's contact, or None if none is found.
-
-    Candidates are the lines of the edges at the supporting vertices of GJK's final
-    simplex. A line L weakly separates when A lies on one closed side and B on the
-    other (exact signs). Then A and B meet iff their traces on L overlap; the traces
-    are the vertices exactly on L, ordered along L by their (x, y) order, so the
-    overlap test is exact too. For touching convex polygons such a line always exists
-    along an edge at a contact vertex; when none is found the caller runs the full
-    separating-axis test.
-    """
-    lines = set()
-    for P, idx in ((A, {s[0] for s in simplex}), (B, {s[1] for s in simplex})):
-        n = len(P)
-        if n < 2:
-            continue
-        for i in idx:
-            for j in ((i - 1) % n, (i + 1) % n):
-                p, q = P[i], P[j]
-                if p != q:
-                    lines.add((tuple(p), tuple(q)) if tuple(p) < tuple(q) else (tuple(q), tuple(p)))
-    for (x0, y0), (x1, y1) in lines:
-        sa = _side_of(A, x0, y0, x1, y1)
-        if sa is None:
-            continue
-        sb = _side_of(B, x0, y0, x1, y1)
-        if sb is None or sa[0] * sb[0] > 0:
-            continue
-        on_a, on_b = sa[1], sb[1]
-        if not on_a or not on_b:
-            return "separated"  # a strict gap on one side of L
-        lo_a, hi_a = min(on_a), max(on_a)  # points exactly on L: (x, y) order is the order along L
-        lo_b, hi_b = min(on_b), max(on_b)
-        return "touching" if max(lo_a, lo_b) <= min(hi_a, hi_b) else "separated"
-    return None
-
-
-def _side_of(P: list, x0: float, y0: float, x1: float, y1: float):
-    """(+1 or -1, points on the line) if P lies on one closed side of line (x0,y0)->(x1,y1),
-    else None (exact signs)."""
-    side = 0
-    on = []
-    for x, y in P:
-        s = orient2d_xy(x0, y0, x1, y1, x, y)
-        if s == 0:
-            on.append((x, y))
-        elif side == 0:
-            side = s
-        elif s != side:
-            return None
-    return (side or 1), on
-
-
 def _norm2(c) -> float:
     vx, vy = _combine(c[1], c[0], 2, 3)
     return vx * vx + vy * vy
-
-
-# ---------------------------------------------------------------- exact decisions
-
-
-def exact_relation(A, B) -> str:
-    """'separated', 'touching' or 'overlapping', decided in exact rational arithmetic.
-
-    Separating axis test over the hull edges of both sets (and, for a point or a
-    segment, the segment's direction and the axis joining the two sets): separated
-    if some axis separates strictly, touching if one separates only weakly (the sets
-    meet but no interior point of one is interior to the other's side), else
-    overlapping.
-
-    >>> exact_relation([[0, 0], [1, 0], [0, 1]], [[1, 0], [2, 0], [1, 1]])
-    'touching'
-    """
-    from .hull import convex_hull
-
-    ga = _as_hull(as_array(A, nonempty=True), convex_hull)
-    gb = _as_hull(as_array(B, nonempty=True), convex_hull)
-    if len(ga) >= 3 and len(gb) >= 3:
-        return _relation_polygons(ga, gb)
-    ha = [(Fraction(x), Fraction(y)) for x, y in ga.tolist()]
-    hb = [(Fraction(x), Fraction(y)) for x, y in gb.tolist()]
-    weak = False
-    for ax in _axes(ha, hb):
-        pa = [ax[0] * x + ax[1] * y for x, y in ha]
-        pb = [ax[0] * x + ax[1] * y for x, y in hb]
-        lo_a, hi_a, lo_b, hi_b = min(pa), max(pa), min(pb), max(pb)
-        if hi_a < lo_b or hi_b < lo_a:
-            return "separated"
-        if hi_a == lo_b or hi_b == lo_a:
-            weak = True
-    return "touching" if weak else "overlapping"
-
-
-def _as_hull(p: np.ndarray, convex_hull) -> np.ndarray:
-    """p itself if it is already a strictly convex CCW polygon (the usual case: C-space
-    pieces), else its exact hull. Strict left turns everywhere and edge directions that
-    cross from the lower to the upper half-plane exactly once mean p winds once."""
-    n = len(p)
-    if 3 <= n <= 64:
-        pts = p.tolist()
-        ups = 0
-        for i in range(n):
-            (ax, ay), (bx, by), (cx, cy) = pts[i - 2], pts[i - 1], pts[i]
-            if orient2d_xy(ax, ay, bx, by, cx, cy) <= 0:
-                break
-            lower_before = by < ay or (by == ay and bx < ax)
-            upper_after = cy > by or (cy == by and cx > bx)
-            ups += lower_before and upper_after
-        else:
-            if ups == 1:
-                return p
-    return convex_hull(p)
-
-
-def _relation_polygons(ga: np.ndarray, gb: np.ndarray) -> str:
-    """Separating axis test for two convex polygons (CCW hulls) with the exact predicate.
-
-    An edge of A separates iff every vertex of B lies right of its directed line
-    (orient2d < 0), weakly iff on or right of it; the same with A and B swapped.
-    Disjoint compact convex polygons always have a strictly separating edge line,
-    so no strict separator and a weak one means the sets touch. An edge is dropped
-    as soon as one vertex of the other set lies strictly left of it.
-    """
-    if len(ga) * len(gb) > 144:  # large: all edge-vertex signs at once (one filter pass)
-        return _relation_polygons_cols(ga, gb)
-    weak = False
-    for g, h in ((ga.tolist(), gb.tolist()), (gb.tolist(), ga.tolist())):
-        for i in range(len(g)):
-            (x0, y0), (x1, y1) = g[i - 1], g[i]
-            on_line = False
-            for x, y in h:
-                s = orient2d_xy(x0, y0, x1, y1, x, y)
-                if s > 0:
-                    break
-                on_line = on_line or s == 0
-            else:
-                if not on_line:
-                    return "separated"
-                weak = True
-    return "touching" if weak else "overlapping"
-
-
-def _relation_polygons_cols(ga: np.ndarray, gb: np.ndarray) -> str:
-    """:func:`_relation_polygons` with the signs of every edge-vertex pair in one array."""
-    weak = False
-    for g, h in ((ga, gb), (gb, ga)):
-        e0 = np.roll(g, 1, axis=0)[:, None, :]
-        e1 = g[:, None, :]
-        s = orient2d_cols(e0[..., 0], e0[..., 1], e1[..., 0], e1[..., 1], h[None, :, 0], h[None, :, 1])
-        outside = (s <= 0).all(axis=1)
-        if (outside & (s < 0).all(axis=1)).any():
-            return "separated"
-        weak = weak or bool(outside.any())
-    return "touching" if weak else "overlapping"
-
-
-def _axes(ha: list, hb: list) -> list:
-    axes = []
-    for h in (ha, hb):
-        n = len(h)
-        for i in range(n if n > 2 else n - 1):
-            (x0, y0), (x1, y1) = h[i], h[(i + 1) % n]
-            axes.append((y1 - y0, x0 - x1))
-            if n < 3:
-                axes.append((x1 - x0, y1 - y0))
-    if len(ha) < 3 or len(hb) < 3:
-        axes.append((hb[0][0] - ha[0][0], hb[0][1] - ha[0][1]))
-    axes = [a for a in axes if a != (0, 0)]
-    return axes or [(Fraction(1), Fraction(0))]  # two equal points: any axis separates weakly
-
-
-def _exact_distance(a: np.ndarray, b: np.ndarray, origin: np.ndarray):
-    """Distance of disjoint sets by brute force over vertex-edge pairs (the rare sliver case)."""
-    best = (math.inf, None, None)
-    for P, Q, swap in ((a, b, False), (b, a, True)):
-        for p in P:
-            for i in range(len(Q)):
-                q0, q1 = Q[i], Q[(i + 1) % len(Q)] if len(Q) > 1 else Q[i]
-                c = _closest_on_segment(p, q0, q1)
-                d = math.hypot(p[0] - c[0], p[1] - c[1])
-                if d < best[0]:
-                    best = (d, c, p) if swap else (d, p, c)
-    d, pa, pb = best
-    return d, tuple(np.asarray(pa) - origin), tuple(np.asarray(pb) - origin)
-
-
-def _closest_on_segment(p, q0, q1):
-    ex, ey = q1[0] - q0[0], q1[1] - q0[1]
-    ee = ex * ex + ey * ey
-    if ee == 0.0:
-        return q0
-    t = min(1.0, max(0.0, ((p[0] - q0[0]) * ex + (p[1] - q0[1]) * ey) / ee))
-    return (q0[0] + t * ex, q0[1] + t * ey)

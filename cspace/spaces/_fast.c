@@ -684,6 +684,7 @@ done:
 PyObject *fast_pair_sums(PyObject *self, PyObject *args); /* _build.c */
 PyObject *fast_contained(PyObject *self, PyObject *args); /* _build.c */
 PyObject *fast_chords(PyObject *self, PyObject *args);    /* _chords.c */
+PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _gjk.c */
 
 static PyMethodDef methods[] = {
     {"grid", py_grid, METH_VARARGS, "Copy a grid index and its packed pieces; returns a handle."},
@@ -706,6 +707,8 @@ static PyMethodDef methods[] = {
      "se2_pose(handle, x, y, c, s): 1 free, 0 not free, -1 undecided (the exact test's float filter)."},
     {"se2_slow", (PyCFunction)(void (*)(void))py_se2_slow, METH_FASTCALL,
      "se2_slow(grid, handle, x, y, c, s): 1 free in the slab, 2 free, 0 not free, -1 undecided."},
+    {"gjk", (PyCFunction)(void (*)(void))fast_gjk, METH_FASTCALL,
+     "gjk(a, b, max_iterations): the loop of cspace.kernel.gjk._gjk on float64 (n, 2) arrays."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -38,6 +38,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..kernel.gjk import gjk_distance
+from . import fastpath
 
 ANGLE_STEP = 1e-3  # SE(2): radians of turn below which a sub-motion is not split further
 MAX_SPLITS = 20000  # SE(2): sub-motions evaluated at most (then the bound found so far is kept)
@@ -73,9 +74,16 @@ class Nearest:
     """
 
     def __init__(self, pieces: list[np.ndarray]):
-        self.pieces = [np.asarray(p, dtype=np.float64) for p in pieces]
-        self.lo = np.array([p.min(axis=0) for p in self.pieces]).reshape(-1, 2)
-        self.hi = np.array([p.max(axis=0) for p in self.pieces]).reshape(-1, 2)
+        self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
+        self.loop = fastpath.gjk_loop()  # the compiled GJK loop, or None (pure): fixed at construction
+        sizes = [len(p) for p in self.pieces]
+        if sizes and min(sizes) > 0 and all(p.ndim == 2 for p in self.pieces):  # all boxes in two reductions
+            starts = np.cumsum([0] + sizes[:-1])
+            flat = np.concatenate(self.pieces)
+            self.lo, self.hi = np.minimum.reduceat(flat, starts), np.maximum.reduceat(flat, starts)
+        else:
+            self.lo = np.array([p.min(axis=0) for p in self.pieces]).reshape(-1, 2)
+            self.hi = np.array([p.max(axis=0) for p in self.pieces]).reshape(-1, 2)
 
     def nearest(self, pts: np.ndarray, cap: float = math.inf):
         """(distance, piece, point on the piece) of the closest piece to conv(pts), or
@@ -90,7 +98,7 @@ class Nearest:
         for k in cand[np.argsort(lb[cand], kind="stable")].tolist():
             if lb[k] >= best:
                 break
-            d = gjk_distance(pts, self.pieces[k])
+            d = gjk_distance(pts, self.pieces[k], loop=self.loop)
             if d.distance < best or k_best < 0 and d.distance <= best:
                 best, k_best, w_best = d.distance, k, d.point_b
                 if best == 0.0:
@@ -200,7 +208,8 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # distance found are not measured (GJK's own error is about 2^-50 x that scale). A path
     # with a margin runs at one distance, to rounding, along many segments, where box
     # bounds leave GJK hundreds of pairs: after GJK_FIRST pairs, the rest get tight bounds.
-    slack = TIE * max(float(np.abs(pts).max()), max(float(np.abs(p).max()) for p in obs.pieces))
+    # (the largest |coordinate| of a piece is one of its box's: max |p| from the boxes, the same float)
+    slack = TIE * max(float(np.abs(pts).max()), float(np.abs(obs.lo).max()), float(np.abs(obs.hi).max()))
     queue, pos, measured = np.argsort(lbs, kind="stable").tolist(), 0, 0
     while pos < len(queue):
         t = queue[pos]
@@ -212,7 +221,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
         p0, p1 = segs[i]
         r = rob[j]
         swept = r + p0 if (p0 == p1).all() else np.concatenate([r + p0, r + p1])
-        d = gjk_distance(swept, obs.pieces[k])
+        d = gjk_distance(swept, obs.pieces[k], loop=obs.loop)
         if d.distance < best or arg is None:
             best, arg = d.distance, (i, j, k, d.point_b)
             if best == 0.0:
@@ -227,7 +236,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     if arg is None:
         return PathClearance(math.inf, (), (), -1, "exact")
     i, j, k, w = arg
-    where = _closest_position(segs[i], rob[j], obs.pieces[k])
+    where = _closest_position(segs[i], rob[j], obs.pieces[k], obs.loop)
     return PathClearance(float(best), where, tuple(float(v) for v in w), i, "exact")
 
 
@@ -312,14 +321,14 @@ def _reach(lo: np.ndarray, hi: np.ndarray, obs: Nearest) -> np.ndarray:
     return own + other
 
 
-def _closest_position(seg, robot_piece: np.ndarray, obstacle: np.ndarray) -> tuple:
+def _closest_position(seg, robot_piece: np.ndarray, obstacle: np.ndarray, loop=None) -> tuple:
     """The reference position on the segment where the robot piece is closest to the
     obstacle: the segment's point nearest to obstacle ⊕ (−piece) (GJK)."""
     from ..kernel.minkowski import minkowski_sum, reflect
 
     p0, p1 = seg
     cobs = minkowski_sum(obstacle, reflect(robot_piece)) if len(robot_piece) > 1 or robot_piece.any() else obstacle
-    d = gjk_distance(np.array([p0, p1]), cobs)
+    d = gjk_distance(np.array([p0, p1]), cobs, loop=loop)
     return float(d.point_a[0]), float(d.point_a[1])
 
 

@@ -64,6 +64,19 @@ def compiled() -> bool:
     return _fast is not None
 
 
+def gjk_loop():
+    """The compiled GJK loop (``_fast.gjk``) for :func:`cspace.kernel.gjk.gjk_distance`'s
+    ``loop=``, or None on the pure path. It repeats the pure loop's float operations in
+    order, so the answers are the same to the bit (tests/test_gjk_fast.py).
+
+    >>> from cspace.kernel.gjk import gjk_distance
+    >>> sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1]])
+    >>> gjk_distance(sq, sq + 3, loop=gjk_loop()).distance == gjk_distance(sq, sq + 3).distance
+    True
+    """
+    return None if _fast is None else _fast.gjk
+
+
 def classify_boxes(*args) -> int:
     """``_fast.classify``: the grid build's cell classification of boxes of cells, the
     numpy route's arithmetic in C (cspace/spaces/cellclass.py calls it when
