@@ -248,7 +248,7 @@ def _tighter_bounds(lbs, rows, ks, a, b, rob, obs) -> np.ndarray:
     GJK runs on few pairs. Scenes far from unit scale (products could underflow or
     overflow) keep the box bounds."""
     from ..kernel.minkowski import reflect
-    from ..kernel.pairsums import pairwise_sums
+    from .cspace_build import pair_sums  # compiled when built; equal to pairwise_sums
 
     if not len(rows):
         return lbs
@@ -263,7 +263,7 @@ def _tighter_bounds(lbs, rows, ks, a, b, rob, obs) -> np.ndarray:
             continue
         obst = [obs.pieces[k] for k in (uniq[sel] // nr).tolist()]
         r = rob[jj]
-        sums = obst if len(r) == 1 and not r.any() else pairwise_sums(obst, [reflect(r)])
+        sums = obst if len(r) == 1 and not r.any() else pair_sums(obst, [reflect(r)])
         for t, poly in zip(sel.tolist(), sums):
             polys[t] = poly
     sizes = np.array([len(p) for p in polys])
