@@ -495,7 +495,9 @@ def test_tighter_bounds_prune_a_margin_path():
         mp.undo()
     assert fast.distance == res.min_clearance
     assert fast.distance == pytest.approx(slow.distance, rel=1e-12)
-    assert n_fast * 3 <= len(calls), (n_fast, len(calls))
+    # After GJK_FIRST pairs on box bounds, the tight bounds leave GJK one or two; box bounds
+    # alone leave it dozens more.
+    assert n_fast <= cl.GJK_FIRST + 2 and len(calls) >= cl.GJK_FIRST + 30, (n_fast, len(calls))
 
 
 @pytest.mark.parametrize("value, fault", [

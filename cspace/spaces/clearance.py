@@ -45,7 +45,7 @@ MAX_SPLITS = 20000  # SE(2): sub-motions evaluated at most (then the bound found
 # Translation: the search stops at pairs whose lower bound is within TIE x the coordinate scale
 # of the best distance found (see path_clearance).
 TIE = 2.0**-44
-GJK_FIRST = 16  # pairs measured on box bounds before the rest get tight ones
+GJK_FIRST = 32  # pairs measured on box bounds before the rest get tight ones
 
 
 class PathClearance(NamedTuple):
@@ -211,6 +211,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # (the largest |coordinate| of a piece is one of its box's: max |p| from the boxes, the same float)
     slack = TIE * max(float(np.abs(pts).max()), float(np.abs(obs.lo).max()), float(np.abs(obs.hi).max()))
     queue, pos, measured = np.argsort(lbs, kind="stable").tolist(), 0, 0
+    still = (a == b).all(axis=1).tolist()  # a segment of one point sweeps the piece itself
     while pos < len(queue):
         t = queue[pos]
         pos += 1
@@ -220,7 +221,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
         i, j = divmod(row, nr)
         p0, p1 = segs[i]
         r = rob[j]
-        swept = r + p0 if (p0 == p1).all() else np.concatenate([r + p0, r + p1])
+        swept = r + p0 if still[i] else np.concatenate([r + p0, r + p1])
         d = gjk_distance(swept, obs.pieces[k], loop=obs.loop)
         if d.distance < best or arg is None:
             best, arg = d.distance, (i, j, k, d.point_b)
@@ -324,10 +325,11 @@ def _reach(lo: np.ndarray, hi: np.ndarray, obs: Nearest) -> np.ndarray:
 def _closest_position(seg, robot_piece: np.ndarray, obstacle: np.ndarray, loop=None) -> tuple:
     """The reference position on the segment where the robot piece is closest to the
     obstacle: the segment's point nearest to obstacle ⊕ (−piece) (GJK)."""
-    from ..kernel.minkowski import minkowski_sum, reflect
+    from ..kernel.minkowski import reflect
+    from .cspace_build import pair_sums  # minkowski_sum's arrays; compiled when built
 
     p0, p1 = seg
-    cobs = minkowski_sum(obstacle, reflect(robot_piece)) if len(robot_piece) > 1 or robot_piece.any() else obstacle
+    cobs = pair_sums([obstacle], [reflect(robot_piece)])[0] if len(robot_piece) > 1 or robot_piece.any() else obstacle
     d = gjk_distance(np.array([p0, p1]), cobs, loop=loop)
     return float(d.point_a[0]), float(d.point_a[1])
 
