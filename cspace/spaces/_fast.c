@@ -613,7 +613,10 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn)
    sum of the weights of the edges not strictly inside. Cells not separated are written
    (row, i, j, inside, mask), piece by piece, row-major; the outputs hold at least the
    sum of the boxes' cells. No filter, no rounding argument of its own: the same doubles
-   as the numpy route, so the same answers (tests/test_fastpath.py compares the grids). */
+   as the numpy route, so the same answers (tests/test_fastpath.py compares the grids).
+   Two shortcuts change no output: a separated cell is not written, so its remaining edges
+   are skipped; padded edges (c = +inf, after a piece's own) leave every cell strictly
+   inside with weight 0, so the loop stops at the first. */
 static PyObject *py_classify(PyObject *self, PyObject *args)
 {
     PyObject *o[15];
@@ -656,6 +659,7 @@ static PyObject *py_classify(PyObject *self, PyObject *args)
                 int inside = 1, separated = 0;
                 int64_t mask = 0;
                 for (Py_ssize_t e = 0; e < E; e++) {
+                    if (cr[e] == HUGE_VAL) break; /* padding (every cell strictly inside, weight 0): the rest too */
                     double d = cx0 * nr[2 * e];
                     d += cy0 * nr[2 * e + 1];
                     d -= cr[e];
@@ -663,7 +667,10 @@ static PyObject *py_classify(PyObject *self, PyObject *args)
                         inside = 0;
                         mask += wr[e];
                     }
-                    if (d >= m - lr[e]) separated = 1;
+                    if (d >= m - lr[e]) {
+                        separated = 1; /* not written: its other edges cannot matter */
+                        break;
+                    }
                 }
                 if (separated) continue;
                 if (n >= cap) {

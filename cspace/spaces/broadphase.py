@@ -118,7 +118,7 @@ class GridIndex(CellClassifier):
         if cc.size:
             # A cell touched by any piece but not wholly inside one is MIXED; its
             # candidates in piece order.
-            order = np.lexsort((cp, cc))
+            order = np.argsort(cc * n + cp)  # by cell, then piece: (cell, piece) pairs are unique
             cc, cp, cm = cc[order], cp[order], cm[order]
             touched = np.zeros(nx * ny, dtype=bool)
             touched[cc] = True

@@ -260,7 +260,7 @@ class CellClassifier:
         if not parts:
             z = np.zeros(0, dtype=np.int64)
             return z, z, np.zeros(0, dtype=bool), z
-        row, ii, jj, inside, masks = (np.concatenate(x) for x in zip(*parts))
+        row, ii, jj, inside, masks = parts[0] if len(parts) == 1 else (np.concatenate(x) for x in zip(*parts))
         pid = np.asarray(ks, dtype=np.int64)[row]
         if wide.any():
             masks = np.where(wide[row], np.int64(WIDE_MASK), masks)
