@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from array import array
+from functools import cached_property
 
 import numpy as np
 
@@ -64,7 +65,8 @@ class GridIndex(CellClassifier):
     """Uniform grid over ``bounds`` classifying cells against convex ``pieces``.
 
     ``cells`` sets the cell count (default: from the pieces); ``shape`` = (nx, ny)
-    fixes the columns and rows instead, to share another grid's cells.
+    fixes the columns and rows instead, to share another grid's cells; ``boxes``: the
+    pieces' boxes (:func:`cspace.kernel.polygon.piece_boxes`) when the caller has them.
 
     >>> g = GridIndex([np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])], (0, 4, 0, 4), cells=16)
     >>> int(g.state_at(3.5, 3.5)), int(g.state_at(0.5, 0.5))
@@ -72,12 +74,12 @@ class GridIndex(CellClassifier):
     """
 
     def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None,
-                 shape: tuple[int, int] | None = None):
+                 shape: tuple[int, int] | None = None, boxes: tuple[np.ndarray, np.ndarray] | None = None):
         xmin, xmax, ymin, ymax = map(float, bounds)
         self.bounds = (xmin, xmax, ymin, ymax)
         n = len(pieces)
         w, h = xmax - xmin, ymax - ymin
-        self._lo, self._hi = piece_boxes(pieces)  # each piece's box, in one pass
+        self._lo, self._hi = boxes if boxes is not None else piece_boxes(pieces)  # each piece's box, in one pass
         if cells is None:
             # About 256 cells per piece, at least 64 x 64: measured on the bundled scenes
             # (plans of RRTConnect, compiled and pure paths), 1024 per piece and at least
@@ -133,21 +135,37 @@ class GridIndex(CellClassifier):
         self.blocker = blocker
         self._cand = cp
         self._starts = starts
+        self._masks = cm
         # Compact copies for the scalar hot path: indexing bytes or an array.array yields
         # a Python int as cheaply as a list does, and they are built by one copy of the
         # buffer instead of one Python object per cell (a million cells: ~1 ms, not ~50).
+        # The state bytes serve every point test; the other copies only the Python narrow
+        # phase, so they are made when it first runs (with the compiled path, rarely).
         self.state_list = state.astype(np.uint8).tobytes()
-        self.blocker_list = _ints(blocker)
-        self._cand_list = _ints(cp)
-        # For each candidate (cell, piece): a bit mask of the piece's edges whose line
-        # may pass within the margin of the cell (bit e: edge from vertex e-1 to e).
-        # Every other edge has the whole widened cell strictly on its
-        # inner side, so a point located in the cell needs no test against it.
-        # (Pieces of more than MASK_EDGES edges: WIDE_MASK, see edge_mask.)
-        self.cand_masks_list = _ints(cm)
-        self._starts_list = _ints(starts)
         self._rows = None
         self._sat_rows = None
+
+    @cached_property
+    def blocker_list(self) -> array:
+        """``blocker`` as an array.array (the pure path's scalar reads), made on first use."""
+        return _ints(self.blocker)
+
+    @cached_property
+    def _cand_list(self) -> array:
+        return _ints(self._cand)
+
+    @cached_property
+    def _starts_list(self) -> array:
+        return _ints(self._starts)
+
+    @cached_property
+    def cand_masks_list(self) -> array:
+        """For each candidate (cell, piece): a bit mask of the piece's edges whose line may
+        pass within the margin of the cell (bit e: edge from vertex e-1 to e). Every other
+        edge has the whole widened cell strictly on its inner side, so a point located in
+        the cell needs no test against it. (Pieces of more than MASK_EDGES edges:
+        WIDE_MASK, see edge_mask.)"""
+        return _ints(self._masks)
 
     @property
     def _sat(self) -> list[array]:
@@ -263,10 +281,6 @@ class GridIndex(CellClassifier):
 
     def stats(self) -> dict:
         """Cell counts by class, for reports."""
-        return {
-            "cells": int(self.nx * self.ny),
-            "grid": [int(self.nx), int(self.ny)],
-            "free": int((self.state == FREE).sum()),
-            "blocked": int((self.state == BLOCKED).sum()),
-            "mixed": int((self.state == MIXED).sum()),
-        }
+        free, mixed, blocked = np.bincount(self.state, minlength=3).tolist()[:3]
+        return {"cells": int(self.nx * self.ny), "grid": [int(self.nx), int(self.ny)],
+                "free": free, "blocked": blocked, "mixed": mixed}

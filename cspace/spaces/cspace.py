@@ -89,7 +89,7 @@ class CSpace(PointQueries, SegmentQueries):
         self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
         t = time.perf_counter()
         self.packed = PieceSet(self.pieces)
-        self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells)
+        self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells, boxes=(self.packed.lo, self.packed.hi))
         self._coarse = None
         self.stages.append(Stage("index", True, time.perf_counter() - t, self.index.stats()))
         # The compiled fast path's copy of the grid and pieces (None on the pure path).

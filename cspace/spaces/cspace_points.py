@@ -149,8 +149,7 @@ class PointQueries:
         """
         from ..kernel.predicates import _UNDERFLOW_GUARD, CCW_ERRBOUND_A, orient2d_xy
 
-        starts, cand = self.index._starts_list, self.index._cand_list
-        masks = self.index.cand_masks_list
+        index = self.index  # its scalar lists are made when this first runs (edges_near)
         packed = self.packed
         edge_mask, pieces = self.index.edge_mask, self.pieces
         by_cell: dict = {}  # cell -> per candidate piece, its edges named by the cell's mask
@@ -161,6 +160,7 @@ class PointQueries:
             # Only the edges whose line passes near this cell: the cell lies well
             # inside every other edge's half-plane (certified at build, with margin).
             groups = []
+            starts, cand, masks = index._starts_list, index._cand_list, index.cand_masks_list
             for t in range(starts[cell], starts[cell + 1]):
                 pts, mask = packed._lists[cand[t]], masks[t]
                 if mask == WIDE_MASK:  # a wide piece: its mask in this cell, once
