@@ -26,62 +26,7 @@
    Any other pair gets count -1 and the caller computes it with minkowski_sum (the
    pure path, exact, equal array for array). So both paths give the same arrays.
 */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#include <math.h>
-#include <stdint.h>
-#include <stdlib.h>
-#include <string.h>
-
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif !defined(__GNUC__)
-#pragma STDC FP_CONTRACT OFF
-#endif /* GCC: -ffp-contract=off, from setup.py */
-
-#define M_EPS (1.0 / 9007199254740992.0) /* 2^-53 */
-#define M_ERRBOUND_A ((3.0 + 16.0 * M_EPS) * M_EPS)
-#define M_UNDERFLOW_GUARD 1e-280
-#define M_UNDECIDED 2
-#define M_SPLIT 134217729.0 /* 2^27 + 1 */
-
-/* Knuth's TwoSum error of s = fl(a + b). */
-static inline double sum_err(double a, double b, double s)
-{
-    double bv = s - a, av = s - bv;
-    return (a - av) + (b - bv);
-}
-
-/* Dekker's TwoProduct error of p = fl(a * b). */
-static inline double prod_err(double a, double b, double p)
-{
-    double t = M_SPLIT * a, ah = t - (t - a), al = a - ah;
-    t = M_SPLIT * b;
-    double bh = t - (t - b), bl = b - bh;
-    return ((ah * bh - p) + ah * bl + al * bh) + al * bl;
-}
-
-/* Certified sign of (b - a) x (d - c): +1, -1, 0, or M_UNDECIDED (cross_diff_cols's stages). */
-static int cross_sign(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy)
-{
-    double ux = bx - ax, uy = by - ay, vx = dx - cx, vy = dy - cy;
-    double left = ux * vy, right = uy * vx;
-    double det = left - right, detsum = fabs(left) + fabs(right);
-    if (detsum > M_UNDERFLOW_GUARD && detsum < HUGE_VAL) {
-        double bound = M_ERRBOUND_A * detsum;
-        if (det > bound) return 1;
-        if (-det > bound) return -1;
-    }
-    if (detsum == 0.0 && (ux == 0.0 || vy == 0.0) && (uy == 0.0 || vx == 0.0)) return 0;
-    /* Every difference and product exact (far from under- and overflow): one rounding keeps the sign. */
-    if (!(isfinite(ux) && isfinite(uy) && isfinite(vx) && isfinite(vy))) return M_UNDECIDED;
-    if (!((fabs(left) > 0x1p-900 || ux == 0.0 || vy == 0.0) && fabs(left) < 0x1p1000)) return M_UNDECIDED;
-    if (!((fabs(right) > 0x1p-900 || uy == 0.0 || vx == 0.0) && fabs(right) < 0x1p1000)) return M_UNDECIDED;
-    if (sum_err(bx, -ax, ux) != 0.0 || sum_err(by, -ay, uy) != 0.0 || sum_err(dx, -cx, vx) != 0.0
-        || sum_err(dy, -cy, vy) != 0.0 || prod_err(ux, vy, left) != 0.0 || prod_err(uy, vx, right) != 0.0)
-        return M_UNDECIDED;
-    return (det > 0.0) - (det < 0.0);
-}
+#include "_fast.h"
 
 /* Is the edge direction (dx, dy) in the lower half [pi, 2 pi)? (lower_half) */
 static inline int lower(double dx, double dy)
@@ -129,7 +74,7 @@ static int chain(const double *pts, int64_t n, int64_t step, double *out, int64_
         while (len >= 2) {
             const double *a = out + 2 * (len - 2), *b = out + 2 * (len - 1);
             int s = cross_sign(p[0], p[1], a[0], a[1], p[0], p[1], b[0], b[1]); /* orient2d(a, b, p) */
-            if (s == M_UNDECIDED) return 0;
+            if (s == UNDECIDED) return 0;
             if (s > 0) break;
             len--;
         }
@@ -195,7 +140,7 @@ static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, d
         const double *a1 = A + 2 * ((k + 1) % na), *b1 = B + 2 * ((l + 1) % nb);
         int ha = lower(a1[0] - va[0], a1[1] - va[1]), hb = lower(b1[0] - vb[0], b1[1] - vb[1]);
         int c = ha != hb ? (ha < hb ? 1 : -1) : cross_sign(va[0], va[1], a1[0], a1[1], vb[0], vb[1], b1[0], b1[1]);
-        if (c == M_UNDECIDED) return -1;
+        if (c == UNDECIDED) return -1;
         if (c >= 0) k++; /* a first (b turns CCW from a), or the same direction: fused */
         if (c <= 0) l++;
     }
@@ -204,7 +149,7 @@ static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, d
         for (int64_t v = 0; v < n; v++) {
             const double *p = out + 2 * ((v + n - 1) % n), *q = out + 2 * v, *r = out + 2 * ((v + 1) % n);
             int s = cross_sign(r[0], r[1], p[0], p[1], r[0], r[1], q[0], q[1]);
-            if (s == M_UNDECIDED) return -1;
+            if (s == UNDECIDED) return -1;
             repair |= s != 1;
         }
         if (repair) return hull_in_place(out, n);
@@ -320,7 +265,7 @@ PyObject *fast_contained(PyObject *self, PyObject *args)
             for (int64_t i = 0; i < nq; i++) {
                 const double *s = Q + 2 * i, *e = Q + 2 * (i + 1 < nq ? i + 1 : 0);
                 int sg = cross_sign(vx, vy, s[0], s[1], vx, vy, e[0], e[1]);
-                if (sg == M_UNDECIDED) {
+                if (sg == UNDECIDED) {
                     answer = -1;
                 } else if (sg < 0) {
                     answer = 0;

@@ -10,17 +10,7 @@
    one edge, the arc's middle vertex is added. No decision here needs certifying: the
    grid's classification uses the sagittas as the numpy route does.
 */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#include <math.h>
-#include <stdint.h>
-#include <string.h>
-
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif !defined(__GNUC__)
-#pragma STDC FP_CONTRACT OFF
-#endif /* GCC: -ffp-contract=off, from setup.py */
+#include "_fast.h"
 
 /* One piece: q (s vertices), keep (s flags, the start set) -> out (n vertices), sag (n); returns n. */
 static int64_t chord_piece(const double *q, int64_t s, char *keep, double limit, int64_t *idx, double *out,

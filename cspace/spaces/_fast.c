@@ -5,12 +5,12 @@
    the pure-Python path then answers exactly (rationals). It never guesses: every
    answer it gives is the exact answer, so the two paths answer identically.
 
-   - orient(): Shewchuk's stage-A filter, the same bound as cspace/kernel/predicates.py
+   - orient() (_fast.h): Shewchuk's stage-A filter, the same bound as cspace/kernel/predicates.py
      (|fl(det) - det| <= (3 + 16 eps) eps (|left| + |right|), valid when no product
-     underflows: detsum > 1e-280, and detsum finite), plus the exact zero when a
-     factor of each product is an exact zero difference. Anything else: undecided.
-     FP contraction (FMA) is switched off so each product is rounded once, as the
-     bound assumes (setup.py also passes -ffp-contract=off).
+     underflows: detsum > 1e-280, and detsum finite), the exact zero when a factor of
+     each product is an exact zero difference, and the sign of a determinant whose
+     operations were all exact. Anything else: undecided. FP contraction (FMA) is
+     switched off so each product is rounded once, as the bound assumes.
    - seg_piece(), point_piece(): the separating-axis narrow phase of cspace/kernel/pieces.py
      (a closed segment and a closed convex CCW piece are disjoint iff an edge line of
      the piece or the segment's own line separates them strictly), each axis decided
@@ -21,22 +21,7 @@
      lies inside its blocker, a MIXED cell lists every piece that may meet it. So
      every piece the segment meets is tested, each at most once (a stamp per piece).
 */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#include <math.h>
-#include <stdint.h>
-#include <string.h>
-
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif !defined(__GNUC__)
-#pragma STDC FP_CONTRACT OFF
-#endif /* GCC: -ffp-contract=off, from setup.py */
-
-#define EPS (1.0 / 9007199254740992.0) /* 2^-53 */
-#define ERRBOUND_A ((3.0 + 16.0 * EPS) * EPS)
-#define UNDERFLOW_GUARD 1e-280
-#define UNDECIDED 2
+#include "_fast.h"
 
 enum { FREE = 0, MIXED = 1, BLOCKED = 2 };
 
@@ -51,23 +36,6 @@ typedef struct {
     uint32_t *stamp;                    /* per piece: the query that last tested it */
     uint32_t gen;
 } Grid;
-
-/* Certified sign of orient2d(a, b, c) = (a - c) x (b - c): +1, -1, 0, or UNDECIDED. */
-static inline int orient(double ax, double ay, double bx, double by, double cx, double cy)
-{
-    double ux = ax - cx, uy = ay - cy, vx = bx - cx, vy = by - cy;
-    double left = ux * vy, right = uy * vx;
-    double det = left - right;
-    double detsum = fabs(left) + fabs(right);
-    if (detsum > UNDERFLOW_GUARD && detsum < HUGE_VAL) {
-        double bound = ERRBOUND_A * detsum;
-        if (det > bound) return 1;
-        if (-det > bound) return -1;
-    } else if (detsum == 0.0 && (ux == 0.0 || vy == 0.0) && (uy == 0.0 || vx == 0.0)) {
-        return 0; /* a factor of each product is an exact zero (x - y == 0 iff x == y) */
-    }
-    return UNDECIDED;
-}
 
 /* The cell of a floored grid coordinate f, clamped to 0 .. n - 1 (f is never NaN here). */
 static inline int64_t clamp_cell(double f, int64_t n)
@@ -688,10 +656,6 @@ done:
     return count < 0 ? NULL : PyLong_FromSsize_t(count);
 }
 
-PyObject *fast_pair_sums(PyObject *self, PyObject *args); /* _build.c */
-PyObject *fast_contained(PyObject *self, PyObject *args); /* _build.c */
-PyObject *fast_chords(PyObject *self, PyObject *args);    /* _chords.c */
-PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _gjk.c */
 
 static PyMethodDef methods[] = {
     {"grid", py_grid, METH_VARARGS, "Copy a grid index and its packed pieces; returns a handle."},

@@ -9,23 +9,14 @@
    simplex ends the loop, as does v.v - v.w <= REL_TOL v.v; _solve2 and _solve3 take
    the same branches (a flat triangle: the first best of its three edges by _norm2, as
    Python's min), and _combine sums as Python does (x = l0 p + l1 q, then x += l2 r).
-   No FMA contraction (the pragma below; setup.py). The hypot of the points and the
+   No FMA contraction (_fast.h; setup.py). The hypot of the points and the
    "deep" test are left to Python (its math.hypot need not be libm's).
 
    Returns None when a local coordinate is not finite (the caller then runs the pure
    path, which rescales), else (pax, pay, pbx, pby, iterations, inside, simplex, extent):
    the closest points before hypot, inside as a bool, simplex a tuple of (ia, ib, wx, wy),
    extent the largest |local coordinate| (1.0 if all are 0, as _scale). */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#include <math.h>
-#include <stdint.h>
-
-#if defined(__clang__)
-#pragma clang fp contract(off)
-#elif !defined(__GNUC__)
-#pragma STDC FP_CONTRACT OFF
-#endif /* GCC: -ffp-contract=off, from setup.py */
+#include "_fast.h"
 
 #define GJK_REL_TOL 1e-14 /* gjk.REL_TOL */
 #define GJK_STACK 512     /* doubles of local coordinates kept on the stack */
