@@ -569,94 +569,6 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn)
     return unknown ? -1 : 1;
 }
 
-/* classify(nrm, c, hi, lo, weights, rows, i0, i1, j0, j1, x_off, y_off, cw, ch, m,
-            out_row, out_i, out_j, out_inside, out_mask) -> count
-
-   The grid build's cell classification (cspace/spaces/cellclass.py, CellClassifier's
-   evaluate) for the pieces `rows`: every cell (i, j) of piece r's box i0[r]..i1[r] x
-   j0[r]..j1[r] against its E padded edges (nrm: K x E x 2, c, hi, lo: K x E float64;
-   weights: K x E int64), with the same float operations in the same order:
-   d = (x_off + i cw) n_x;  d += (y_off + j ch) n_y;  d -= c;
-   inside when d <= -m - hi for every edge, separated when d >= m - lo for one, mask the
-   sum of the weights of the edges not strictly inside. Cells not separated are written
-   (row, i, j, inside, mask), piece by piece, row-major; the outputs hold at least the
-   sum of the boxes' cells. No filter, no rounding argument of its own: the same doubles
-   as the numpy route, so the same answers (tests/test_fastpath.py compares the grids).
-   Two shortcuts change no output: a separated cell is not written, so its remaining edges
-   are skipped; padded edges (c = +inf, after a piece's own) leave every cell strictly
-   inside with weight 0, so the loop stops at the first. */
-static PyObject *py_classify(PyObject *self, PyObject *args)
-{
-    PyObject *o[15];
-    double x_off, y_off, cw, ch, m;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOdddddOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &o[7],
-                          &o[8], &o[9], &x_off, &y_off, &cw, &ch, &m, &o[10], &o[11], &o[12], &o[13], &o[14]))
-        return NULL;
-    Py_buffer b[15];
-    int got = 0;
-    Py_ssize_t count = -1;
-    for (; got < 15; got++) {
-        int flags = got >= 10 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
-        if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
-    }
-    const double *nrm = b[0].buf, *c = b[1].buf, *hi = b[2].buf, *lo = b[3].buf;
-    const int64_t *w = b[4].buf, *rows = b[5].buf, *i0 = b[6].buf, *i1 = b[7].buf, *j0 = b[8].buf, *j1 = b[9].buf;
-    int64_t *orow = b[10].buf, *oi = b[11].buf, *oj = b[12].buf, *omask = b[14].buf;
-    uint8_t *oin = b[13].buf;
-    Py_ssize_t K = b[6].len / 8, KE = b[1].len / 8, R = b[5].len / 8, cap = b[10].len / 8;
-    Py_ssize_t E = K ? KE / K : 0;
-    if (b[0].len != 16 * KE || b[2].len != 8 * KE || b[3].len != 8 * KE || b[4].len != 8 * KE
-        || b[7].len != 8 * K || b[8].len != 8 * K || b[9].len != 8 * K || KE != K * E
-        || b[11].len != 8 * cap || b[12].len != 8 * cap || b[13].len != cap || b[14].len != 8 * cap) {
-        PyErr_SetString(PyExc_ValueError, "_fast.classify: inconsistent array sizes");
-        goto done;
-    }
-    Py_ssize_t n = 0;
-    for (Py_ssize_t t = 0; t < R; t++) {
-        int64_t r = rows[t];
-        if (r < 0 || r >= K) {
-            PyErr_SetString(PyExc_ValueError, "_fast.classify: a row out of range");
-            goto done;
-        }
-        const double *nr = nrm + 2 * r * E, *cr = c + r * E, *hr = hi + r * E, *lr = lo + r * E;
-        const int64_t *wr = w + r * E;
-        for (int64_t j = j0[r]; j <= j1[r]; j++) {
-            double cy0 = y_off + (double)j * ch;
-            for (int64_t i = i0[r]; i <= i1[r]; i++) {
-                double cx0 = x_off + (double)i * cw;
-                int inside = 1, separated = 0;
-                int64_t mask = 0;
-                for (Py_ssize_t e = 0; e < E; e++) {
-                    if (cr[e] == HUGE_VAL) break; /* padding (every cell strictly inside, weight 0): the rest too */
-                    double d = cx0 * nr[2 * e];
-                    d += cy0 * nr[2 * e + 1];
-                    d -= cr[e];
-                    if (!(d <= -m - hr[e])) {
-                        inside = 0;
-                        mask += wr[e];
-                    }
-                    if (d >= m - lr[e]) {
-                        separated = 1; /* not written: its other edges cannot matter */
-                        break;
-                    }
-                }
-                if (separated) continue;
-                if (n >= cap) {
-                    PyErr_SetString(PyExc_ValueError, "_fast.classify: outputs too small");
-                    goto done;
-                }
-                orow[n] = r, oi[n] = i, oj[n] = j, oin[n] = (uint8_t)inside, omask[n] = mask;
-                n++;
-            }
-        }
-    }
-    count = n;
-done:
-    for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
-    return count < 0 ? NULL : PyLong_FromSsize_t(count);
-}
-
-
 static PyMethodDef methods[] = {
     {"grid", py_grid, METH_VARARGS, "Copy a grid index and its packed pieces; returns a handle."},
     {"segment", (PyCFunction)(void (*)(void))py_segment, METH_FASTCALL,
@@ -665,8 +577,8 @@ static PyMethodDef methods[] = {
      "point(grid, x, y): 1 free, 0 not free, -1 undecided."},
     {"orient", (PyCFunction)(void (*)(void))py_orient, METH_FASTCALL,
      "orient(ax, ay, bx, by, cx, cy): the float filter's sign of orient2d, 2 if undecided."},
-    {"classify", py_classify, METH_VARARGS,
-     "classify(...): the grid build's cell classification of boxes of cells (see cellclass.py)."},
+    {"classify", fast_classify, METH_VARARGS,
+     "classify(...): the grid build's half-planes and cell classification of boxes of cells (_cells.c)."},
     {"pair_sums", fast_pair_sums, METH_VARARGS,
      "pair_sums(a_xy, a_off, b_xy, b_off, out_xy, out_count): the C-space build's pair sums (see _build.c)."},
     {"contained", fast_contained, METH_VARARGS,

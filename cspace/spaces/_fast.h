@@ -1,7 +1,7 @@
 /* Shared by the C files of cspace's optional compiled fast path (cspace.spaces._fast):
-   _fast.c (grid queries, SE(2) filter, cell classification, the module), _build.c (the
-   C-space build's pair sums and containment), _chords.c (chord polygons), _gjk.c (the
-   GJK loop of min_clearance).
+   _fast.c (grid queries, SE(2) filter, the module), _build.c (the C-space build's pair
+   sums and containment), _cells.c (the grid build's cell classification), _chords.c
+   (chord polygons), _gjk.c (the GJK loop of min_clearance).
 
    The one certified predicate they share: the sign of a cross product of two edge
    vectors, decided only where floats certify it (Shewchuk's stage-A filter, the same
@@ -80,6 +80,7 @@ static inline int orient(double ax, double ay, double bx, double by, double cx, 
 PyObject *fast_pair_sums(PyObject *self, PyObject *args);                     /* _build.c */
 PyObject *fast_contained(PyObject *self, PyObject *args);                     /* _build.c */
 PyObject *fast_chords(PyObject *self, PyObject *args);                        /* _chords.c */
+PyObject *fast_classify(PyObject *self, PyObject *args);                      /* _cells.c */
 PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs);  /* _gjk.c */
 
 #endif

@@ -54,13 +54,15 @@ def _runs(rows: np.ndarray, jj: np.ndarray, lo: np.ndarray, hi: np.ndarray):
 
 
 
-def _compiled_boxes(rows, cells, nrm, c, hi, lo, weights, i0, i1, j0, j1, x_off, y_off, cw, ch, m) -> list:
-    """The compiled route of :meth:`CellClassifier._classify_many`: every cell of the boxes
-    of ``rows`` evaluated by ``_fast.classify`` (the numpy route's arithmetic, in C), in
-    chunks of at most 2^21 cells; parts ``(row, i, j, inside, mask)`` of the kept cells."""
+def _compiled_boxes(rows, cells, Q, sizes, sag, wide, i0, i1, j0, j1, x_off, y_off, cw, ch, m) -> list:
+    """The compiled route of :meth:`CellClassifier._classify_many`: the half-planes of the
+    pieces ``rows`` and every cell of their boxes evaluated by ``_fast.classify`` (the numpy
+    route's arithmetic, in C), in chunks of at most 2^21 cells; parts ``(row, i, j, inside,
+    mask)`` of the kept cells."""
     out = []
     f64, i64 = np.ascontiguousarray, lambda a: np.ascontiguousarray(a, dtype=np.int64)
-    nrm, c, hi, lo, weights = f64(nrm), f64(c), f64(hi), f64(lo), i64(weights)
+    Q, sizes, wide = f64(Q, dtype=np.float64), i64(sizes), np.ascontiguousarray(wide, dtype=np.uint8)
+    sag = np.zeros(0) if sag is None else f64(sag, dtype=np.float64)
     i0, i1, j0, j1 = i64(i0), i64(i1), i64(j0), i64(j1)
     start = 0
     while start < len(rows):
@@ -71,7 +73,7 @@ def _compiled_boxes(rows, cells, nrm, c, hi, lo, weights, i0, i1, j0, j1, x_off,
         chunk = i64(rows[start:stop])
         o = [np.empty(cap, dtype=np.int64) for _ in range(3)] + [np.empty(cap, dtype=np.uint8),
                                                                  np.empty(cap, dtype=np.int64)]
-        n = fastpath.classify_boxes(nrm, c, hi, lo, weights, chunk, i0, i1, j0, j1,
+        n = fastpath.classify_boxes(Q, sizes, sag, wide, chunk, i0, i1, j0, j1,
                                     float(x_off), float(y_off), float(cw), float(ch), float(m), *o)
         out.append((o[0][:n], o[1][:n], o[2][:n], o[3][:n].astype(bool), o[4][:n]))
         start = stop
@@ -153,7 +155,7 @@ class CellClassifier:
         # inside or separated by them and the exact narrow phase decides (quietly).
         with np.errstate(invalid="ignore", divide="ignore"):
             nrm /= np.hypot(nrm[:, 0], nrm[:, 1])[:, None]
-        c = np.einsum("ij,ij->i", nrm, q)
+        c = nrm[:, 0] * q[:, 0] + nrm[:, 1] * q[:, 1]  # the build's c, the same doubles
         hi = np.maximum(nrm[:, 0], 0.0) * self.cw + np.maximum(nrm[:, 1], 0.0) * self.ch
         lo = np.minimum(nrm[:, 0], 0.0) * self.cw + np.minimum(nrm[:, 1], 0.0) * self.ch
         return nrm, c, hi, lo
@@ -184,24 +186,6 @@ class CellClassifier:
             chords = fastpath.chord_polygons if fastpath.compiled() and self.compiled else chord_polygons
             Q, sizes, sag = chords(Q, sizes, self.cw + self.ch, 0.25 * min(self.cw, self.ch))
             E = Q.shape[1]
-        slot = np.arange(E)
-        valid = slot[None, :] < sizes[:, None]
-        nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
-        e = np.take_along_axis(Q, nxt[:, :, None], axis=1) - Q
-        nrm = np.stack([e[:, :, 1], -e[:, :, 0]], axis=2)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
-        nrm[~valid] = 0.0
-        c = np.einsum("kij,kij->ki", nrm, Q)
-        c[~valid] = np.inf
-        hi = np.maximum(nrm[:, :, 0], 0.0) * self.cw + np.maximum(nrm[:, :, 1], 0.0) * self.ch
-        lo = np.minimum(nrm[:, :, 0], 0.0) * self.cw + np.minimum(nrm[:, :, 1], 0.0) * self.ch
-        if sag is not None:  # separation from a chord's line pushed out past every vertex
-            lo -= sag
-        # Bit e stands for the edge ending at vertex e: slot i (edge i -> i+1) is bit (i + 1) % n.
-        with_masks = not wide.all()
-        shift = np.where(wide[:, None], 0, (slot[None, :] + 1) % sizes[:, None])
-        weights = np.where(valid & ~wide[:, None], np.left_shift(np.int64(1), shift), 0)
         # Each piece's box of cells (widened by the margin), clipped to the grid.
         lo_xy, hi_xy = self._lo[ks], self._hi[ks]
         i0 = np.maximum(np.floor((lo_xy[:, 0] - m - self.x0) * self.inv_w), 0).astype(np.int64)
@@ -211,6 +195,34 @@ class CellClassifier:
         W = np.maximum(i1 - i0 + 1, 0)
         H = np.maximum(j1 - j0 + 1, 0)
         x_off, y_off, cw, ch = self.x0 - self.ox, self.y0 - self.oy, self.cw, self.ch
+        parts = []
+        narrow_box = W <= SCAN_COLUMNS
+        if fastpath.compiled() and self.compiled:  # every box up to 2^20 cells in C, the same doubles
+            small = (W * H > 0) & (W * H <= 1 << 20)
+            parts += _compiled_boxes(np.flatnonzero(small), W * H, Q, sizes, sag, wide, i0, i1, j0, j1,
+                                     x_off, y_off, cw, ch, m)
+            narrow_box = narrow_box & ~small
+            H = np.where(small, 0, H)
+        if not (narrow_box & (W * H > 0)).any() and not (~narrow_box & (H > 0)).any():
+            return self._gathered(parts, ks, wide)
+        slot = np.arange(E)
+        valid = slot[None, :] < sizes[:, None]
+        nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
+        e = np.take_along_axis(Q, nxt[:, :, None], axis=1) - Q
+        nrm = np.stack([e[:, :, 1], -e[:, :, 0]], axis=2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nrm /= np.hypot(nrm[:, :, 0], nrm[:, :, 1])[:, :, None]
+        nrm[~valid] = 0.0
+        c = nrm[:, :, 0] * Q[:, :, 0] + nrm[:, :, 1] * Q[:, :, 1]
+        c[~valid] = np.inf
+        hi = np.maximum(nrm[:, :, 0], 0.0) * self.cw + np.maximum(nrm[:, :, 1], 0.0) * self.ch
+        lo = np.minimum(nrm[:, :, 0], 0.0) * self.cw + np.minimum(nrm[:, :, 1], 0.0) * self.ch
+        if sag is not None:  # separation from a chord's line pushed out past every vertex
+            lo -= sag
+        # Bit e stands for the edge ending at vertex e: slot i (edge i -> i+1) is bit (i + 1) % n.
+        with_masks = not wide.all()
+        shift = np.where(wide[:, None], 0, (slot[None, :] + 1) % sizes[:, None])
+        weights = np.where(valid & ~wide[:, None], np.left_shift(np.int64(1), shift), 0)
 
         def evaluate(row, ii, jj):
             """inside, separated, mask of the cells (piece row[k], cell ii[k], jj[k])."""
@@ -235,14 +247,6 @@ class CellClassifier:
         # Pieces at most SCAN_COLUMNS cells wide: every cell of their box is evaluated.
         # Wider ones row by row (_scan_rows): per row and edge the column where the edge's
         # test flips is found exactly, so only the cells near the boundary are evaluated.
-        narrow_box = W <= SCAN_COLUMNS
-        parts = []
-        if fastpath.compiled() and self.compiled:  # every box up to 2^20 cells in C, the same doubles
-            small = (W * H > 0) & (W * H <= 1 << 20)
-            parts += _compiled_boxes(np.flatnonzero(small), W * H, nrm, c, hi, lo, weights, i0, i1, j0, j1,
-                                     x_off, y_off, cw, ch, m)
-            narrow_box = narrow_box & ~small
-            H = np.where(small, 0, H)
         dense = np.flatnonzero(narrow_box & (W * H > 0))
         if len(dense):
             counts = (W * H)[dense]
@@ -257,6 +261,10 @@ class CellClassifier:
         scan = np.flatnonzero(~narrow_box & (H > 0))
         if len(scan):
             parts += self._scan_rows(scan, i0, i1, j0, H, nrm, c, hi, lo, evaluate)
+        return self._gathered(parts, ks, wide)
+
+    def _gathered(self, parts: list, ks: list[int], wide: np.ndarray):
+        """:meth:`_classify_many`'s answer from its parts ``(row, i, j, inside, mask)``."""
         if not parts:
             z = np.zeros(0, dtype=np.int64)
             return z, z, np.zeros(0, dtype=bool), z

@@ -78,9 +78,9 @@ def gjk_loop():
 
 
 def classify_boxes(*args) -> int:
-    """``_fast.classify``: the grid build's cell classification of boxes of cells, the
-    numpy route's arithmetic in C (cspace/spaces/cellclass.py calls it when
-    :func:`compiled`)."""
+    """``_fast.classify`` (cspace/spaces/_cells.c): the grid build's half-planes and cell
+    classification of boxes of cells, the numpy route's arithmetic in C
+    (cspace/spaces/cellclass.py calls it when :func:`compiled`)."""
     return _fast.classify(*args)
 
 

@@ -1,0 +1,122 @@
+/* The grid build's cell classification (part of cspace.spaces._fast): CellClassifier's
+   numpy route (cspace/spaces/cellclass.py, _classify_many and its evaluate) in C, with
+   the same float operations in the same order, so the same grid.
+
+   Each piece's edge i -> i+1 (padded vertices Q, local frame) is a half-plane
+   n . x <= c with n = (e_y, -e_x) / hypot(e_y, -e_x), c = n_x Q_x + n_y Q_y; over a cell
+   the signed distance of its corners ranges over d + lo .. d + hi with
+   hi = max(n_x, 0) cw + max(n_y, 0) ch, lo = min(n_x, 0) cw + min(n_y, 0) ch (less the
+   chord's sagitta for chord polygons), d = (x_off + i cw) n_x + (y_off + j ch) n_y - c.
+   A cell is inside when d <= -m - hi for every edge, separated when d >= m - lo for one;
+   its mask sums the weights (bit (i + 1) mod size, 0 for wide pieces) of the edges it is
+   not strictly inside. Cells not separated are written (row, i, j, inside, mask), piece
+   by piece, row-major. No filter and no rounding argument of its own: the numpy route's
+   doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum and
+   minimum propagate them: no cell is inside or separated by such an edge.
+
+   Two shortcuts change no output: a separated cell is not written, so its remaining
+   edges are skipped; a piece's padded slots (after its own edges) would leave every cell
+   strictly inside with weight 0, so they are not evaluated. */
+#include "_fast.h"
+
+/* numpy's maximum(x, 0.0) and minimum(x, 0.0): NaN propagates. */
+static inline double max0(double x) { return (x >= 0.0 || isnan(x)) ? x : 0.0; }
+static inline double min0(double x) { return (x <= 0.0 || isnan(x)) ? x : 0.0; }
+
+/* classify(Q, sizes, sag, wide, rows, i0, i1, j0, j1, x_off, y_off, cw, ch, m,
+            out_row, out_i, out_j, out_inside, out_mask) -> count
+
+   Q: float64 K x E x 2; sizes: int64 K; sag: float64 K x E, or empty (no chords);
+   wide: uint8 K (WIDE pieces: weights 0); rows: int64, the pieces to classify; i0..j1:
+   int64 K, each piece's box of cells; outputs: room for the rows' boxes' cells. */
+PyObject *fast_classify(PyObject *self, PyObject *args)
+{
+    PyObject *o[14];
+    double x_off, y_off, cw, ch, m;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOdddddOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &o[7],
+                          &o[8], &x_off, &y_off, &cw, &ch, &m, &o[9], &o[10], &o[11], &o[12], &o[13]))
+        return NULL;
+    Py_buffer b[14];
+    int got = 0;
+    Py_ssize_t count = -1;
+    double *hp = NULL;
+    for (; got < 14; got++) {
+        int flags = got >= 9 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
+        if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
+    }
+    const double *Q = b[0].buf, *sag = b[2].buf;
+    const int64_t *sizes = b[1].buf, *rows = b[4].buf, *i0 = b[5].buf, *i1 = b[6].buf, *j0 = b[7].buf, *j1 = b[8].buf;
+    const uint8_t *wide = b[3].buf;
+    int64_t *orow = b[9].buf, *oi = b[10].buf, *oj = b[11].buf, *omask = b[13].buf;
+    uint8_t *oin = b[12].buf;
+    Py_ssize_t K = b[1].len / 8, R = b[4].len / 8, cap = b[9].len / 8;
+    Py_ssize_t E = K ? b[0].len / 16 / K : 0;
+    int has_sag = b[2].len > 0;
+    if (b[0].len != 16 * K * E || (has_sag && b[2].len != 8 * K * E) || b[3].len != K || b[5].len != 8 * K
+        || b[6].len != 8 * K || b[7].len != 8 * K || b[8].len != 8 * K || b[10].len != 8 * cap
+        || b[11].len != 8 * cap || b[12].len != cap || b[13].len != 8 * cap) {
+        PyErr_SetString(PyExc_ValueError, "_fast.classify: inconsistent array sizes");
+        goto done;
+    }
+    hp = PyMem_Malloc(sizeof(double) * 6 * (E ? E : 1)); /* per edge: n_x, n_y, c, hi, lo, weight */
+    if (!hp) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t n = 0;
+    for (Py_ssize_t t = 0; t < R; t++) {
+        int64_t r = rows[t];
+        if (r < 0 || r >= K || sizes[r] < 1 || sizes[r] > E) {
+            PyErr_SetString(PyExc_ValueError, "_fast.classify: a row or size out of range");
+            goto done;
+        }
+        int64_t s = sizes[r];
+        const double *q = Q + 2 * r * E;
+        double *nx = hp, *ny = hp + E, *c = hp + 2 * E, *hi = hp + 3 * E, *lo = hp + 4 * E;
+        int64_t *w = (int64_t *)(hp + 5 * E);
+        for (int64_t e = 0; e < s; e++) { /* the half-planes, as _classify_many computes them */
+            int64_t f = e + 1 < s ? e + 1 : 0;
+            double ex = q[2 * f] - q[2 * e], ey = q[2 * f + 1] - q[2 * e + 1];
+            double h = hypot(ey, -ex);
+            nx[e] = ey / h, ny[e] = -ex / h;
+            c[e] = nx[e] * q[2 * e] + ny[e] * q[2 * e + 1];
+            hi[e] = max0(nx[e]) * cw + max0(ny[e]) * ch;
+            lo[e] = min0(nx[e]) * cw + min0(ny[e]) * ch;
+            if (has_sag) lo[e] -= sag[r * E + e];
+            w[e] = wide[r] ? 0 : (int64_t)((uint64_t)1 << ((e + 1) % s));
+        }
+        for (int64_t j = j0[r]; j <= j1[r]; j++) {
+            double cy0 = y_off + (double)j * ch;
+            for (int64_t i = i0[r]; i <= i1[r]; i++) {
+                double cx0 = x_off + (double)i * cw;
+                int inside = 1, separated = 0;
+                int64_t mask = 0;
+                for (int64_t e = 0; e < s; e++) {
+                    double d = cx0 * nx[e];
+                    d += cy0 * ny[e];
+                    d -= c[e];
+                    if (!(d <= -m - hi[e])) {
+                        inside = 0;
+                        mask += w[e];
+                    }
+                    if (d >= m - lo[e]) {
+                        separated = 1;
+                        break;
+                    }
+                }
+                if (separated) continue;
+                if (n >= cap) {
+                    PyErr_SetString(PyExc_ValueError, "_fast.classify: outputs too small");
+                    goto done;
+                }
+                orow[n] = r, oi[n] = i, oj[n] = j, oin[n] = (uint8_t)inside, omask[n] = mask;
+                n++;
+            }
+        }
+    }
+    count = n;
+done:
+    PyMem_Free(hp);
+    for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
+    return count < 0 ? NULL : PyLong_FromSsize_t(count);
+}
