@@ -1,4 +1,4 @@
-/* The grid build's cell classification (part of cspace.spaces._fast): CellClassifier's
+/* The grid build (part of cspace.spaces._fast): classify() is CellClassifier's
    numpy route (cspace/spaces/cellclass.py, _classify_many and its evaluate) in C, with
    the same float operations in the same order, so the same grid.
 
@@ -16,7 +16,10 @@
 
    Two shortcuts change no output: a separated cell is not written, so its remaining
    edges are skipped; a piece's padded slots (after its own edges) would leave every cell
-   strictly inside with weight 0, so they are not evaluated. */
+   strictly inside with weight 0, so they are not evaluated.
+
+   assemble() turns the classified entries into the grid's arrays, as GridIndex's numpy
+   route does. */
 #include "_fast.h"
 
 /* numpy's maximum(x, 0.0) and minimum(x, 0.0): NaN propagates. */
@@ -119,4 +122,80 @@ done:
     PyMem_Free(hp);
     for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
     return count < 0 ? NULL : PyLong_FromSsize_t(count);
+}
+
+/* assemble(cc, cp, cm, inside, npieces, out_state, out_blocker, out_starts, out_cand, out_masks) -> None
+
+   The grid from its classified (cell, piece, mask, inside) entries, as GridIndex's numpy
+   route assembles it: a cell inside a piece is BLOCKED, its blocker the largest such
+   piece; the other entries are the candidates, by cell and then piece (a counting sort
+   by cell, then each cell's few candidates by piece), a cell with a candidate and no
+   blocker MIXED, starts[c] .. starts[c + 1] the candidates of cell c. Outputs: state
+   int8 (cells, zeroed here), blocker int64 (cells), starts int64 (cells + 1), cand and
+   masks int64 (room for every entry). */
+PyObject *fast_assemble(PyObject *self, PyObject *args)
+{
+    PyObject *o[9];
+    Py_ssize_t npieces;
+    if (!PyArg_ParseTuple(args, "OOOOnOOOOO", &o[0], &o[1], &o[2], &o[3], &npieces, &o[4], &o[5], &o[6], &o[7], &o[8]))
+        return NULL;
+    Py_buffer b[9];
+    int got = 0, ok = 0;
+    for (; got < 9; got++) {
+        int flags = got >= 4 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
+        if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
+    }
+    const int64_t *cc = b[0].buf, *cp = b[1].buf, *cm = b[2].buf;
+    const uint8_t *inside = b[3].buf;
+    int8_t *state = b[4].buf;
+    int64_t *blocker = b[5].buf, *starts = b[6].buf, *cand = b[7].buf, *masks = b[8].buf;
+    Py_ssize_t n = b[0].len / 8, cells = b[4].len;
+    if (b[1].len != 8 * n || b[2].len != 8 * n || b[3].len != n || b[5].len != 8 * cells
+        || b[6].len != 8 * (cells + 1) || b[7].len < 8 * n || b[8].len < 8 * n) {
+        PyErr_SetString(PyExc_ValueError, "_fast.assemble: inconsistent array sizes");
+        goto done;
+    }
+    memset(state, 0, (size_t)cells);
+    memset(starts, 0, sizeof(int64_t) * (size_t)(cells + 1));
+    for (Py_ssize_t c = 0; c < cells; c++) blocker[c] = -1;
+    for (Py_ssize_t t = 0; t < n; t++) {
+        if (cc[t] < 0 || cc[t] >= cells || cp[t] < 0 || cp[t] >= npieces) {
+            PyErr_SetString(PyExc_ValueError, "_fast.assemble: a cell or piece out of range");
+            goto done;
+        }
+        if (inside[t]) {
+            state[cc[t]] = 2; /* BLOCKED */
+            if (cp[t] > blocker[cc[t]]) blocker[cc[t]] = cp[t];
+        } else {
+            starts[cc[t] + 1]++;
+        }
+    }
+    for (Py_ssize_t c = 0; c < cells; c++) {
+        if (starts[c + 1] && state[c] != 2) state[c] = 1; /* MIXED */
+        starts[c + 1] += starts[c];
+    }
+    int64_t *fill = PyMem_Malloc(sizeof(int64_t) * (size_t)(cells ? cells : 1));
+    if (!fill) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    memcpy(fill, starts, sizeof(int64_t) * (size_t)cells);
+    for (Py_ssize_t t = 0; t < n; t++) { /* by cell, each cell's candidates in entry order... */
+        if (inside[t]) continue;
+        int64_t k = fill[cc[t]]++;
+        cand[k] = cp[t], masks[k] = cm[t];
+    }
+    PyMem_Free(fill);
+    for (Py_ssize_t c = 0; c < cells; c++) { /* ... then by piece (insertion sort: a few each) */
+        for (int64_t k = starts[c] + 1; k < starts[c + 1]; k++) {
+            int64_t p = cand[k], m = masks[k], h = k;
+            for (; h > starts[c] && cand[h - 1] > p; h--) cand[h] = cand[h - 1], masks[h] = masks[h - 1];
+            cand[h] = p, masks[h] = m;
+        }
+    }
+    ok = 1;
+done:
+    for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
+    if (!ok) return NULL;
+    Py_RETURN_NONE;
 }

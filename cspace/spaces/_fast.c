@@ -577,6 +577,8 @@ static PyMethodDef methods[] = {
      "point(grid, x, y): 1 free, 0 not free, -1 undecided."},
     {"orient", (PyCFunction)(void (*)(void))py_orient, METH_FASTCALL,
      "orient(ax, ay, bx, by, cx, cy): the float filter's sign of orient2d, 2 if undecided."},
+    {"assemble", fast_assemble, METH_VARARGS,
+     "assemble(cc, cp, cm, inside, npieces, state, blocker, starts, cand, masks): the grid from its entries (_cells.c)."},
     {"classify", fast_classify, METH_VARARGS,
      "classify(...): the grid build's half-planes and cell classification of boxes of cells (_cells.c)."},
     {"pair_sums", fast_pair_sums, METH_VARARGS,

@@ -81,6 +81,7 @@ PyObject *fast_pair_sums(PyObject *self, PyObject *args);                     /*
 PyObject *fast_contained(PyObject *self, PyObject *args);                     /* _build.c */
 PyObject *fast_chords(PyObject *self, PyObject *args);                        /* _chords.c */
 PyObject *fast_classify(PyObject *self, PyObject *args);                      /* _cells.c */
+PyObject *fast_assemble(PyObject *self, PyObject *args);                      /* _cells.c */
 PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs);  /* _gjk.c */
 
 #endif

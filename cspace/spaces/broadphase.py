@@ -23,6 +23,7 @@ from functools import cached_property
 import numpy as np
 
 from ..kernel.polygon import piece_boxes
+from . import fastpath
 from .cellclass import MASK_EDGES, WIDE_MASK, CellClassifier  # noqa: F401  (the masks: part of the grid's API)
 
 FREE, MIXED, BLOCKED = 0, 1, 2
@@ -108,9 +109,34 @@ class GridIndex(CellClassifier):
         big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] +
                   ([float(max(np.abs(self._lo[full]).max(), np.abs(self._hi[full]).max()))] if full.any() else []))
         self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
+        cc, cp, cm, inside = self._classify_all(pieces)
+        if fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
+            state, blocker = np.empty(nx * ny, np.int8), np.empty(nx * ny, np.int64)
+            starts, cand, masks = np.empty(nx * ny + 1, np.int64), np.empty(len(cc), np.int64), np.empty(len(cc), np.int64)
+            fastpath.assemble(cc, cp, cm, inside, n, state, blocker, starts, cand, masks)
+            cp, cm = cand[: int(starts[-1])], masks[: int(starts[-1])]
+        else:
+            state, blocker, cp, cm, starts = self._assembled(cc, cp, cm, inside, n)
+        self.state = state
+        self.blocker = blocker
+        self._cand = cp
+        self._starts = starts
+        self._masks = cm
+        # Compact copies for the scalar hot path: indexing bytes or an array.array yields
+        # a Python int as cheaply as a list does, and they are built by one copy of the
+        # buffer instead of one Python object per cell (a million cells: ~1 ms, not ~50).
+        # The state bytes serve every point test; the other copies only the Python narrow
+        # phase, so they are made when it first runs (with the compiled path, rarely).
+        self.state_list = state.astype(np.uint8).tobytes()
+        self._rows = None
+        self._sat_rows = None
+
+    def _assembled(self, cc, cp, cm, inside, n: int):
+        """The grid's arrays from its classified (cell, piece, mask, inside) entries:
+        ``(state, blocker, candidates, masks, starts)`` (numpy; ``_fast.assemble`` in C)."""
+        nx, ny = self.nx, self.ny
         state = np.zeros(nx * ny, dtype=np.int8)
         blocker = np.full(nx * ny, -1, dtype=np.int64)
-        cc, cp, cm, inside = self._classify_all(pieces)
         if cc.size:
             # A cell inside a piece is BLOCKED, its blocker the last such piece.
             blk = cc[inside]
@@ -131,19 +157,7 @@ class GridIndex(CellClassifier):
             cp = np.zeros(0, dtype=np.int64)
             cm = np.zeros(0, dtype=np.int64)
             starts = np.zeros(nx * ny + 1, dtype=np.int64)
-        self.state = state
-        self.blocker = blocker
-        self._cand = cp
-        self._starts = starts
-        self._masks = cm
-        # Compact copies for the scalar hot path: indexing bytes or an array.array yields
-        # a Python int as cheaply as a list does, and they are built by one copy of the
-        # buffer instead of one Python object per cell (a million cells: ~1 ms, not ~50).
-        # The state bytes serve every point test; the other copies only the Python narrow
-        # phase, so they are made when it first runs (with the compiled path, rarely).
-        self.state_list = state.astype(np.uint8).tobytes()
-        self._rows = None
-        self._sat_rows = None
+        return state, blocker, cp, cm, starts
 
     @cached_property
     def blocker_list(self) -> array:
