@@ -195,7 +195,7 @@ def test_se2_bundled_scene_matches_pure():
 def _grids_equal(a, b) -> bool:
     return (np.array_equal(a.state, b.state) and np.array_equal(a.blocker, b.blocker)
             and np.array_equal(a._cand, b._cand) and np.array_equal(a._starts, b._starts)
-            and list(a.cand_masks_list) == list(b.cand_masks_list))
+            and list(a.cand_masks_list) == list(b.cand_masks_list) and a.stats() == b.stats())
 
 
 def _both_routes(pieces, bounds, cells, monkeypatch):

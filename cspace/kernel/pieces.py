@@ -12,6 +12,8 @@ length zero).
 """
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 from .polygon import piece_boxes, ring_neighbours
@@ -32,14 +34,20 @@ class PieceSet:
         self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         if self.pieces:  # packed in one pass each (a scene may hold 10^5 pieces)
             self.start = np.concatenate(self.pieces).reshape(-1, 2)
-            self.end = self.start[ring_neighbours(sizes)[1]]
             lo, hi = piece_boxes(self.pieces)
         else:
-            self.start = self.end = np.zeros((0, 2))
+            self.start = np.zeros((0, 2))
             lo = hi = np.zeros((0, 2))
+        self._sizes = sizes
         self.owner = np.repeat(np.arange(len(self.pieces)), sizes)
         self.lo, self.hi = lo, hi
         self._scalar = None
+
+    @cached_property
+    def end(self) -> np.ndarray:
+        """Each edge's end vertex (the next vertex of its piece), made on first use: the
+        compiled fast path never asks for it."""
+        return self.start[ring_neighbours(self._sizes)[1]] if len(self.start) else np.zeros((0, 2))
 
     @property
     def _lists(self) -> list[list]:

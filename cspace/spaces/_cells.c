@@ -124,7 +124,8 @@ done:
     return count < 0 ? NULL : PyLong_FromSsize_t(count);
 }
 
-/* assemble(cc, cp, cm, inside, npieces, out_state, out_blocker, out_starts, out_cand, out_masks) -> None
+/* assemble(cc, cp, cm, inside, npieces, out_state, out_blocker, out_starts, out_cand, out_masks)
+       -> (free, mixed, blocked) cell counts
 
    The grid from its classified (cell, piece, mask, inside) entries, as GridIndex's numpy
    route assembles it: a cell inside a piece is BLOCKED, its blocker the largest such
@@ -193,9 +194,11 @@ PyObject *fast_assemble(PyObject *self, PyObject *args)
             cand[h] = p, masks[h] = m;
         }
     }
+    Py_ssize_t counts[3] = {0, 0, 0};
+    for (Py_ssize_t c = 0; c < cells; c++) counts[state[c]]++;
     ok = 1;
 done:
     for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
     if (!ok) return NULL;
-    Py_RETURN_NONE;
+    return Py_BuildValue("(nnn)", counts[0], counts[1], counts[2]);
 }

@@ -113,10 +113,11 @@ class GridIndex(CellClassifier):
         if fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
             state, blocker = np.empty(nx * ny, np.int8), np.empty(nx * ny, np.int64)
             starts, cand, masks = np.empty(nx * ny + 1, np.int64), np.empty(len(cc), np.int64), np.empty(len(cc), np.int64)
-            fastpath.assemble(cc, cp, cm, inside, n, state, blocker, starts, cand, masks)
+            self._counts = fastpath.assemble(cc, cp, cm, inside, n, state, blocker, starts, cand, masks)
             cp, cm = cand[: int(starts[-1])], masks[: int(starts[-1])]
         else:
             state, blocker, cp, cm, starts = self._assembled(cc, cp, cm, inside, n)
+            self._counts = None
         self.state = state
         self.blocker = blocker
         self._cand = cp
@@ -295,6 +296,6 @@ class GridIndex(CellClassifier):
 
     def stats(self) -> dict:
         """Cell counts by class, for reports."""
-        free, mixed, blocked = np.bincount(self.state, minlength=3).tolist()[:3]
+        free, mixed, blocked = self._counts or np.bincount(self.state, minlength=3).tolist()[:3]
         return {"cells": int(self.nx * self.ny), "grid": [int(self.nx), int(self.ny)],
                 "free": free, "blocked": blocked, "mixed": mixed}

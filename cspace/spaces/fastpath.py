@@ -77,13 +77,14 @@ def gjk_loop():
     return None if _fast is None else _fast.gjk
 
 
-def assemble(*args) -> None:
+def assemble(*args) -> tuple[int, int, int]:
     """``_fast.assemble`` (cspace/spaces/_cells.c): the grid's state, blockers, candidates,
     masks and starts from its classified entries, as GridIndex's numpy route assembles
-    them (cspace/spaces/broadphase.py calls it when :func:`compiled`)."""
+    them (cspace/spaces/broadphase.py calls it when :func:`compiled`); returns the counts of
+    FREE, MIXED and BLOCKED cells."""
     cc, cp, cm, inside, n, *out = args
     i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
-    _fast.assemble(i64(cc), i64(cp), i64(cm), np.ascontiguousarray(inside, dtype=np.uint8), int(n), *out)
+    return _fast.assemble(i64(cc), i64(cp), i64(cm), np.ascontiguousarray(inside, dtype=np.uint8), int(n), *out)
 
 
 def classify_boxes(*args) -> int:
