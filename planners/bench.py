@@ -172,7 +172,6 @@ def run(args) -> int:
     scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
     check_scenarios(objective, held)
     os.makedirs(out, exist_ok=True)
-    _clear_outputs(out)  # never mix two sweeps in one folder
     tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on, objective)
     t0 = time.perf_counter()
     rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
@@ -181,6 +180,9 @@ def run(args) -> int:
             "iterations": args.iterations, "objective": objective, "workers": args.workers, "scheduler": args.scheduler,
             "wall_s": time.perf_counter() - t0, "complete": not interrupted,
             "hard_limit": f"budget * {HARD_FACTOR:g} + {HARD_MARGIN:g} s"}
+    # Never mix two sweeps in one folder: an earlier sweep's outputs go only now, so a sweep
+    # killed before it writes (kill -9, a power cut) leaves the earlier results whole.
+    _clear_outputs(out)
     interrupted = _write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
     if not args.quiet:
         sys.stderr.write(summary(rows) + "\n")

@@ -66,6 +66,24 @@ def test_children_die_with_the_bench(tmp_path, sig):
 
 
 @needs_fork
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="reads /proc")
+def test_a_sweep_killed_before_it_writes_leaves_the_earlier_results(tmp_path):
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "results.json").write_text("earlier")
+    proc = subprocess.Popen([sys.executable, "-m", "planners.cli", "bench", BASIC, "--planners", "RRTstar",
+                             "--times", "20", "--runs", "1", "--workers", "1", "--out", str(out), "-q"],
+                            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 15
+    while not _children(proc.pid) and time.time() < deadline:
+        time.sleep(0.1)
+    assert _children(proc.pid), "the run did not start"
+    proc.kill()
+    proc.wait(timeout=10)
+    assert (out / "results.json").read_text() == "earlier"
+
+
+@needs_fork
 def test_forked_run_past_its_hard_limit_is_a_timeout_and_a_crash_is_recorded():
     from cspace import CSpace, load_scenario
     from planners.bench_pool import run_forked
