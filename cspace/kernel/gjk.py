@@ -70,6 +70,12 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS, *, loop=None) -> Di
     >>> gjk_distance([[0, 0], [1, 0], [1, 1], [0, 1]], [[1, 0], [2, 0], [2, 1], [1, 1]]).status
     'touching'
     """
+    if loop is not None and _plain(A) and _plain(B):  # the compiled loop checks finiteness itself
+        a, b = _open(A), _open(B)
+        raw = loop(a, b, max_iterations)
+        if raw is not None and SAFE_MIN <= raw[7] < SAFE_MAX:
+            ox, oy = a[0].tolist()
+            return _answer(a, b, ox, oy, raw[7], _outcome(*raw))
     a = as_array(A, copy=False, nonempty=True)  # only read: no copy
     b = as_array(B, copy=False, nonempty=True)
     ox, oy = a[0].tolist()
@@ -109,6 +115,19 @@ def _answer(a: np.ndarray, b: np.ndarray, ox: float, oy: float, extent: float, r
             dist, pa, pb = _exact_distance(a, b, a[0])
     return Distance(float(dist), np.array((pa[0] + ox, pa[1] + oy)), np.array((pb[0] + ox, pb[1] + oy)),
                     it, "separated")
+
+
+def _plain(A) -> bool:
+    """A non-empty (N, 2) float64 array: what as_array would pass through (bar NaN and
+    infinities, which the compiled loop reports by returning None)."""
+    return type(A) is np.ndarray and A.dtype == np.float64 and A.ndim == 2 and A.shape[1] == 2 and len(A) > 0
+
+
+def _open(a: np.ndarray) -> np.ndarray:
+    """``a`` without a closing repeat of its first vertex, as as_array gives it."""
+    if len(a) > 1 and a[0, 0] == a[-1, 0] and a[0, 1] == a[-1, 1]:
+        return a[:-1]
+    return a
 
 
 def gjk_intersects(A, B) -> bool:

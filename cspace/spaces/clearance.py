@@ -185,7 +185,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # The broad phase over the whole path at once: the box of every (segment, robot piece)
     # sweep against every obstacle box, the pairs then visited by increasing box distance
     # (a lower bound) until it reaches the best distance found.
-    a, b = np.array([s[0] for s in segs]), np.array([s[1] for s in segs])
+    a, b = (pts[:-1], pts[1:]) if len(pts) > 1 else (pts, pts)  # the segments' ends, as rows
     rlo = np.array([r.min(axis=0) for r in rob])
     rhi = np.array([r.max(axis=0) for r in rob])
     lo = (np.minimum(a, b)[:, None, :] + rlo[None, :, :]).reshape(-1, 2)  # (segment, piece) rows
