@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernel.union import union as checked_union
+
 SLIVER = 1e-6  # relative to the scene's size (squared for areas)
 MITRE = 10.0
 
@@ -80,7 +82,7 @@ def footprint(tri: np.ndarray, sliver: float = SLIVER):
     if len(tri) == 0:
         return shapely.Polygon(), info
     polys = shapely.polygons(np.concatenate((tri, tri[:, :1]), axis=1))
-    union = shapely.union_all(polys)
+    union = checked_union(polys)
     info["vertices_before"] = _vertices(union)
     s = sliver * size
     parts = []
@@ -88,7 +90,7 @@ def footprint(tri: np.ndarray, sliver: float = SLIVER):
         holes = [h for h in p.interiors if not _slit(shapely.Polygon(h), s, size)]
         info["holes_filled"] += len(p.interiors) - len(holes)
         parts.append(shapely.Polygon(p.exterior, holes))
-    filled = shapely.union_all(parts)
+    filled = checked_union(parts)
     exact = shapely.simplify(filled, 0.0)  # exactly collinear vertices only: the same set
     simple = shapely.simplify(filled, s, preserve_topology=True)
     if _vertices(simple) < _vertices(exact):  # near-collinear vertices: removed, and the loss covered

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernel.union import union
 from .schema import Scenario
 
 
@@ -29,7 +30,7 @@ class CollisionProbe:
         if self._tree is None:
             return None
         if self._sc.robot:
-            body = shapely.union_all([shapely.Polygon(p) for p in self._sc.robot_at(x, y, theta)])
+            body = union([shapely.Polygon(p) for p in self._sc.robot_at(x, y, theta)])
         else:
             body = shapely.Point(x, y)
         hits = self._tree.query(body, predicate="intersects")

@@ -27,6 +27,7 @@ from .decompose import convex_decompose, decompose_normalized
 from .pairsums import pairwise_sums
 from .polygon import as_array, collinear_extent, is_convex, normalize, prev_next
 from .scaling import scaled_copies
+from .union import union
 
 
 def minkowski_pieces(A, B, holes_a=None, holes_b=None) -> list[np.ndarray]:
@@ -61,7 +62,7 @@ def minkowski_sum_nonconvex(A, B, holes_a=None, holes_b=None):
 
     parts_a, parts_b = _parts(A, holes_a, "A"), _parts(B, holes_b, "B")
     sums = [_sum(a, ha, b, hb) for a, ha in parts_a for b, hb in parts_b]
-    return _multipolygon(sums[0] if len(sums) == 1 else shapely.union_all(sums))
+    return _multipolygon(sums[0] if len(sums) == 1 else union(sums))
 
 
 def _parts(P, holes, name: str) -> list:
@@ -113,7 +114,7 @@ def _sum(A, holes_a, B, holes_b):
         X, holes_x, x_convex, Q = route
         pieces = [X] if x_convex else decompose_normalized(X, holes_x)
         if all(len(p) >= 3 for p in pieces):
-            return shapely.union_all(convex_sums_with(pieces, Q))
+            return union(convex_sums_with(pieces, Q))
     return _union_of_pairwise_sums(A, holes_a, B, holes_b)
 
 
@@ -186,4 +187,4 @@ def _union_of_pairwise_sums(A, holes_a, B, holes_b):
     # Union row by row (row i is A_i ⊕ B: pieces that overlap a lot), then the rows:
     # GEOS's cascaded union is about twice as fast this way as on the flat list.
     rows = shapely.union_all(polys.reshape(len(pa), len(pb)), axis=1)
-    return shapely.union_all(rows)
+    return union(polys, first=shapely.union_all(rows))  # checked against every pairwise sum

@@ -25,6 +25,7 @@ from .hull import convex_hull
 from .minkowski import minkowski_sum
 from .polygon import as_array
 from .predicates import orient2d_xy
+from .union import union as checked_union
 
 TWO_PI = 2.0 * math.pi
 # Every slab's hull interval is widened by this much on both sides, so an angle within
@@ -302,7 +303,7 @@ def inscribed_radius(robot_parts: list[np.ndarray]) -> float:
     polys = [Polygon(as_array(p)) for p in robot_parts if len(p) >= 3]
     if not polys:
         return 0.0
-    union = shapely.union_all(polys)
+    union = checked_union(polys)
     origin = Point(0.0, 0.0)
     if not union.covers(origin):
         return 0.0

@@ -35,6 +35,8 @@ from typing import Callable
 
 import numpy as np
 
+from ..kernel.union import union
+
 
 @dataclass
 class ShortestPath:
@@ -65,8 +67,9 @@ def free_space(pieces: list, bounds) -> "object":
     polys = [shapely.Polygon(p) for p in split_pieces(pieces)[0]]
     if not polys:
         return box
-    return shapely.orient_polygons(box.difference(shapely.union_all(polys))) \
-        if hasattr(shapely, "orient_polygons") else _orient(box.difference(shapely.union_all(polys)))
+    taken = union(polys)  # checked (cspace.kernel.union): GEOS's float overlay can drop a piece
+    return shapely.orient_polygons(box.difference(taken)) if hasattr(shapely, "orient_polygons") \
+        else _orient(box.difference(taken))
 
 
 def _orient(geom):
