@@ -10,7 +10,7 @@ import math
 import random
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from cspace.spaces.car_curves import (
@@ -235,6 +235,7 @@ radii = st.floats(0.05, 20.0)
 
 @settings(max_examples=150, deadline=None)
 @given(poses, poses, radii)
+@example((0.0, 0.0, 0.0), (1e-06, 0.0, 1e-06), 1.0)  # found in CI: Dubins' one arc ends 5e-13 aside
 def test_length_bounds_and_symmetry(q0, q1, r):
     dub = curve_length(dubins_segments(q0, q1, r))
     rs = curve_length(reeds_shepp_segments(q0, q1, r))
@@ -244,12 +245,16 @@ def test_length_bounds_and_symmetry(q0, q1, r):
     # Reverse gears only add options; no car is shorter than the straight line; a Reeds–Shepp
     # path driven backwards in time is a path from q1 to q0; the heading must change by its
     # angle, at least r per radian of turn. (OMPL's near-coincident Dubins rule is a straight
-    # step, shorter than any real path sideways: those pairs are left out of the Dubins bounds.)
+    # step, shorter than any real path sideways: those pairs are left out of the Dubins bounds.
+    # Between poses closer than 1e-3 radii Dubins' curve may end up to 2e-6 radii short of q1,
+    # as OMPL's does (car_curves' docstring), and a car pays about the square root of a sideways
+    # offset to close it: there it bounds no curve that ends at q1, and rs <= dub is not asked.)
     assert gap <= rs + tol
     assert rs == pytest.approx(rs_back, rel=1e-9, abs=tol)
     assert rs >= r * angle_gap(q0[2], q1[2]) - tol
-    if not is_near_coincident(q0, q1, r):
+    if not is_close(q0, q1, r):
         assert rs <= dub + tol
+    if not is_near_coincident(q0, q1, r):
         assert dub >= r * angle_gap(q0[2], q1[2]) - tol
 
 
