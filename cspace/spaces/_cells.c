@@ -9,8 +9,9 @@
    chord's sagitta for chord polygons), d = (x_off + i cw) n_x + (y_off + j ch) n_y - c.
    A cell is inside when d <= -m - hi for every edge, separated when d >= m - lo for one;
    its mask sums the weights (bit (i + 1) mod size, 0 for wide pieces) of the edges it is
-   not strictly inside. Cells not separated are written (row, i, j, inside, mask), piece
-   by piece, row-major. No filter and no rounding argument of its own: the numpy route's
+   not strictly inside. Cells not separated are written (piece id, cell j nx + i, inside,
+   mask; WIDE_MASK for wide pieces), piece by piece, row-major: the entries
+   CellClassifier._gathered makes of the numpy route's. No filter and no rounding argument of its own: the numpy route's
    doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum and
    minimum propagate them: no cell is inside or separated by such an edge.
 
@@ -27,36 +28,40 @@ static inline double max0(double x) { return (x >= 0.0 || isnan(x)) ? x : 0.0; }
 static inline double min0(double x) { return (x <= 0.0 || isnan(x)) ? x : 0.0; }
 
 /* classify(Q, sizes, sag, wide, rows, i0, i1, j0, j1, x_off, y_off, cw, ch, m,
-            out_row, out_i, out_j, out_inside, out_mask) -> count
+            ids, nx, wide_mask, out_piece, out_cell, out_inside, out_mask) -> count
 
    Q: float64 K x E x 2; sizes: int64 K; sag: float64 K x E, or empty (no chords);
-   wide: uint8 K (WIDE pieces: weights 0); rows: int64, the pieces to classify; i0..j1:
-   int64 K, each piece's box of cells; outputs: room for the rows' boxes' cells. */
+   wide: uint8 K (WIDE pieces: weights 0, mask wide_mask); rows: int64, the pieces to
+   classify; i0..j1: int64 K, each piece's box of cells; ids: int64 K, each piece's id
+   in the grid; nx: the grid's columns; outputs: room for the rows' boxes' cells. */
 PyObject *fast_classify(PyObject *self, PyObject *args)
 {
     PyObject *o[14];
     double x_off, y_off, cw, ch, m;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOdddddOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &o[7],
-                          &o[8], &x_off, &y_off, &cw, &ch, &m, &o[9], &o[10], &o[11], &o[12], &o[13]))
+    long long gnx, wide_mask;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOdddddOLLOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &o[7],
+                          &o[8], &x_off, &y_off, &cw, &ch, &m, &o[9], &gnx, &wide_mask, &o[10], &o[11], &o[12],
+                          &o[13]))
         return NULL;
     Py_buffer b[14];
     int got = 0;
     Py_ssize_t count = -1;
     double *hp = NULL;
     for (; got < 14; got++) {
-        int flags = got >= 9 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
+        int flags = got >= 10 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
         if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
     }
     const double *Q = b[0].buf, *sag = b[2].buf;
     const int64_t *sizes = b[1].buf, *rows = b[4].buf, *i0 = b[5].buf, *i1 = b[6].buf, *j0 = b[7].buf, *j1 = b[8].buf;
+    const int64_t *ids = b[9].buf;
     const uint8_t *wide = b[3].buf;
-    int64_t *orow = b[9].buf, *oi = b[10].buf, *oj = b[11].buf, *omask = b[13].buf;
+    int64_t *opiece = b[10].buf, *ocell = b[11].buf, *omask = b[13].buf;
     uint8_t *oin = b[12].buf;
-    Py_ssize_t K = b[1].len / 8, R = b[4].len / 8, cap = b[9].len / 8;
+    Py_ssize_t K = b[1].len / 8, R = b[4].len / 8, cap = b[10].len / 8;
     Py_ssize_t E = K ? b[0].len / 16 / K : 0;
     int has_sag = b[2].len > 0;
     if (b[0].len != 16 * K * E || (has_sag && b[2].len != 8 * K * E) || b[3].len != K || b[5].len != 8 * K
-        || b[6].len != 8 * K || b[7].len != 8 * K || b[8].len != 8 * K || b[10].len != 8 * cap
+        || b[6].len != 8 * K || b[7].len != 8 * K || b[8].len != 8 * K || b[9].len != 8 * K
         || b[11].len != 8 * cap || b[12].len != cap || b[13].len != 8 * cap) {
         PyErr_SetString(PyExc_ValueError, "_fast.classify: inconsistent array sizes");
         goto done;
@@ -112,7 +117,8 @@ PyObject *fast_classify(PyObject *self, PyObject *args)
                     PyErr_SetString(PyExc_ValueError, "_fast.classify: outputs too small");
                     goto done;
                 }
-                orow[n] = r, oi[n] = i, oj[n] = j, oin[n] = (uint8_t)inside, omask[n] = mask;
+                opiece[n] = ids[r], ocell[n] = j * (int64_t)gnx + i, oin[n] = (uint8_t)inside;
+                omask[n] = wide[r] ? (int64_t)wide_mask : mask;
                 n++;
             }
         }
@@ -171,22 +177,21 @@ PyObject *fast_assemble(PyObject *self, PyObject *args)
             starts[cc[t] + 1]++;
         }
     }
+    /* starts[c + 1] becomes the first slot of cell c (the counts' exclusive prefix sums); placing
+       cell c's candidates advances it to cell c's end, which is cell c + 1's start: the
+       counting sort needs no cursor array of its own. */
+    int64_t run = 0;
     for (Py_ssize_t c = 0; c < cells; c++) {
-        if (starts[c + 1] && state[c] != 2) state[c] = 1; /* MIXED */
-        starts[c + 1] += starts[c];
+        int64_t count = starts[c + 1];
+        if (count && state[c] != 2) state[c] = 1; /* MIXED */
+        starts[c + 1] = run;
+        run += count;
     }
-    int64_t *fill = PyMem_Malloc(sizeof(int64_t) * (size_t)(cells ? cells : 1));
-    if (!fill) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    memcpy(fill, starts, sizeof(int64_t) * (size_t)cells);
     for (Py_ssize_t t = 0; t < n; t++) { /* by cell, each cell's candidates in entry order... */
         if (inside[t]) continue;
-        int64_t k = fill[cc[t]]++;
+        int64_t k = starts[cc[t] + 1]++;
         cand[k] = cp[t], masks[k] = cm[t];
     }
-    PyMem_Free(fill);
     for (Py_ssize_t c = 0; c < cells; c++) { /* ... then by piece (insertion sort: a few each) */
         for (int64_t k = starts[c] + 1; k < starts[c + 1]; k++) {
             int64_t p = cand[k], m = masks[k], h = k;

@@ -90,7 +90,7 @@ class GridIndex(CellClassifier):
             cells = int(min(max(CELLS_PER_PIECE * n, MIN_CELLS), 1 << 20)) if n else 1  # no piece: one FREE cell
             # Large, overlapping pieces (comb sums) would each cover a big share of that
             # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
-            cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist())
+            cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist()) if n else 0.0
             if cover * cells > _PAIR_BUDGET:
                 cells = max(int(_PAIR_BUDGET / cover), 1 << 12)
         nx = max(1, min(4096, int(round(math.sqrt(cells * w / h)))))
@@ -109,14 +109,18 @@ class GridIndex(CellClassifier):
         big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] +
                   ([float(max(np.abs(self._lo[full]).max(), np.abs(self._hi[full]).max()))] if full.any() else []))
         self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
-        cc, cp, cm, inside = self._classify_all(pieces)
-        if fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
+        if not n:  # nothing to classify: every cell FREE
+            cp = cm = np.zeros(0, np.int64)
+            state, blocker, starts = np.zeros(nx * ny, np.int8), np.full(nx * ny, -1, np.int64), np.zeros(nx * ny + 1, np.int64)
+            self._counts = (nx * ny, 0, 0)
+        elif fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
+            cc, cp, cm, inside = self._classify_all(pieces)
             state, blocker = np.empty(nx * ny, np.int8), np.empty(nx * ny, np.int64)
             starts, cand, masks = np.empty(nx * ny + 1, np.int64), np.empty(len(cc), np.int64), np.empty(len(cc), np.int64)
             self._counts = fastpath.assemble(cc, cp, cm, inside, n, state, blocker, starts, cand, masks)
             cp, cm = cand[: int(starts[-1])], masks[: int(starts[-1])]
         else:
-            state, blocker, cp, cm, starts = self._assembled(cc, cp, cm, inside, n)
+            state, blocker, cp, cm, starts = self._assembled(*self._classify_all(pieces), n)
             self._counts = None
         self.state = state
         self.blocker = blocker

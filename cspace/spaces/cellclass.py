@@ -54,28 +54,30 @@ def _runs(rows: np.ndarray, jj: np.ndarray, lo: np.ndarray, hi: np.ndarray):
 
 
 
-def _compiled_boxes(rows, cells, Q, sizes, sag, wide, i0, i1, j0, j1, x_off, y_off, cw, ch, m) -> list:
+def _compiled_boxes(rows, cells, Q, sizes, sag, wide, i0, i1, j0, j1, x_off, y_off, cw, ch, m, ids, nx) -> list:
     """The compiled route of :meth:`CellClassifier._classify_many`: the half-planes of the
     pieces ``rows`` and every cell of their boxes evaluated by ``_fast.classify`` (the numpy
-    route's arithmetic, in C), in chunks of at most 2^21 cells; parts ``(row, i, j, inside,
-    mask)`` of the kept cells."""
+    route's arithmetic, in C), in chunks of at most 2^21 cells; parts ``(piece, cell,
+    inside, mask)`` of the kept cells (``ids``: each row's piece; ``nx``: the grid's
+    columns), the entries :meth:`CellClassifier._gathered` makes of the numpy route's."""
     out = []
     f64, i64 = np.ascontiguousarray, lambda a: np.ascontiguousarray(a, dtype=np.int64)
     Q, sizes, wide = f64(Q, dtype=np.float64), i64(sizes), np.ascontiguousarray(wide, dtype=np.uint8)
     sag = np.zeros(0) if sag is None else f64(sag, dtype=np.float64)
-    i0, i1, j0, j1 = i64(i0), i64(i1), i64(j0), i64(j1)
+    i0, i1, j0, j1, ids = i64(i0), i64(i1), i64(j0), i64(j1), i64(ids)
+    # Chunks of consecutive rows of at most 2^21 cells (a bigger row alone).
+    ends = np.cumsum(cells[rows])
     start = 0
     while start < len(rows):
-        stop, cap = start, 0
-        while stop < len(rows) and (stop == start or cap + cells[rows[stop]] <= 1 << 21):
-            cap += int(cells[rows[stop]])
-            stop += 1
+        base = int(ends[start - 1]) if start else 0
+        stop = max(start + 1, int(np.searchsorted(ends, base + (1 << 21), side="right")))
+        cap = int(ends[stop - 1]) - base
         chunk = i64(rows[start:stop])
-        o = [np.empty(cap, dtype=np.int64) for _ in range(3)] + [np.empty(cap, dtype=np.uint8),
-                                                                 np.empty(cap, dtype=np.int64)]
-        n = fastpath.classify_boxes(Q, sizes, sag, wide, chunk, i0, i1, j0, j1,
-                                    float(x_off), float(y_off), float(cw), float(ch), float(m), *o)
-        out.append((o[0][:n], o[1][:n], o[2][:n], o[3][:n].astype(bool), o[4][:n]))
+        o = [np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.uint8),
+             np.empty(cap, dtype=np.int64)]
+        n = fastpath.classify_boxes(Q, sizes, sag, wide, chunk, i0, i1, j0, j1, float(x_off), float(y_off),
+                                    float(cw), float(ch), float(m), ids, int(nx), WIDE_MASK, *o)
+        out.append((o[0][:n], o[1][:n], o[2][:n].view(bool), o[3][:n]))
         start = stop
     return out
 
@@ -176,8 +178,13 @@ class CellClassifier:
         E = int(sizes.max())
         K = len(ks)
         Q = np.zeros((K, E, 2))
-        for r, k in enumerate(ks):
-            Q[r, : sizes[r]] = pieces[k]
+        if K < 16:
+            for r, k in enumerate(ks):
+                Q[r, : sizes[r]] = pieces[k]
+        else:  # one scatter of all the vertices
+            first = np.cumsum(sizes) - sizes
+            Q[np.repeat(np.arange(K), sizes), np.arange(int(first[-1] + sizes[-1])) - np.repeat(first, sizes)] = \
+                np.concatenate([pieces[k] for k in ks])
         Q -= (self.ox, self.oy)
         # Pieces wider than MASK_EDGES get WIDE_MASK (their cells' masks on demand).
         wide = sizes > MASK_EDGES
@@ -195,16 +202,16 @@ class CellClassifier:
         W = np.maximum(i1 - i0 + 1, 0)
         H = np.maximum(j1 - j0 + 1, 0)
         x_off, y_off, cw, ch = self.x0 - self.ox, self.y0 - self.oy, self.cw, self.ch
-        parts = []
+        parts, done = [], []
         narrow_box = W <= SCAN_COLUMNS
         if fastpath.compiled() and self.compiled:  # every box up to 2^20 cells in C, the same doubles
             small = (W * H > 0) & (W * H <= 1 << 20)
-            parts += _compiled_boxes(np.flatnonzero(small), W * H, Q, sizes, sag, wide, i0, i1, j0, j1,
-                                     x_off, y_off, cw, ch, m)
+            done = _compiled_boxes(np.flatnonzero(small), W * H, Q, sizes, sag, wide, i0, i1, j0, j1,
+                                   x_off, y_off, cw, ch, m, ks, self.nx)
             narrow_box = narrow_box & ~small
             H = np.where(small, 0, H)
         if not (narrow_box & (W * H > 0)).any() and not (~narrow_box & (H > 0)).any():
-            return self._gathered(parts, ks, wide)
+            return self._joined(done)
         slot = np.arange(E)
         valid = slot[None, :] < sizes[:, None]
         nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
@@ -261,18 +268,24 @@ class CellClassifier:
         scan = np.flatnonzero(~narrow_box & (H > 0))
         if len(scan):
             parts += self._scan_rows(scan, i0, i1, j0, H, nrm, c, hi, lo, evaluate)
-        return self._gathered(parts, ks, wide)
+        return self._joined(done + ([self._gathered(parts, ks, wide)] if parts else []))
 
-    def _gathered(self, parts: list, ks: list[int], wide: np.ndarray):
-        """:meth:`_classify_many`'s answer from its parts ``(row, i, j, inside, mask)``."""
-        if not parts:
-            z = np.zeros(0, dtype=np.int64)
-            return z, z, np.zeros(0, dtype=bool), z
+    def _gathered(self, parts: list, ks: list[int], wide: np.ndarray) -> tuple:
+        """Entries ``(piece, cell, inside, mask)`` from the numpy route's parts ``(row, i, j,
+        inside, mask)``."""
         row, ii, jj, inside, masks = parts[0] if len(parts) == 1 else (np.concatenate(x) for x in zip(*parts))
         pid = np.asarray(ks, dtype=np.int64)[row]
         if wide.any():
             masks = np.where(wide[row], np.int64(WIDE_MASK), masks)
         return pid, jj * self.nx + ii, inside, masks
+
+    @staticmethod
+    def _joined(parts: list) -> tuple:
+        """:meth:`_classify_many`'s answer ``(piece, cell, inside, mask)`` from its parts."""
+        if not parts:
+            z = np.zeros(0, dtype=np.int64)
+            return z, z, np.zeros(0, dtype=bool), z
+        return parts[0] if len(parts) == 1 else tuple(np.concatenate(x) for x in zip(*parts))
 
     def _scan_rows(self, pieces, i0, i1, j0, H, nrm, c, hi, lo, evaluate) -> list:
         """:meth:`_classify_many`'s cells of wide boxes, row by row, the same answers.
