@@ -122,6 +122,8 @@ class CellClassifier:
         if not cand_cells:
             z = np.zeros(0, dtype=np.int64)
             return z, z, z, np.zeros(0, dtype=bool)
+        if len(cand_cells) == 1:  # one group: its arrays as they are (a copy costs fresh pages)
+            return cand_cells[0], cand_piece[0], cand_mask[0], inside_parts[0]
         return (np.concatenate(cand_cells), np.concatenate(cand_piece), np.concatenate(cand_mask),
                 np.concatenate(inside_parts))
 

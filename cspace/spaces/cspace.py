@@ -91,9 +91,9 @@ class CSpace(PointQueries, SegmentQueries):
         self.packed = PieceSet(self.pieces)
         self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells, boxes=(self.packed.lo, self.packed.hi))
         self._coarse = None
-        self.stages.append(Stage("index", True, time.perf_counter() - t, self.index.stats()))
-        # The compiled fast path's copy of the grid and pieces (None on the pure path).
+        # The compiled fast path's copy of the grid and pieces (None on the pure path): part of the index.
         self._fast = fastpath.grid_handle(self.index, self.packed, self.bounds)
+        self.stages.append(Stage("index", True, time.perf_counter() - t, self.index.stats()))
         self.checks = {"points": 0, "segments": 0, "exact_points": 0, "exact_segments": 0}
         self._points = itertools.count()
         self._batch_points = 0  # points answered by is_free on arrays
