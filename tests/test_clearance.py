@@ -450,8 +450,9 @@ def test_tighter_bounds_change_nothing_but_the_work(seed, monkeypatch):
         o = obstacles[0]
         path = np.vstack([path[:3], o, path[-2:]])
     calls = []
-    real = cl.gjk_distance
+    real, real_below = cl.gjk_distance, cl.gjk_distance_below
     monkeypatch.setattr(cl, "gjk_distance", lambda *x, **k: calls.append(1) or real(*x, **k))
+    monkeypatch.setattr(cl, "gjk_distance_below", lambda *x, **k: calls.append(1) or real_below(*x, **k))
     fast = cl.path_clearance(path, robot, obstacles)
     n_fast = len(calls)
     monkeypatch.setattr(cl, "_tighter_bounds", lambda lbs, *rest: lbs)
@@ -480,10 +481,12 @@ def test_tighter_bounds_prune_a_margin_path():
     sc = res.scenario_data
     cs = CSpace.from_scenario(sc)
     calls = []
-    real = cl.gjk_distance
+    real, real_below = cl.gjk_distance, cl.gjk_distance_below
     cl_gjk = lambda *x, **k: calls.append(1) or real(*x, **k)  # noqa: E731
+    cl_below = lambda *x, **k: calls.append(1) or real_below(*x, **k)  # noqa: E731
     mp = pytest.MonkeyPatch()
     mp.setattr(cl, "gjk_distance", cl_gjk)
+    mp.setattr(cl, "gjk_distance_below", cl_below)
     try:
         fast = cl.path_clearance(res.path, cs.robot_pieces, cs.obstacle_pieces)
         n_fast = len(calls)

@@ -99,6 +99,33 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS, *, loop=None) -> Di
     return _answer(a, b, ox, oy, extent, _gjk(al, bl, max_iterations))
 
 
+def gjk_distance_below(A, B, bound: float, *, loop=None) -> Distance | None:
+    """:func:`gjk_distance` of A and B, or None when the compiled ``loop`` shows the sets
+    separated by at least ``bound`` (outside the exact band: the distance gjk_distance
+    would return, to the bit, is not below ``bound``). A search for the nearest of many
+    pairs skips building the answers of those that cannot win.
+
+    >>> sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1]])
+    >>> from cspace.spaces.fastpath import gjk_loop
+    >>> far = gjk_distance_below(sq, sq + 3, 1.0, loop=gjk_loop())
+    >>> far is None if gjk_loop() else far.distance == gjk_distance(sq, sq + 3).distance
+    True
+    >>> gjk_distance_below(sq, sq + 3, 9.0, loop=gjk_loop()).distance == gjk_distance(sq, sq + 3).distance
+    True
+    """
+    if loop is not None and _plain(A) and _plain(B):
+        a, b = _open(A), _open(B)
+        raw = loop(a, b, MAX_ITERATIONS)
+        if raw is not None and SAFE_MIN <= raw[7] < SAFE_MAX:
+            if not raw[5]:  # not inside: gjk_distance returns this distance unless in the exact band
+                dist = math.hypot(raw[0] - raw[2], raw[1] - raw[3])
+                if dist >= bound and dist > EXACT_BAND * raw[7]:
+                    return None
+            ox, oy = a[0].tolist()
+            return _answer(a, b, ox, oy, raw[7], _outcome(*raw))
+    return gjk_distance(A, B, loop=loop)
+
+
 def _answer(a: np.ndarray, b: np.ndarray, ox: float, oy: float, extent: float, result) -> Distance:
     """The Distance from :func:`_gjk`'s result (local frame, origin (ox, oy) = a[0]): the
     exact relation where the float distance is within its error band of zero."""

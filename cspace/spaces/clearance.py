@@ -37,7 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..kernel.gjk import gjk_distance
+from ..kernel.gjk import gjk_distance, gjk_distance_below
 from . import fastpath
 
 ANGLE_STEP = 1e-3  # SE(2): radians of turn below which a sub-motion is not split further
@@ -98,8 +98,9 @@ class Nearest:
         for k in cand[np.argsort(lb[cand], kind="stable")].tolist():
             if lb[k] >= best:
                 break
-            d = gjk_distance(pts, self.pieces[k], loop=self.loop)
-            if d.distance < best or k_best < 0 and d.distance <= best:
+            d = gjk_distance_below(pts, self.pieces[k], best if k_best >= 0 else math.nextafter(best, math.inf),
+                                   loop=self.loop)
+            if d is not None and (d.distance < best or k_best < 0 and d.distance <= best):
                 best, k_best, w_best = d.distance, k, d.point_b
                 if best == 0.0:
                     break
@@ -212,6 +213,9 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     slack = TIE * max(float(np.abs(pts).max()), float(np.abs(obs.lo).max()), float(np.abs(obs.hi).max()))
     queue, pos, measured = np.argsort(lbs, kind="stable").tolist(), 0, 0
     still = (a == b).all(axis=1).tolist()  # a segment of one point sweeps the piece itself
+    # Each robot piece placed at every path point: a segment's swept point set is two
+    # consecutive placements, one contiguous block (a view, no copy).
+    placed = [(r[None, :, :] + pts[:, None, :]).reshape(-1, 2) for r in rob]
     while pos < len(queue):
         t = queue[pos]
         pos += 1
@@ -219,11 +223,10 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
             break
         row, k = int(rows[t]), int(ks[t])
         i, j = divmod(row, nr)
-        p0, p1 = segs[i]
-        r = rob[j]
-        swept = r + p0 if still[i] else np.concatenate([r + p0, r + p1])
-        d = gjk_distance(swept, obs.pieces[k], loop=obs.loop)
-        if d.distance < best or arg is None:
+        nv = len(rob[j])
+        swept = placed[j][i * nv:(i + 1 if still[i] else i + 2) * nv]
+        d = gjk_distance_below(swept, obs.pieces[k], best if arg is not None else math.inf, loop=obs.loop)
+        if d is not None and (d.distance < best or arg is None):
             best, arg = d.distance, (i, j, k, d.point_b)
             if best == 0.0:
                 break
