@@ -26,7 +26,7 @@ _NAMES = {
     "convex_decompose": "kernel.decompose",
     "pairwise_sums": "kernel.pairsums",
     "convolution_cycles": "kernel.convolution", "convex_sums_with": "kernel.convolution",
-    "minkowski_pieces": "kernel.nonconvex", "minkowski_sum_nonconvex": "kernel.nonconvex",
+    "minkowski_pieces": "kernel.nonconvex", "minkowski_sum_nonconvex": "kernel.nonconvex", "UnionError": "kernel.union",
     "CSpace": "spaces.cspace", "decompose_obstacles": "spaces.cspace_build", "decompose_robot": "spaces.cspace_build",
     "rotate": "kernel.slab", "rotate_piece": "kernel.slab", "wrap_angle": "kernel.slab", "slab_hull": "kernel.slab", "slab_inner": "kernel.slab",
     "slab_pad": "kernel.slab", "slab_of": "kernel.slab", "slab_range": "kernel.slab", "inscribed_radius": "kernel.slab",

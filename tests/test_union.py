@@ -77,10 +77,14 @@ def test_a_failing_float_union_is_taken_again_with_snap_rounding(monkeypatch):
 
 
 def test_a_union_wrong_both_ways_raises(monkeypatch):
+    import cspace
+
     a, b = shapely.box(0, 0, 2, 2), shapely.box(1, 1, 3, 3)
     monkeypatch.setattr(shapely, "union_all", lambda polys, **kw: polys[0])
-    with pytest.raises(UnionError, match="failed its check"):
+    with pytest.raises(cspace.UnionError, match="failed its check"):
         union([a, b])
+    with pytest.raises(UnionError):  # and through the public sum: never the wrong region
+        minkowski_sum_nonconvex(ROTATED_COMB, ROTATED_COMB)
 
 
 boxes = st.tuples(st.integers(-20, 20), st.integers(-20, 20), st.integers(1, 15), st.integers(1, 15))
