@@ -69,6 +69,19 @@ def test_containment_pruning_equals_the_scan(seed):
     assert want and _contained_pieces(pieces) == want
 
 
+def test_containment_pruning_of_a_fan_equals_the_scan():
+    # Wedges from one centre (a star's spikes, as decomposed) share their inner vertex: each
+    # piece stands for itself by its far vertex; nested half-wedges must still be found.
+    k = 60
+    a = np.linspace(0, 2 * np.pi, k, endpoint=False)
+    wedges = [np.array([[0.0, 0.0], [10 * np.cos(t), 10 * np.sin(t)], [10 * np.cos(t + 0.2), 10 * np.sin(t + 0.2)]])
+              for t in a]
+    nested = [0.5 * w for w in wedges[::7]] + [wedges[3].copy()]
+    pieces = wedges + nested
+    want = contained_reference(pieces)
+    assert len(want) == len(nested) and _contained_pieces(pieces) == want
+
+
 def test_pair_sums_equal_minkowski_sum():
     rng = np.random.default_rng(3)
     obs = random_pieces(rng, 40) + [np.array([[np.cos(t), np.sin(t)] for t in np.linspace(0, 6.2, 90)])]

@@ -116,19 +116,28 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
     order = np.argsort(lo[:, 0], kind="stable")
     removed: dict[int, int] = {}
     # Pairs (q, p), p != q, whose box lies inside q's box (closed), each q's in the order of
-    # ``order``. A piece inside q has its first vertex in q: an STRtree of the pieces
-    # proposes the pieces holding each first vertex (near-linear, where boxes of long
-    # thin pieces overlap by the thousand), the exact box comparisons and the exact
-    # vertex test below decide. (Pieces of fewer than 3 vertices: boxes covering boxes.)
+    # ``order``. A piece inside q has every vertex in q, so one vertex stands for it: an
+    # STRtree of those points proposes the pieces holding each (near-linear, where boxes of
+    # long thin pieces overlap by the thousand), the exact box comparisons and the exact
+    # vertex test below decide. The vertex is the one farthest from the middle of the
+    # pieces' boxes: pieces fanning out from one place (a star's spikes) share their inner
+    # vertices with many others, while their far ends lie in few. (Pieces of fewer than 3
+    # vertices: boxes covering boxes.)
     import shapely
 
     sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
     if (sizes >= 3).all():
-        rings = shapely.linearrings(np.concatenate(pieces), indices=np.repeat(np.arange(n), sizes))
-        firsts = shapely.points(np.array([p[0] for p in pieces]))
+        flat = np.concatenate(pieces)
+        rings = shapely.linearrings(flat, indices=np.repeat(np.arange(n), sizes))
+        mid = 0.5 * (lo.min(axis=0) + hi.max(axis=0))
+        far = ((flat - mid) ** 2).sum(axis=1)
+        starts = np.cumsum(sizes) - sizes
+        pick = np.flatnonzero(far == np.repeat(np.maximum.reduceat(far, starts), sizes))
+        first = np.unique(np.repeat(np.arange(n), sizes)[pick], return_index=True)[1]  # one per piece
+        reps = shapely.points(flat[pick[first]])
         # The pieces are the (prepared) query geometries, the points the tree: a piece of
         # 10^5 vertices is indexed once, not walked once per point near it.
-        qs, ps = shapely.STRtree(firsts).query(shapely.polygons(rings), predicate="intersects")
+        qs, ps = shapely.STRtree(reps).query(shapely.polygons(rings), predicate="intersects")
     else:
         boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
         qs, ps = shapely.STRtree(boxes).query(boxes, predicate="covers")
