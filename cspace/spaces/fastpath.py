@@ -107,6 +107,12 @@ def pair_sums(pa: list, pb: list) -> list | None:
     """
     if _fast is None:
         return None
+    if len(pa) == 1 and len(pb) == 1:  # one pair (min_clearance's closest position): the lean call
+        a, b = np.ascontiguousarray(pa[0], dtype=np.float64), np.ascontiguousarray(pb[0], dtype=np.float64)
+        out, count = np.empty((len(a) + len(b), 2)), np.empty(1, dtype=np.int64)
+        _fast.pair_sums(a, np.array([0, len(a)], dtype=np.int64), b, np.array([0, len(b)], dtype=np.int64), out, count)
+        c = int(count[0])
+        return [out[:c] if c > 0 else None]
     a_off = np.zeros(len(pa) + 1, dtype=np.int64)
     b_off = np.zeros(len(pb) + 1, dtype=np.int64)
     np.cumsum([len(p) for p in pa], out=a_off[1:])
