@@ -16,8 +16,8 @@ with a phantom corridor), so every union is checked against its inputs:
   across a gap, or a hole bitten out of an input, has samples off them all).
 
 This is a detector of GEOS's failures, not a proof of the union (a region lost or
-gained whose boundary runs entirely along other inputs' edges could pass it). When it fires, the union is
-taken again with snap rounding (``grid_size`` a power of two, 2^-42 of the coordinate
+gained whose boundary runs entirely along other inputs' edges could pass it). When it
+fires, the union is taken again with snap rounding (``grid_size`` a power of two, 2^-42 of the coordinate
 scale: GEOS's fixed-precision overlay, robust by construction, about five times
 slower) and checked again; if that fails too, :class:`UnionError` is raised rather
 than a wrong region returned.
@@ -64,7 +64,8 @@ def union(polys, first=None):
     if faithful(region, polys, slack=grid):
         return region
     raise UnionError(f"GEOS {shapely.geos_version_string}: the union of {len(polys)} polygons failed its check "
-                     "(an input not covered, or the area out of bounds), with and without snap rounding")
+                     "(its area out of bounds, an input not covered, or its boundary off the inputs' edges), "
+                     "with and without snap rounding")
 
 
 def faithful(region, polys, slack: float = 0.0) -> bool:
@@ -101,7 +102,13 @@ def faithful(region, polys, slack: float = 0.0) -> bool:
 def _on_edges(p: np.ndarray, edges: np.ndarray, tol: float) -> bool:
     """Is every point within ``tol`` of one of the segments ``edges`` (K, 2, 2)? The
     segments whose boxes (widened by tol) hold the point are measured, in blocks of
-    about 2^18 (point, segment) pairs (few points reach here)."""
+    about 2^18 (point, segment) pairs; many points against many segments go through an
+    STRtree of the segments instead."""
+    if len(p) * len(edges) > 1 << 22:
+        import shapely
+
+        near = shapely.STRtree(shapely.linestrings(edges)).query(shapely.points(p), predicate="dwithin", distance=tol)
+        return len(np.unique(near[0])) == len(p)
     lo, hi = edges.min(axis=1) - tol, edges.max(axis=1) + tol
     step = max(1, (1 << 18) // max(len(edges), 1))
     for s in range(0, len(p), step):
