@@ -102,3 +102,20 @@ def test_right_unions_pass(spec, angle):
     ref = snapped_union(polys)
     assert shapely.symmetric_difference(got, ref).area <= 1e-9 * ref.area
     assert union_mod.faithful(shapely.union_all(polys), polys) or shapely.union_all(polys).area != pytest.approx(ref.area)
+
+
+def test_a_big_soup_checks_through_the_tree():
+    # Enough off-vertex points and edges that the union's boundary is matched through an
+    # STRtree of the inputs' edges: a right union passes, one with a bite taken does not.
+    rng = np.random.default_rng(1)
+    tri = rng.uniform(0, 60, (800, 1, 2)) + rng.uniform(-2, 2, (800, 3, 2))
+    polys = shapely.polygons(np.concatenate((tri, tri[:, :1]), axis=1))
+    polys = np.array([shapely.orient_polygons(p) for p in polys[shapely.area(polys) > 1e-3]])
+    right = shapely.union_all(polys)
+    own, _ = union_mod._samples(np.array([right], dtype=object))
+    pts, edges = union_mod._samples(polys)
+    rest = ~np.isin(own[:, 0] + 1j * own[:, 1], pts[:, 0] + 1j * pts[:, 1])
+    assert rest.sum() * len(edges) > 1 << 22  # the tree's branch
+    assert faithful(right, polys)
+    x, y = shapely.get_coordinates(polys[0]).mean(axis=0)
+    assert not faithful(right.difference(shapely.Point(x, y).buffer(0.05)), polys)
