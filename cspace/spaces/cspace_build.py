@@ -102,6 +102,10 @@ def decompose_robot(robot: list[np.ndarray], is_disk: bool = False) -> tuple[lis
     return pieces, split
 
 
+# From this many pieces on, the containment prune proposes each piece by its far vertex.
+FAR_VERTEX_PIECES = 4096
+
+
 def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
     """Convex pieces lying inside another piece (exact containment test): removed -> container.
 
@@ -119,22 +123,26 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
     # ``order``. A piece inside q has every vertex in q, so one vertex stands for it: an
     # STRtree of those points proposes the pieces holding each (near-linear, where boxes of
     # long thin pieces overlap by the thousand), the exact box comparisons and the exact
-    # vertex test below decide. The vertex is the one farthest from the middle of the
-    # pieces' boxes: pieces fanning out from one place (a star's spikes) share their inner
-    # vertices with many others, while their far ends lie in few. (Pieces of fewer than 3
+    # vertex test below decide. The vertex: the first, or among many pieces the one
+    # farthest from the middle of the pieces' boxes (pieces fanning out from one place, a
+    # star's spikes, share their inner vertices with many others, while their far ends lie
+    # in few; choosing it costs more than it saves on small scenes). (Pieces of fewer than 3
     # vertices: boxes covering boxes.)
     import shapely
 
     sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
     if (sizes >= 3).all():
         flat = np.concatenate(pieces)
-        rings = shapely.linearrings(flat, indices=np.repeat(np.arange(n), sizes))
-        mid = 0.5 * (lo.min(axis=0) + hi.max(axis=0))
-        far = ((flat - mid) ** 2).sum(axis=1)
+        owner = np.repeat(np.arange(n), sizes)
+        rings = shapely.linearrings(flat, indices=owner)
         starts = np.cumsum(sizes) - sizes
-        pick = np.flatnonzero(far == np.repeat(np.maximum.reduceat(far, starts), sizes))
-        first = np.unique(np.repeat(np.arange(n), sizes)[pick], return_index=True)[1]  # one per piece
-        reps = shapely.points(flat[pick[first]])
+        if n >= FAR_VERTEX_PIECES:
+            mid = 0.5 * (lo.min(axis=0) + hi.max(axis=0))
+            d = flat - mid
+            far = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]
+            pick = np.flatnonzero(far == np.maximum.reduceat(far, starts)[owner])
+            starts = pick[np.r_[True, owner[pick[1:]] != owner[pick[:-1]]]]  # the first of ties: one per piece
+        reps = shapely.points(flat[starts])
         # The pieces are the (prepared) query geometries, the points the tree: a piece of
         # 10^5 vertices is indexed once, not walked once per point near it.
         qs, ps = shapely.STRtree(reps).query(shapely.polygons(rings), predicate="intersects")
