@@ -111,7 +111,8 @@ class GridIndex(CellClassifier):
         self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
         if not n:  # nothing to classify: every cell FREE
             cp = cm = np.zeros(0, np.int64)
-            state, blocker, starts = np.zeros(nx * ny, np.int8), np.full(nx * ny, -1, np.int64), np.zeros(nx * ny + 1, np.int64)
+            state, blocker = np.zeros(nx * ny, np.int8), np.full(nx * ny, -1, np.int64)
+            starts = np.zeros(nx * ny + 1, np.int64)
             self._counts = (nx * ny, 0, 0)
         elif fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
             cc, cp, cm, inside = self._classify_all(pieces)

@@ -183,10 +183,10 @@ class CellClassifier:
         if K < 16:
             for r, k in enumerate(ks):
                 Q[r, : sizes[r]] = pieces[k]
-        else:  # one scatter of all the vertices
-            first = np.cumsum(sizes) - sizes
-            Q[np.repeat(np.arange(K), sizes), np.arange(int(first[-1] + sizes[-1])) - np.repeat(first, sizes)] = \
-                np.concatenate([pieces[k] for k in ks])
+        else:  # one scatter of all the vertices: row r, slots 0 .. sizes[r] - 1
+            row = np.repeat(np.arange(K), sizes)
+            col = np.arange(len(row)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+            Q[row, col] = np.concatenate([pieces[k] for k in ks])
         Q -= (self.ox, self.oy)
         # Pieces wider than MASK_EDGES get WIDE_MASK (their cells' masks on demand).
         wide = sizes > MASK_EDGES
