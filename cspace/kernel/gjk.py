@@ -70,17 +70,13 @@ def gjk_distance(A, B, max_iterations: int = MAX_ITERATIONS, *, loop=None) -> Di
     >>> gjk_distance([[0, 0], [1, 0], [1, 1], [0, 1]], [[1, 0], [2, 0], [2, 1], [1, 1]]).status
     'touching'
     """
-    if loop is not None and _plain(A) and _plain(B):  # the compiled loop checks finiteness itself
-        a, b = _open(A), _open(B)
-        raw = loop(a, b, max_iterations)
-        if raw is not None and SAFE_MIN <= raw[7] < SAFE_MAX:
-            ox, oy = a[0].tolist()
-            return _answer(a, b, ox, oy, raw[7], _outcome(*raw))
+    if (fast := _compiled(A, B, max_iterations, loop)) is not None:
+        return _answer_raw(*fast)
     a = as_array(A, copy=False, nonempty=True)  # only read: no copy
     b = as_array(B, copy=False, nonempty=True)
-    ox, oy = a[0].tolist()
     if loop is not None and (raw := loop(a, b, max_iterations)) is not None and SAFE_MIN <= raw[7] < SAFE_MAX:
-        return _answer(a, b, ox, oy, raw[7], _outcome(*raw))
+        return _answer_raw(a, b, raw)
+    ox, oy = a[0].tolist()
     if len(a) + len(b) <= 80:  # Python floats (an overflow is inf, silently): cheaper when small
         al = [(x - ox, y - oy) for x, y in a.tolist()]
         bl = [(x - ox, y - oy) for x, y in b.tolist()]
@@ -113,17 +109,33 @@ def gjk_distance_below(A, B, bound: float, *, loop=None) -> Distance | None:
     >>> gjk_distance_below(sq, sq + 3, 9.0, loop=gjk_loop()).distance == gjk_distance(sq, sq + 3).distance
     True
     """
-    if loop is not None and _plain(A) and _plain(B):
+    if (fast := _compiled(A, B, MAX_ITERATIONS, loop)) is None:
+        return gjk_distance(A, B, loop=loop)
+    raw = fast[2]
+    if not raw[5]:  # not inside: gjk_distance returns this distance unless in the exact band
+        dist = math.hypot(raw[0] - raw[2], raw[1] - raw[3])
+        if dist >= bound and dist > EXACT_BAND * raw[7]:
+            return None
+    return _answer_raw(*fast)
+
+
+def _compiled(A, B, max_iterations: int, loop):
+    """``(a, b, raw)``: the compiled ``loop``'s result on plain (N, 2) float64 arrays A and B
+    (a closing repeat of the first vertex dropped, as as_array does), or None where it
+    does not answer (no loop, other inputs, a non-finite coordinate, an extent outside
+    the safe range): gjk_distance's fast entry."""
+    if loop is not None and _plain(A) and _plain(B):  # the compiled loop checks finiteness itself
         a, b = _open(A), _open(B)
-        raw = loop(a, b, MAX_ITERATIONS)
+        raw = loop(a, b, max_iterations)
         if raw is not None and SAFE_MIN <= raw[7] < SAFE_MAX:
-            if not raw[5]:  # not inside: gjk_distance returns this distance unless in the exact band
-                dist = math.hypot(raw[0] - raw[2], raw[1] - raw[3])
-                if dist >= bound and dist > EXACT_BAND * raw[7]:
-                    return None
-            ox, oy = a[0].tolist()
-            return _answer(a, b, ox, oy, raw[7], _outcome(*raw))
-    return gjk_distance(A, B, loop=loop)
+            return a, b, raw
+    return None
+
+
+def _answer_raw(a: np.ndarray, b: np.ndarray, raw) -> Distance:
+    """The Distance from the compiled loop's result on a and b (local frame at a[0])."""
+    ox, oy = a[0].tolist()
+    return _answer(a, b, ox, oy, raw[7], _outcome(*raw))
 
 
 def _answer(a: np.ndarray, b: np.ndarray, ox: float, oy: float, extent: float, result) -> Distance:

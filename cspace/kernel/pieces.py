@@ -16,7 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .polygon import piece_boxes, ring_neighbours
+from .polygon import packed_boxes, piece_boxes, ring_neighbours
 from .predicates import orient2d_cols, orient2d_xy
 
 
@@ -34,11 +34,8 @@ class PieceSet:
         self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         if self.pieces:  # packed in one pass each (a scene may hold 10^5 pieces)
             self.start = np.concatenate(self.pieces).reshape(-1, 2)
-            if sizes.min() > 0:  # the boxes from the packed vertices: piece_boxes' answer, one pass less
-                lo = np.minimum.reduceat(self.start, self.offsets[:-1], axis=0)
-                hi = np.maximum.reduceat(self.start, self.offsets[:-1], axis=0)
-            else:
-                lo, hi = piece_boxes(self.pieces)
+            # the boxes from the packed vertices (piece_boxes' answer, without packing again)
+            lo, hi = packed_boxes(self.start, self.offsets[:-1]) if sizes.min() > 0 else piece_boxes(self.pieces)
         else:
             self.start = np.zeros((0, 2))
             lo = hi = np.zeros((0, 2))

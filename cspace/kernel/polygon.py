@@ -187,10 +187,19 @@ def piece_boxes(pieces: list) -> tuple[np.ndarray, np.ndarray]:
     full = np.flatnonzero(sizes > 0)
     if len(full):
         pts = np.concatenate([pieces[k] for k in full.tolist()] if len(full) < n else pieces).reshape(-1, 2)
-        starts = np.cumsum(sizes[full]) - sizes[full]
-        lo[full] = np.minimum.reduceat(pts, starts, axis=0)
-        hi[full] = np.maximum.reduceat(pts, starts, axis=0)
+        lo[full], hi[full] = packed_boxes(pts, np.cumsum(sizes[full]) - sizes[full])
     return lo, hi
+
+
+def packed_boxes(pts: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The boxes ``(lo, hi)`` of non-empty pieces stored one after another in ``pts``,
+    piece k from row ``starts[k]``: two reductions over all the vertices.
+
+    >>> lo, hi = packed_boxes(np.array([[0., 1], [2, 0], [5, 5], [6, 7]]), np.array([0, 2]))
+    >>> lo.tolist(), hi.tolist()
+    ([[0.0, 0.0], [5.0, 5.0]], [[2.0, 1.0], [6.0, 7.0]])
+    """
+    return np.minimum.reduceat(pts, starts, axis=0), np.maximum.reduceat(pts, starts, axis=0)
 
 
 def ring_neighbours(sizes) -> tuple[np.ndarray, np.ndarray]:

@@ -38,6 +38,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..kernel.gjk import gjk_distance, gjk_distance_below
+from ..kernel.polygon import packed_boxes
 from . import fastpath
 
 ANGLE_STEP = 1e-3  # SE(2): radians of turn below which a sub-motion is not split further
@@ -78,9 +79,7 @@ class Nearest:
         self.loop = fastpath.gjk_loop()  # the compiled GJK loop, or None (pure): fixed at construction
         sizes = [len(p) for p in self.pieces]
         if sizes and min(sizes) > 0 and all(p.ndim == 2 for p in self.pieces):  # all boxes in two reductions
-            starts = np.cumsum([0] + sizes[:-1])
-            flat = np.concatenate(self.pieces)
-            self.lo, self.hi = np.minimum.reduceat(flat, starts), np.maximum.reduceat(flat, starts)
+            self.lo, self.hi = packed_boxes(np.concatenate(self.pieces), np.cumsum([0] + sizes[:-1]))
         else:
             self.lo = np.array([p.min(axis=0) for p in self.pieces]).reshape(-1, 2)
             self.hi = np.array([p.max(axis=0) for p in self.pieces]).reshape(-1, 2)
