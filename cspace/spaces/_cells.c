@@ -11,8 +11,8 @@
    its mask sums the weights (bit (i + 1) mod size, 0 for wide pieces) of the edges it is
    not strictly inside. Cells not separated are written (piece id, cell j nx + i, inside,
    mask; WIDE_MASK for wide pieces), piece by piece, row-major: the entries
-   CellClassifier._gathered makes of the numpy route's. No filter and no rounding argument of its own: the numpy route's
-   doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum and
+   CellClassifier._gathered makes of the numpy route's. No filter and no rounding argument
+   of its own: the numpy route's doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum and
    minimum propagate them: no cell is inside or separated by such an edge.
 
    Two shortcuts change no output: a separated cell is not written, so its remaining

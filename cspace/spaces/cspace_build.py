@@ -135,14 +135,14 @@ def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
         flat = np.concatenate(pieces)
         owner = np.repeat(np.arange(n), sizes)
         rings = shapely.linearrings(flat, indices=owner)
-        starts = np.cumsum(sizes) - sizes
+        rep = np.cumsum(sizes) - sizes  # each piece's first vertex
         if n >= FAR_VERTEX_PIECES:
             mid = 0.5 * (lo.min(axis=0) + hi.max(axis=0))
             d = flat - mid
             far = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]
-            pick = np.flatnonzero(far == np.maximum.reduceat(far, starts)[owner])
-            starts = pick[np.r_[True, owner[pick[1:]] != owner[pick[:-1]]]]  # the first of ties: one per piece
-        reps = shapely.points(flat[starts])
+            pick = np.flatnonzero(far == np.maximum.reduceat(far, rep)[owner])
+            rep = pick[np.r_[True, owner[pick[1:]] != owner[pick[:-1]]]]  # the first of ties: one per piece
+        reps = shapely.points(flat[rep])
         # The pieces are the (prepared) query geometries, the points the tree: a piece of
         # 10^5 vertices is indexed once, not walked once per point near it.
         qs, ps = shapely.STRtree(reps).query(shapely.polygons(rings), predicate="intersects")
