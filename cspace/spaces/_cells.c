@@ -15,9 +15,18 @@
    of its own: the numpy route's doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum and
    minimum propagate them: no cell is inside or separated by such an edge.
 
-   Two shortcuts change no output: a separated cell is not written, so its remaining
+   Three shortcuts change no output: a separated cell is not written, so its remaining
    edges are skipped; a piece's padded slots (after its own edges) would leave every cell
-   strictly inside with weight 0, so they are not evaluated.
+   strictly inside with weight 0, so they are not evaluated; and along a row of cells
+   only the ends are evaluated. Why the last is exact: along a row, d is computed from
+   x_off + i cw by a product and two sums with fixed operands, and rounding is monotone,
+   so each edge's d is a monotone function of i in doubles too. Each edge's "strictly
+   inside" thus holds on a prefix or a suffix of the row, and so does its "strictly
+   outside": the inside cells (every edge inside) form one run, and so do the cells not
+   separated (no edge outside). The row is scanned from its left end to the first cell
+   not separated and from its right end likewise; between them, from the left to the
+   first inside cell and from the right to the last; every cell between those two is
+   inside (mask 0) without a test. The entries come out in the same order.
 
    assemble() turns the classified entries into the grid's arrays, as GridIndex's numpy
    route does. */
@@ -26,6 +35,42 @@
 /* numpy's maximum(x, 0.0) and minimum(x, 0.0): NaN propagates. */
 static inline double max0(double x) { return (x >= 0.0 || isnan(x)) ? x : 0.0; }
 static inline double min0(double x) { return (x <= 0.0 || isnan(x)) ? x : 0.0; }
+
+/* A piece's half-planes (per edge: outward unit normal, offset, the cell's corner spread
+   hi and lo, mask weight), its edge count and the grid's margin. */
+typedef struct {
+    double *nx, *ny, *c, *hi, *lo;
+    int64_t *w;
+    int64_t s;
+    double m;
+} Edges;
+
+enum { SEPARATED = 0, MEETS = 1, INSIDE = 2 };
+
+/* The cell with corner (cx0, cy0): SEPARATED (one edge has it strictly outside by the
+   margin; its other edges skipped), INSIDE (every edge has it strictly inside by the
+   margin) or MEETS, with *mask the weights of the edges it is not strictly inside. */
+static inline int cell_test(const Edges *h, double cx0, double cy0, int64_t *mask)
+{
+    int inside = 1;
+    int64_t mk = 0;
+    for (int64_t e = 0; e < h->s; e++) {
+        double d = cx0 * h->nx[e];
+        d += cy0 * h->ny[e];
+        d -= h->c[e];
+        if (!(d <= -h->m - h->hi[e])) {
+            inside = 0;
+            mk += h->w[e];
+        }
+        if (d >= h->m - h->lo[e]) return SEPARATED;
+    }
+    *mask = mk;
+    return inside ? INSIDE : MEETS;
+}
+
+/* Write the entry of cell i of the current row: a wide piece's mask is wide_mask. */
+#define PUT(i, in, mk)                                                                   \
+    (opiece[n] = id, ocell[n] = row0 + (i), oin[n] = (uint8_t)(in), omask[n] = is_wide ? (int64_t)wide_mask : (mk), n++)
 
 /* classify(Q, sizes, sag, wide, rows, i0, i1, j0, j1, x_off, y_off, cw, ch, m,
             ids, nx, wide_mask, out_piece, out_cell, out_inside, out_mask) -> count
@@ -47,6 +92,7 @@ PyObject *fast_classify(PyObject *self, PyObject *args)
     int got = 0;
     Py_ssize_t count = -1;
     double *hp = NULL;
+    int64_t *right = NULL;
     for (; got < 14; got++) {
         int flags = got >= 10 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
         if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
@@ -71,61 +117,82 @@ PyObject *fast_classify(PyObject *self, PyObject *args)
         PyErr_NoMemory();
         goto done;
     }
-    Py_ssize_t n = 0;
-    for (Py_ssize_t t = 0; t < R; t++) {
+    Py_ssize_t n = 0, width = 1;
+    for (Py_ssize_t t = 0; t < R; t++) { /* the widest box: room for a row's right run */
         int64_t r = rows[t];
         if (r < 0 || r >= K || sizes[r] < 1 || sizes[r] > E) {
             PyErr_SetString(PyExc_ValueError, "_fast.classify: a row or size out of range");
             goto done;
         }
+        if (i1[r] - i0[r] + 1 > width) width = i1[r] - i0[r] + 1;
+    }
+    right = PyMem_Malloc(sizeof(int64_t) * (size_t)width);
+    if (!right) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t t = 0; t < R; t++) {
+        int64_t r = rows[t];
         int64_t s = sizes[r];
         const double *q = Q + 2 * r * E;
-        double *nx = hp, *ny = hp + E, *c = hp + 2 * E, *hi = hp + 3 * E, *lo = hp + 4 * E;
-        int64_t *w = (int64_t *)(hp + 5 * E);
+        Edges h = {hp, hp + E, hp + 2 * E, hp + 3 * E, hp + 4 * E, (int64_t *)(hp + 5 * E), s, m};
         for (int64_t e = 0; e < s; e++) { /* the half-planes, as _classify_many computes them */
             int64_t f = e + 1 < s ? e + 1 : 0;
             double ex = q[2 * f] - q[2 * e], ey = q[2 * f + 1] - q[2 * e + 1];
-            double h = hypot(ey, -ex);
-            nx[e] = ey / h, ny[e] = -ex / h;
-            c[e] = nx[e] * q[2 * e] + ny[e] * q[2 * e + 1];
-            hi[e] = max0(nx[e]) * cw + max0(ny[e]) * ch;
-            lo[e] = min0(nx[e]) * cw + min0(ny[e]) * ch;
-            if (has_sag) lo[e] -= sag[r * E + e];
-            w[e] = wide[r] ? 0 : (int64_t)((uint64_t)1 << ((e + 1) % s));
+            double len = hypot(ey, -ex);
+            h.nx[e] = ey / len, h.ny[e] = -ex / len;
+            h.c[e] = h.nx[e] * q[2 * e] + h.ny[e] * q[2 * e + 1];
+            h.hi[e] = max0(h.nx[e]) * cw + max0(h.ny[e]) * ch;
+            h.lo[e] = min0(h.nx[e]) * cw + min0(h.ny[e]) * ch;
+            if (has_sag) h.lo[e] -= sag[r * E + e];
+            h.w[e] = wide[r] ? 0 : (int64_t)((uint64_t)1 << ((e + 1) % s));
         }
+        int64_t id = ids[r];
+        int is_wide = wide[r] != 0;
         for (int64_t j = j0[r]; j <= j1[r]; j++) {
             double cy0 = y_off + (double)j * ch;
-            for (int64_t i = i0[r]; i <= i1[r]; i++) {
-                double cx0 = x_off + (double)i * cw;
-                int inside = 1, separated = 0;
-                int64_t mask = 0;
-                for (int64_t e = 0; e < s; e++) {
-                    double d = cx0 * nx[e];
-                    d += cy0 * ny[e];
-                    d -= c[e];
-                    if (!(d <= -m - hi[e])) {
-                        inside = 0;
-                        mask += w[e];
-                    }
-                    if (d >= m - lo[e]) {
-                        separated = 1;
-                        break;
-                    }
-                }
-                if (separated) continue;
-                if (n >= cap) {
-                    PyErr_SetString(PyExc_ValueError, "_fast.classify: outputs too small");
-                    goto done;
-                }
-                opiece[n] = ids[r], ocell[n] = j * (int64_t)gnx + i, oin[n] = (uint8_t)inside;
-                omask[n] = wide[r] ? (int64_t)wide_mask : mask;
-                n++;
+            int64_t row0 = j * (int64_t)gnx, L = i0[r], Rr = i1[r], ml = 0, mr = 0;
+            int tl = SEPARATED, tr;
+            /* The row's cells not separated: [L, Rr], from either end. */
+            for (; L <= Rr; L++)
+                if ((tl = cell_test(&h, x_off + (double)L * cw, cy0, &ml)) != SEPARATED) break;
+            if (L > Rr) continue;
+            if (n + (Rr - L + 1) > cap) {
+                PyErr_SetString(PyExc_ValueError, "_fast.classify: outputs too small");
+                goto done;
             }
+            tr = tl, mr = ml;
+            for (; Rr > L; Rr--)
+                if ((tr = cell_test(&h, x_off + (double)Rr * cw, cy0, &mr)) != SEPARATED) break;
+            if (Rr == L) tr = tl, mr = ml;
+            /* From L rightwards up to the first inside cell a. */
+            int64_t a = L, mk = ml;
+            int ta = tl;
+            for (;;) {
+                PUT(a, ta == INSIDE, mk);
+                if (ta == INSIDE || a == Rr) break;
+                a++;
+                if (a == Rr) ta = tr, mk = mr;
+                else ta = cell_test(&h, x_off + (double)a * cw, cy0, &mk);
+            }
+            if (ta != INSIDE) continue; /* no inside cell: the row is written */
+            /* From Rr leftwards down to the last inside cell b; then (a, b] inside, then (b, Rr]. */
+            int64_t b = Rr, nr = 0;
+            int tb = tr;
+            mk = mr;
+            while (b > a && tb != INSIDE) {
+                right[nr++] = mk;
+                b--;
+                if (b > a) tb = cell_test(&h, x_off + (double)b * cw, cy0, &mk);
+            }
+            for (int64_t i = a + 1; i <= b; i++) PUT(i, 1, 0);
+            for (int64_t k = nr - 1; k >= 0; k--) PUT(Rr - k, 0, right[k]);
         }
     }
     count = n;
 done:
     PyMem_Free(hp);
+    PyMem_Free(right);
     for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
     return count < 0 ? NULL : PyLong_FromSsize_t(count);
 }
@@ -148,6 +215,7 @@ PyObject *fast_assemble(PyObject *self, PyObject *args)
         return NULL;
     Py_buffer b[9];
     int got = 0, ok = 0;
+    Py_ssize_t cells = 0, mixed = 0, blocked = 0;
     for (; got < 9; got++) {
         int flags = got >= 4 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
         if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
@@ -156,7 +224,8 @@ PyObject *fast_assemble(PyObject *self, PyObject *args)
     const uint8_t *inside = b[3].buf;
     int8_t *state = b[4].buf;
     int64_t *blocker = b[5].buf, *starts = b[6].buf, *cand = b[7].buf, *masks = b[8].buf;
-    Py_ssize_t n = b[0].len / 8, cells = b[4].len;
+    Py_ssize_t n = b[0].len / 8;
+    cells = b[4].len;
     if (b[1].len != 8 * n || b[2].len != 8 * n || b[3].len != n || b[5].len != 8 * cells
         || b[6].len != 8 * (cells + 1) || b[7].len < 8 * n || b[8].len < 8 * n) {
         PyErr_SetString(PyExc_ValueError, "_fast.assemble: inconsistent array sizes");
@@ -164,7 +233,7 @@ PyObject *fast_assemble(PyObject *self, PyObject *args)
     }
     memset(state, 0, (size_t)cells);
     memset(starts, 0, sizeof(int64_t) * (size_t)(cells + 1));
-    for (Py_ssize_t c = 0; c < cells; c++) blocker[c] = -1;
+    memset(blocker, 0xff, sizeof(int64_t) * (size_t)cells); /* every byte 0xff: -1 */
     for (Py_ssize_t t = 0; t < n; t++) {
         if (cc[t] < 0 || cc[t] >= cells || cp[t] < 0 || cp[t] >= npieces) {
             PyErr_SetString(PyExc_ValueError, "_fast.assemble: a cell or piece out of range");
@@ -184,6 +253,7 @@ PyObject *fast_assemble(PyObject *self, PyObject *args)
     for (Py_ssize_t c = 0; c < cells; c++) {
         int64_t count = starts[c + 1];
         if (count && state[c] != 2) state[c] = 1; /* MIXED */
+        mixed += state[c] == 1, blocked += state[c] == 2;
         starts[c + 1] = run;
         run += count;
     }
@@ -199,11 +269,9 @@ PyObject *fast_assemble(PyObject *self, PyObject *args)
             cand[h] = p, masks[h] = m;
         }
     }
-    Py_ssize_t counts[3] = {0, 0, 0};
-    for (Py_ssize_t c = 0; c < cells; c++) counts[state[c]]++;
     ok = 1;
 done:
     for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
     if (!ok) return NULL;
-    return Py_BuildValue("(nnn)", counts[0], counts[1], counts[2]);
+    return Py_BuildValue("(nnn)", cells - mixed - blocked, mixed, blocked);
 }
