@@ -210,6 +210,32 @@ def _both_routes(pieces, bounds, cells, monkeypatch):
 
 
 @needs_c
+def test_grid_handle_holds_read_only_arrays():
+    # The handle holds the grid's and the pieces' arrays instead of copying them: they are
+    # read-only from then on, and the handle keeps them alive after their owners are gone.
+    import gc
+
+    from cspace.spaces import _fast
+    from cspace.spaces.broadphase import GridIndex
+    from cspace.kernel.pieces import PieceSet
+
+    pieces = [np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]]), np.array([[1.0, 1.0], [3.0, 1.5], [2.0, 3.0]])]
+    g, ps = GridIndex(pieces, (0, 10, 0, 10), cells=256), PieceSet(pieces)
+    h = fastpath.grid_handle(g, ps, (0, 10, 0, 10))
+    for a in (g.state, g.blocker, g._starts, g._cand, ps.offsets, ps.start):
+        assert not a.flags.writeable
+        with pytest.raises(ValueError):
+            a[...] = 0
+    queries = [(5.0, 5.0), (0.5, 0.5), (2.0, 2.0), (6.0 + 1e-9, 5.0)]
+    before = [_fast.point(h, x, y) for x, y in queries] + [_fast.segment(h, 0.5, 5.0, 9.5, 5.0)]
+    del g, ps, pieces
+    gc.collect()
+    [np.ones(4096) for _ in range(64)]  # fresh allocations over any freed memory
+    assert [_fast.point(h, x, y) for x, y in queries] + [_fast.segment(h, 0.5, 5.0, 9.5, 5.0)] == before
+    assert before[0] == 0 and before[1] == 1
+
+
+@needs_c
 @pytest.mark.parametrize("margin", [0.0, 0.01])
 def test_compiled_classification_builds_the_same_grid(margin, monkeypatch):
     # The C route of the grid build evaluates every cell of each box with the numpy

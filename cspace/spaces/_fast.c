@@ -35,6 +35,8 @@ typedef struct {
     double *xy;                         /* vertices, x y interleaved, CCW */
     uint32_t *stamp;                    /* per piece: the query that last tested it */
     uint32_t gen;
+    Py_buffer view[6];                  /* the arrays above but stamp, held (read-only), not copied */
+    int nview;
 } Grid;
 
 /* The cell of a floored grid coordinate f, clamped to 0 .. n - 1 (f is never NaN here). */
@@ -94,12 +96,7 @@ static int point_piece(const Grid *g, int64_t k, double x, double y)
 
 static void grid_release(Grid *g)
 {
-    PyMem_Free(g->state);
-    PyMem_Free(g->blocker);
-    PyMem_Free(g->starts);
-    PyMem_Free(g->cand);
-    PyMem_Free(g->offsets);
-    PyMem_Free(g->xy);
+    for (int k = 0; k < g->nview; k++) PyBuffer_Release(&g->view[k]);
     PyMem_Free(g->stamp);
     PyMem_Free(g);
 }
@@ -117,7 +114,7 @@ static void *copy_buffer(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const
     if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS) < 0) return NULL;
     void *out = NULL;
     if (view.len != size * count) {
-        PyErr_Format(PyExc_ValueError, "_fast.grid: %s has %zd bytes, expected %zd", name, view.len, size * count);
+        PyErr_Format(PyExc_ValueError, "_fast: %s has %zd bytes, expected %zd", name, view.len, size * count);
     } else {
         out = PyMem_Malloc(view.len ? view.len : 1);
         if (!out) PyErr_NoMemory();
@@ -127,9 +124,25 @@ static void *copy_buffer(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const
     return out;
 }
 
+/* A view of `count` items of `size` bytes held by g until its release (the caller hands
+   over read-only arrays that live as long as the handle: no copy). */
+static void *hold_buffer(Grid *g, PyObject *obj, Py_ssize_t size, Py_ssize_t count, const char *name)
+{
+    Py_buffer *view = &g->view[g->nview];
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS) < 0) return NULL;
+    g->nview++;
+    if (view->len != size * count) {
+        PyErr_Format(PyExc_ValueError, "_fast.grid: %s has %zd bytes, expected %zd", name, view->len, size * count);
+        return NULL;
+    }
+    static char empty[16];
+    return view->len ? view->buf : (void *)empty;
+}
+
 /* grid(state, blocker, starts, cand, offsets, xy, nx, ny, x0, y0, iw, ih, cw, ch, margin,
         xmin, xmax, ymin, ymax) -> capsule. Arrays: uint8 cells, int64 cells, int64 cells + 1,
-   int64 candidates, int64 pieces + 1, float64 2 x vertices; all copied. */
+   int64 candidates, int64 pieces + 1, float64 2 x vertices; held, not copied: the caller
+   makes them read-only (GridIndex and PieceSet do), and the handle keeps them alive. */
 static PyObject *py_grid(PyObject *self, PyObject *args)
 {
     PyObject *st, *bl, *sts, *ca, *of, *xy;
@@ -158,12 +171,16 @@ static PyObject *py_grid(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "_fast.grid: offsets is empty");
         goto fail;
     }
-    if (!(g->state = copy_buffer(st, 1, cells, "state"))) goto fail;
-    if (!(g->blocker = copy_buffer(bl, 8, cells, "blocker"))) goto fail;
-    if (!(g->starts = copy_buffer(sts, 8, cells + 1, "starts"))) goto fail;
-    if (!(g->cand = copy_buffer(ca, 8, ncand, "cand"))) goto fail;
-    if (!(g->offsets = copy_buffer(of, 8, g->npieces + 1, "offsets"))) goto fail;
-    if (!(g->xy = copy_buffer(xy, 16, g->offsets[g->npieces], "xy"))) goto fail;
+    if (!(g->state = hold_buffer(g, st, 1, cells, "state"))) goto fail;
+    if (!(g->blocker = hold_buffer(g, bl, 8, cells, "blocker"))) goto fail;
+    if (!(g->starts = hold_buffer(g, sts, 8, cells + 1, "starts"))) goto fail;
+    if (!(g->cand = hold_buffer(g, ca, 8, ncand, "cand"))) goto fail;
+    if (!(g->offsets = hold_buffer(g, of, 8, g->npieces + 1, "offsets"))) goto fail;
+    if (g->offsets[0] != 0 || g->offsets[g->npieces] < 0) {
+        PyErr_SetString(PyExc_ValueError, "_fast.grid: offsets do not start at 0");
+        goto fail;
+    }
+    if (!(g->xy = hold_buffer(g, xy, 16, g->offsets[g->npieces], "xy"))) goto fail;
     for (int64_t k = 0; k < g->npieces; k++) { /* every piece has a vertex; indices in range */
         if (g->offsets[k + 1] <= g->offsets[k]) {
             PyErr_SetString(PyExc_ValueError, "_fast.grid: a piece without vertices");

@@ -43,16 +43,16 @@ def grid_handle(index, packed, bounds):
     """
     if _fast is None:
         return None
-    xy = packed.start if len(packed) else np.zeros((0, 2))
-    return _fast.grid(
-        np.ascontiguousarray(index.state, dtype=np.uint8),
-        np.ascontiguousarray(index.blocker, dtype=np.int64),
-        np.ascontiguousarray(index._starts, dtype=np.int64),
-        np.ascontiguousarray(index._cand, dtype=np.int64),
-        np.ascontiguousarray(packed.offsets, dtype=np.int64),
-        np.ascontiguousarray(xy, dtype=np.float64),
-        index.nx, index.ny, index.x0, index.y0, index.inv_w, index.inv_h, index.cw, index.ch, index.margin,
-        *map(float, bounds))
+    # The handle holds these arrays (no copy): the grid's and the pieces' own, read-only.
+    arrays = (index.state, index.blocker, index._starts, index._cand, packed.offsets,
+              packed.start if len(packed) else np.zeros((0, 2)))
+    for a in arrays:
+        a.flags.writeable = False
+    f64, i64 = (lambda a: np.ascontiguousarray(a, dtype=np.float64)), (lambda a: np.ascontiguousarray(a, dtype=np.int64))
+    st, bl, sts, ca, of, xy = arrays
+    return _fast.grid(np.ascontiguousarray(st).view(np.uint8), i64(bl), i64(sts), i64(ca), i64(of), f64(xy),
+                      index.nx, index.ny, index.x0, index.y0, index.inv_w, index.inv_h, index.cw, index.ch,
+                      index.margin, *map(float, bounds))
 
 
 def compiled() -> bool:
