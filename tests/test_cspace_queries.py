@@ -134,6 +134,28 @@ def test_pruning_drops_outside_and_contained_pieces():
     assert rep["minkowski"]["ran"] is False  # a point robot is not summed
 
 
+def test_index_boxes_are_the_kept_pieces_boxes():
+    # The index takes the prune's boxes of the pieces it kept (outside ones dropped, contained
+    # ones removed): each must be its piece's own box, as piece_boxes computes it afresh.
+    from cspace.kernel.polygon import piece_boxes
+
+    rng = np.random.default_rng(7)
+    obstacles = [np.array([[4.5, 4.5], [5.5, 4.5], [5.5, 5.5], [4.5, 5.5]]),
+                 np.array([[40.0, 40.0], [41.0, 40.0], [41.0, 41.0]])]
+    for _ in range(30):
+        c, r = rng.uniform(-1, 11, 2), rng.uniform(0.1, 2.0)
+        k = int(rng.integers(3, 9))
+        a = np.sort(rng.uniform(0, 2 * np.pi, k))
+        obstacles.append(c + r * np.column_stack([np.cos(a), np.sin(a)]))
+    obstacles.append(np.array([[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]]))
+    cs = CSpace((0, 10, 0, 10), obstacles)
+    rep = {s["stage"]: s for s in cs.report()["stages"]}
+    assert rep["prune"]["outside_bounds"] >= 1 and rep["prune"]["inside_another"] >= 1
+    lo, hi = piece_boxes(cs.pieces)
+    assert np.array_equal(cs.packed.lo, lo) and np.array_equal(cs.packed.hi, hi)
+    assert np.array_equal(cs.index._lo, lo) and np.array_equal(cs.index._hi, hi)
+
+
 def test_clearance_matches_shapely_distance():
     pytest.importorskip("cspace.kernel.gjk")
     sc = load_scenario(os.path.join(OMPL_SCENES, "circles.toml"))

@@ -28,14 +28,17 @@ class PieceSet:
     (True, False)
     """
 
-    def __init__(self, pieces: list[np.ndarray]):
+    def __init__(self, pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None):
+        # ``boxes``: the pieces' (lo, hi) (:func:`piece_boxes`) when the caller has them.
         self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
         sizes = np.array([len(p) for p in self.pieces], dtype=np.int64)
         self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         if self.pieces:  # packed in one pass each (a scene may hold 10^5 pieces)
             self.start = np.concatenate(self.pieces).reshape(-1, 2)
-            # the boxes from the packed vertices (piece_boxes' answer, without packing again)
-            lo, hi = packed_boxes(self.start, self.offsets[:-1]) if sizes.min() > 0 else piece_boxes(self.pieces)
+            if boxes is not None:
+                lo, hi = boxes
+            else:  # the boxes from the packed vertices (piece_boxes' answer, without packing again)
+                lo, hi = packed_boxes(self.start, self.offsets[:-1]) if sizes.min() > 0 else piece_boxes(self.pieces)
         else:
             self.start = np.zeros((0, 2))
             lo = hi = np.zeros((0, 2))

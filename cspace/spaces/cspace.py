@@ -88,7 +88,7 @@ class CSpace(PointQueries, SegmentQueries):
         raw, raw_owner = self._sum()
         self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
         t = time.perf_counter()
-        self.packed = PieceSet(self.pieces)
+        self.packed = PieceSet(self.pieces, self._boxes)  # the prune's boxes of the kept pieces
         self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells, boxes=(self.packed.lo, self.packed.hi))
         self._coarse = None
         # The compiled fast path's copy of the grid and pieces (None on the pure path): part of the index.
@@ -199,7 +199,8 @@ class CSpace(PointQueries, SegmentQueries):
         pieces = [pieces[k] for k in keep]
         pairs = [[self._raw_pairs[k]] for k in keep]
         owner = owner[keep] if len(owner) else owner
-        contained = _contained_pieces(pieces)
+        lo, hi = lo[keep], hi[keep]  # the kept pieces' boxes, for the containment test and the index
+        contained = _contained_pieces(pieces, (lo, hi))
         if contained:
             for p in sorted(contained):
                 q = contained[p]
@@ -211,7 +212,9 @@ class CSpace(PointQueries, SegmentQueries):
             pieces = [p for p, m in zip(pieces, mask) if m]
             pairs = [pr for pr, m in zip(pairs, mask) if m]
             owner = owner[mask]
+            lo, hi = lo[mask], hi[mask]
         self.piece_pairs = pairs
+        self._boxes = (lo, hi)
         self.stages.append(Stage("prune", True, time.perf_counter() - t,
                                  {"pieces_before": before, "outside_bounds": outside,
                                   "inside_another": len(contained), "pieces_after": len(pieces)}))

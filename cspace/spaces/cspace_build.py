@@ -106,17 +106,18 @@ def decompose_robot(robot: list[np.ndarray], is_disk: bool = False) -> tuple[lis
 FAR_VERTEX_PIECES = 4096
 
 
-def _contained_pieces(pieces: list[np.ndarray]) -> dict[int, int]:
+def _contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None) -> dict[int, int]:
     """Convex pieces lying inside another piece (exact containment test): removed -> container.
 
     Candidate pairs come from bounding-box containment; a convex piece P lies in a
     convex piece Q iff every vertex of P is on or left of every edge of Q. Of two
-    identical pieces only the later one is removed.
+    identical pieces only the later one is removed. ``boxes``: the pieces' (lo, hi)
+    (:func:`cspace.kernel.polygon.piece_boxes`) when the caller has them.
     """
     n = len(pieces)
     if n < 2:
         return {}
-    lo, hi = piece_boxes(pieces)
+    lo, hi = boxes if boxes is not None else piece_boxes(pieces)
     order = np.argsort(lo[:, 0], kind="stable")
     removed: dict[int, int] = {}
     # Pairs (q, p), p != q, whose box lies inside q's box (closed), each q's in the order of
