@@ -301,6 +301,29 @@ def test_compiled_classification_on_random_pieces(seed):
 
 
 @needs_c
+def test_compiled_entries_leave_huge_pieces_to_the_numpy_routes(monkeypatch):
+    # _fast.entries classifies pieces of up to 1024 edges whose box holds up to 2^20
+    # cells and hands the others back: a 2000-gon and a triangle whose box holds ~1.4
+    # million cells go through the numpy routes, next to a long strip and a wide disk; the grid equals the
+    # all-numpy one, and the same again from packed vertices given by the caller.
+    from cspace.kernel.disk import disk_polygon
+    from cspace.kernel.pieces import PieceSet
+    from cspace.spaces.broadphase import GridIndex
+
+    huge = disk_polygon((3.0, 3.0), 2.0, max_error=1e-7)
+    assert len(huge) > 1024
+    pieces = [huge, np.array([[1.0, 6.0], [9.5, 6.2], [5.0, 9.9]]), disk_polygon((7.0, 3.0), 1.5, max_error=1e-4),
+              np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 0.5], [0.0, 0.5]])]
+    cells = 1 << 22  # the last piece's box: ~2^21 cells
+    c, n = _both_routes(pieces, (0, 10, 0, 10), cells, monkeypatch)
+    assert _grids_equal(c, n)
+    ps = PieceSet(pieces)
+    g = GridIndex(pieces, (0, 10, 0, 10), cells=cells, packed=(ps.start, ps.offsets))
+    assert _grids_equal(g, n)
+    assert (n.state == 2).sum() > 1000
+
+
+@needs_c
 def test_compiled_path_builds_no_pure_only_structures():
     # A scene pays only for the stages it needs: with the compiled walk, the pure segment
     # walk's coarse grid, its summed-area table and the pieces' scalar lists are never built

@@ -1,6 +1,8 @@
-/* The grid build (part of cspace.spaces._fast): classify() is CellClassifier's
-   numpy route (cspace/spaces/cellclass.py, _classify_many and its evaluate) in C, with
-   the same float operations in the same order, so the same grid.
+/* The grid build (part of cspace.spaces._fast): entries() is CellClassifier's numpy
+   route (cspace/spaces/cellclass.py, _classify_all, _classify_many and its evaluate) in C,
+   piece by piece from the packed vertices, with the same float operations in the same
+   order, so the same grid: the local frame's shift, each box's cells, the chord polygons
+   of pieces of more than mask_edges edges (_chords.c), the half-planes and the cells.
 
    Each piece's edge i -> i+1 (padded vertices Q, local frame) is a half-plane
    n . x <= c with n = (e_y, -e_x) / hypot(e_y, -e_x), c = n_x Q_x + n_y Q_y; over a cell
@@ -11,14 +13,13 @@
    its mask sums the weights (bit (i + 1) mod size, 0 for wide pieces) of the edges it is
    not strictly inside. Cells not separated are written (piece id, cell j nx + i, inside,
    mask; WIDE_MASK for wide pieces), piece by piece, row-major: the entries
-   CellClassifier._gathered makes of the numpy route's. No filter and no rounding argument
+   CellClassifier._gathered makes of the numpy route's, up to their order (which the
+   assembly does not see). No filter and no rounding argument
    of its own: the numpy route's doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum and
    minimum propagate them: no cell is inside or separated by such an edge.
 
-   Three shortcuts change no output: a separated cell is not written, so its remaining
-   edges are skipped; a piece's padded slots (after its own edges) would leave every cell
-   strictly inside with weight 0, so they are not evaluated; and along a row of cells
-   only the ends are evaluated. Why the last is exact: along a row, d is computed from
+   Two shortcuts change no output: a separated cell is not written, so its remaining
+   edges are skipped; and along a row of cells only the ends are evaluated. Why the last is exact: along a row, d is computed from
    x_off + i cw by a product and two sums with fixed operands, and rounding is monotone,
    so each edge's d is a monotone function of i in doubles too. Each edge's "strictly
    inside" thus holds on a prefix or a suffix of the row, and so does its "strictly
@@ -45,6 +46,18 @@ typedef struct {
     double m;
 } Edges;
 
+/* Where classified cells go: the grid's frame (x_off, y_off: the local frame's offset of
+   cell (0, 0); cell size; margin; columns), the entry arrays (room for cap entries, n
+   written), and a row's scratch (right: one int64 per column). */
+typedef struct {
+    double x_off, y_off, cw, ch, m;
+    int64_t gnx, wide_mask;
+    int64_t *piece, *cell, *mask;
+    uint8_t *inside;
+    Py_ssize_t n, cap;
+    int64_t *right;
+} Out;
+
 enum { SEPARATED = 0, MEETS = 1, INSIDE = 2 };
 
 /* The cell with corner (cx0, cy0): SEPARATED (one edge has it strictly outside by the
@@ -68,133 +81,206 @@ static inline int cell_test(const Edges *h, double cx0, double cy0, int64_t *mas
     return inside ? INSIDE : MEETS;
 }
 
-/* Write the entry of cell i of the current row: a wide piece's mask is wide_mask. */
-#define PUT(i, in, mk)                                                                   \
-    (opiece[n] = id, ocell[n] = row0 + (i), oin[n] = (uint8_t)(in), omask[n] = is_wide ? (int64_t)wide_mask : (mk), n++)
-
-/* classify(Q, sizes, sag, wide, rows, i0, i1, j0, j1, x_off, y_off, cw, ch, m,
-            ids, nx, wide_mask, out_piece, out_cell, out_inside, out_mask) -> count
-
-   Q: float64 K x E x 2; sizes: int64 K; sag: float64 K x E, or empty (no chords);
-   wide: uint8 K (WIDE pieces: weights 0, mask wide_mask); rows: int64, the pieces to
-   classify; i0..j1: int64 K, each piece's box of cells; ids: int64 K, each piece's id
-   in the grid; nx: the grid's columns; outputs: room for the rows' boxes' cells. */
-PyObject *fast_classify(PyObject *self, PyObject *args)
+/* The half-planes of piece q (s vertices, local frame; sag: its chords' sagittas or NULL),
+   as _classify_many computes them, into h (scratch for s edges). */
+static void half_planes(Edges *h, const double *q, int64_t s, const double *sag, int wide, double cw, double ch)
 {
-    PyObject *o[14];
-    double x_off, y_off, cw, ch, m;
-    long long gnx, wide_mask;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOdddddOLLOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &o[7],
-                          &o[8], &x_off, &y_off, &cw, &ch, &m, &o[9], &gnx, &wide_mask, &o[10], &o[11], &o[12],
-                          &o[13]))
+    h->s = s;
+    for (int64_t e = 0; e < s; e++) {
+        int64_t f = e + 1 < s ? e + 1 : 0;
+        double ex = q[2 * f] - q[2 * e], ey = q[2 * f + 1] - q[2 * e + 1];
+        double len = hypot(ey, -ex);
+        h->nx[e] = ey / len, h->ny[e] = -ex / len;
+        h->c[e] = h->nx[e] * q[2 * e] + h->ny[e] * q[2 * e + 1];
+        h->hi[e] = max0(h->nx[e]) * cw + max0(h->ny[e]) * ch;
+        h->lo[e] = min0(h->nx[e]) * cw + min0(h->ny[e]) * ch;
+        if (sag) h->lo[e] -= sag[e];
+        h->w[e] = wide ? 0 : (int64_t)((uint64_t)1 << ((e + 1) % s));
+    }
+}
+
+/* Write the entry of cell i of the current row: a wide piece's mask is wide_mask. */
+#define PUT(i, in, mk)                                                                                    \
+    (o->piece[o->n] = id, o->cell[o->n] = row0 + (i), o->inside[o->n] = (uint8_t)(in),                    \
+     o->mask[o->n] = wide ? o->wide_mask : (mk), o->n++)
+
+/* The cells of box i0..i1 x j0..j1 that piece id (half-planes h) may meet, row by row,
+   each row scanned from its ends (the header's third shortcut). -1 if o has no room. */
+static int classify_box(Out *o, const Edges *h, int wide, int64_t id, int64_t i0, int64_t i1, int64_t j0, int64_t j1)
+{
+    for (int64_t j = j0; j <= j1; j++) {
+        double cy0 = o->y_off + (double)j * o->ch;
+        int64_t row0 = j * o->gnx, L = i0, Rr = i1, ml = 0, mr = 0;
+        int tl = SEPARATED, tr;
+        /* The row's cells not separated: [L, Rr], from either end. */
+        for (; L <= Rr; L++)
+            if ((tl = cell_test(h, o->x_off + (double)L * o->cw, cy0, &ml)) != SEPARATED) break;
+        if (L > Rr) continue;
+        if (o->n + (Rr - L + 1) > o->cap) return -1;
+        tr = tl, mr = ml;
+        for (; Rr > L; Rr--)
+            if ((tr = cell_test(h, o->x_off + (double)Rr * o->cw, cy0, &mr)) != SEPARATED) break;
+        if (Rr == L) tr = tl, mr = ml;
+        /* From L rightwards up to the first inside cell a. */
+        int64_t a = L, mk = ml;
+        int ta = tl;
+        for (;;) {
+            PUT(a, ta == INSIDE, mk);
+            if (ta == INSIDE || a == Rr) break;
+            a++;
+            if (a == Rr) ta = tr, mk = mr;
+            else ta = cell_test(h, o->x_off + (double)a * o->cw, cy0, &mk);
+        }
+        if (ta != INSIDE) continue; /* no inside cell: the row is written */
+        /* From Rr leftwards down to the last inside cell b; then (a, b] inside, then (b, Rr]. */
+        int64_t b = Rr, nr = 0;
+        int tb = tr;
+        mk = mr;
+        while (b > a && tb != INSIDE) {
+            o->right[nr++] = mk;
+            b--;
+            if (b > a) tb = cell_test(h, o->x_off + (double)b * o->cw, cy0, &mk);
+        }
+        for (int64_t i = a + 1; i <= b; i++) PUT(i, 1, 0);
+        for (int64_t k = nr - 1; k >= 0; k--) PUT(Rr - k, 0, o->right[k]);
+    }
+    return 0;
+}
+
+/* Scratch for the half-planes of pieces of up to E edges (6 doubles an edge). */
+static int edges_alloc(Edges *h, double **hp, Py_ssize_t E, double m)
+{
+    *hp = PyMem_Malloc(sizeof(double) * 6 * (size_t)(E ? E : 1));
+    if (!*hp) return -1;
+    double *p = *hp;
+    *h = (Edges){p, p + E, p + 2 * E, p + 3 * E, p + 4 * E, (int64_t *)(p + 5 * E), 0, m};
+    return 0;
+}
+
+/* A box's first and last cell along one axis, as _classify_many computes them in numpy:
+   floor((lo - m - x0) * inv) clipped below at 0, floor((hi + m - x0) * inv) clipped above
+   at n - 1 (clipped further, to -1 .. n, only where the box then holds no cell anyway). */
+static void cell_range(double lo, double hi, double m, double x0, double inv, int64_t n, int64_t *a, int64_t *b)
+{
+    double f = floor((lo - m - x0) * inv), g = floor((hi + m - x0) * inv);
+    f = f > 0.0 ? f : 0.0;
+    g = g < (double)(n - 1) ? g : (double)(n - 1);
+    *a = (int64_t)(f < (double)n ? f : (double)n);
+    *b = (int64_t)(g > -1.0 ? g : -1.0);
+}
+
+/* entries(xy, offsets, lo, hi, ox, oy, x0, y0, inv_w, inv_h, cw, ch, m, nx, ny,
+           mask_edges, block_edges, max_box, long_edge, tolerance, wide_mask)
+       -> (piece, cell, inside, mask, todo)
+
+   The compiled route of CellClassifier._classify_all from the packed pieces (xy: float64
+   2 x vertices, piece k from offsets[k]; lo, hi: float64 K x 2, their boxes): each piece
+   of at most block_edges edges whose box holds 1 .. max_box cells is shifted to the local
+   frame (x - ox, y - oy), replaced by its chord polygon when it has more than mask_edges
+   edges (mask wide_mask), and classified as classify() does: the same doubles as the
+   padded route, the same entries up to their order. The entries come back as bytearrays
+   (int64, int64, uint8, int64); todo lists the pieces left to the caller (more edges or
+   cells than that). */
+PyObject *fast_entries(PyObject *self, PyObject *args)
+{
+    PyObject *ob[4];
+    Out o = {0};
+    double ox, oy, x0, y0, iw, ih, long_edge, tol;
+    long long ny, mask_edges, block_edges, max_box;
+    if (!PyArg_ParseTuple(args, "OOOOdddddddddLLLLLddL", &ob[0], &ob[1], &ob[2], &ob[3], &ox, &oy, &x0, &y0, &iw,
+                          &ih, &o.cw, &o.ch, &o.m, &o.gnx, &ny, &mask_edges, &block_edges, &max_box, &long_edge,
+                          &tol, &o.wide_mask))
         return NULL;
-    Py_buffer b[14];
+    o.x_off = x0 - ox, o.y_off = y0 - oy;
+    Py_buffer b[4];
     int got = 0;
-    Py_ssize_t count = -1;
-    double *hp = NULL;
-    int64_t *right = NULL;
-    for (; got < 14; got++) {
-        int flags = got >= 10 ? (PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) : PyBUF_C_CONTIGUOUS;
-        if (PyObject_GetBuffer(o[got], &b[got], flags) < 0) goto done;
-    }
-    const double *Q = b[0].buf, *sag = b[2].buf;
-    const int64_t *sizes = b[1].buf, *rows = b[4].buf, *i0 = b[5].buf, *i1 = b[6].buf, *j0 = b[7].buf, *j1 = b[8].buf;
-    const int64_t *ids = b[9].buf;
-    const uint8_t *wide = b[3].buf;
-    int64_t *opiece = b[10].buf, *ocell = b[11].buf, *omask = b[13].buf;
-    uint8_t *oin = b[12].buf;
-    Py_ssize_t K = b[1].len / 8, R = b[4].len / 8, cap = b[10].len / 8;
-    Py_ssize_t E = K ? b[0].len / 16 / K : 0;
-    int has_sag = b[2].len > 0;
-    if (b[0].len != 16 * K * E || (has_sag && b[2].len != 8 * K * E) || b[3].len != K || b[5].len != 8 * K
-        || b[6].len != 8 * K || b[7].len != 8 * K || b[8].len != 8 * K || b[9].len != 8 * K
-        || b[11].len != 8 * cap || b[12].len != cap || b[13].len != 8 * cap) {
-        PyErr_SetString(PyExc_ValueError, "_fast.classify: inconsistent array sizes");
+    PyObject *result = NULL, *todo = NULL, *arr[4] = {NULL, NULL, NULL, NULL};
+    double *hp = NULL, *q = NULL, *cq = NULL, *sag = NULL;
+    char *keep = NULL;
+    int64_t *idx = NULL;
+    for (; got < 4; got++)
+        if (PyObject_GetBuffer(ob[got], &b[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
+    const double *xy = b[0].buf, *lo = b[2].buf, *hi = b[3].buf;
+    const int64_t *off = b[1].buf;
+    Py_ssize_t K = b[1].len / 8 - 1;
+    if (K < 0 || b[2].len != 16 * K || b[3].len != 16 * K || off[0] != 0 || b[0].len != 16 * off[K] || o.gnx < 1
+        || ny < 1 || block_edges < 3) {
+        PyErr_SetString(PyExc_ValueError, "_fast.entries: inconsistent arrays");
         goto done;
     }
-    hp = PyMem_Malloc(sizeof(double) * 6 * (E ? E : 1)); /* per edge: n_x, n_y, c, hi, lo, weight */
-    if (!hp) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    Py_ssize_t n = 0, width = 1;
-    for (Py_ssize_t t = 0; t < R; t++) { /* the widest box: room for a row's right run */
-        int64_t r = rows[t];
-        if (r < 0 || r >= K || sizes[r] < 1 || sizes[r] > E) {
-            PyErr_SetString(PyExc_ValueError, "_fast.classify: a row or size out of range");
+    /* First pass: each piece's cells, the room they need, the longest piece taken. */
+    Py_ssize_t cap = 0, E = 3;
+    for (Py_ssize_t k = 0; k < K; k++) {
+        int64_t s = off[k + 1] - off[k], a, bb, c, d;
+        if (s < 1) {
+            PyErr_SetString(PyExc_ValueError, "_fast.entries: a piece without vertices");
             goto done;
         }
-        if (i1[r] - i0[r] + 1 > width) width = i1[r] - i0[r] + 1;
+        cell_range(lo[2 * k], hi[2 * k], o.m, x0, iw, o.gnx, &a, &bb);
+        cell_range(lo[2 * k + 1], hi[2 * k + 1], o.m, y0, ih, ny, &c, &d);
+        int64_t cells = (bb >= a && d >= c) ? (bb - a + 1) * (d - c + 1) : 0;
+        if (s <= block_edges && cells <= max_box) {
+            cap += cells;
+            if (s > E) E = s;
+        }
     }
-    right = PyMem_Malloc(sizeof(int64_t) * (size_t)width);
-    if (!right) {
+    if (!(todo = PyList_New(0))) goto done;
+    for (int t = 0; t < 4; t++)
+        if (!(arr[t] = PyByteArray_FromStringAndSize(NULL, (t == 2 ? 1 : 8) * (cap ? cap : 1)))) goto done;
+    o.piece = (int64_t *)PyByteArray_AS_STRING(arr[0]), o.cell = (int64_t *)PyByteArray_AS_STRING(arr[1]);
+    o.inside = (uint8_t *)PyByteArray_AS_STRING(arr[2]), o.mask = (int64_t *)PyByteArray_AS_STRING(arr[3]);
+    o.cap = cap;
+    Edges h;
+    if (edges_alloc(&h, &hp, E, o.m) < 0 || !(q = PyMem_Malloc(16 * (size_t)E)) || !(cq = PyMem_Malloc(16 * (size_t)E))
+        || !(sag = PyMem_Malloc(8 * (size_t)E)) || !(keep = PyMem_Malloc((size_t)E)) || !(idx = PyMem_Malloc(8 * (size_t)E))
+        || !(o.right = PyMem_Malloc(sizeof(int64_t) * (size_t)(o.gnx + 1)))) {
         PyErr_NoMemory();
         goto done;
     }
-    for (Py_ssize_t t = 0; t < R; t++) {
-        int64_t r = rows[t];
-        int64_t s = sizes[r];
-        const double *q = Q + 2 * r * E;
-        Edges h = {hp, hp + E, hp + 2 * E, hp + 3 * E, hp + 4 * E, (int64_t *)(hp + 5 * E), s, m};
-        for (int64_t e = 0; e < s; e++) { /* the half-planes, as _classify_many computes them */
-            int64_t f = e + 1 < s ? e + 1 : 0;
-            double ex = q[2 * f] - q[2 * e], ey = q[2 * f + 1] - q[2 * e + 1];
-            double len = hypot(ey, -ex);
-            h.nx[e] = ey / len, h.ny[e] = -ex / len;
-            h.c[e] = h.nx[e] * q[2 * e] + h.ny[e] * q[2 * e + 1];
-            h.hi[e] = max0(h.nx[e]) * cw + max0(h.ny[e]) * ch;
-            h.lo[e] = min0(h.nx[e]) * cw + min0(h.ny[e]) * ch;
-            if (has_sag) h.lo[e] -= sag[r * E + e];
-            h.w[e] = wide[r] ? 0 : (int64_t)((uint64_t)1 << ((e + 1) % s));
-        }
-        int64_t id = ids[r];
-        int is_wide = wide[r] != 0;
-        for (int64_t j = j0[r]; j <= j1[r]; j++) {
-            double cy0 = y_off + (double)j * ch;
-            int64_t row0 = j * (int64_t)gnx, L = i0[r], Rr = i1[r], ml = 0, mr = 0;
-            int tl = SEPARATED, tr;
-            /* The row's cells not separated: [L, Rr], from either end. */
-            for (; L <= Rr; L++)
-                if ((tl = cell_test(&h, x_off + (double)L * cw, cy0, &ml)) != SEPARATED) break;
-            if (L > Rr) continue;
-            if (n + (Rr - L + 1) > cap) {
-                PyErr_SetString(PyExc_ValueError, "_fast.classify: outputs too small");
+    for (Py_ssize_t k = 0; k < K; k++) {
+        int64_t s = off[k + 1] - off[k], a, bb, c, d;
+        cell_range(lo[2 * k], hi[2 * k], o.m, x0, iw, o.gnx, &a, &bb);
+        cell_range(lo[2 * k + 1], hi[2 * k + 1], o.m, y0, ih, ny, &c, &d);
+        int64_t cells = (bb >= a && d >= c) ? (bb - a + 1) * (d - c + 1) : 0;
+        if (s > block_edges || cells > max_box) {
+            PyObject *v = PyLong_FromSsize_t(k);
+            if (!v || PyList_Append(todo, v) < 0) {
+                Py_XDECREF(v);
                 goto done;
             }
-            tr = tl, mr = ml;
-            for (; Rr > L; Rr--)
-                if ((tr = cell_test(&h, x_off + (double)Rr * cw, cy0, &mr)) != SEPARATED) break;
-            if (Rr == L) tr = tl, mr = ml;
-            /* From L rightwards up to the first inside cell a. */
-            int64_t a = L, mk = ml;
-            int ta = tl;
-            for (;;) {
-                PUT(a, ta == INSIDE, mk);
-                if (ta == INSIDE || a == Rr) break;
-                a++;
-                if (a == Rr) ta = tr, mk = mr;
-                else ta = cell_test(&h, x_off + (double)a * cw, cy0, &mk);
-            }
-            if (ta != INSIDE) continue; /* no inside cell: the row is written */
-            /* From Rr leftwards down to the last inside cell b; then (a, b] inside, then (b, Rr]. */
-            int64_t b = Rr, nr = 0;
-            int tb = tr;
-            mk = mr;
-            while (b > a && tb != INSIDE) {
-                right[nr++] = mk;
-                b--;
-                if (b > a) tb = cell_test(&h, x_off + (double)b * cw, cy0, &mk);
-            }
-            for (int64_t i = a + 1; i <= b; i++) PUT(i, 1, 0);
-            for (int64_t k = nr - 1; k >= 0; k--) PUT(Rr - k, 0, right[k]);
+            Py_DECREF(v);
+            continue;
+        }
+        if (!cells) continue;
+        const double *p = xy + 2 * off[k];
+        for (int64_t v = 0; v < s; v++) q[2 * v] = p[2 * v] - ox, q[2 * v + 1] = p[2 * v + 1] - oy;
+        int wide = s > mask_edges;
+        if (wide) {
+            int64_t n = chord_polygon(q, s, long_edge, tol, keep, idx, cq, sag);
+            half_planes(&h, cq, n, sag, 1, o.cw, o.ch);
+        } else {
+            half_planes(&h, q, s, NULL, 0, o.cw, o.ch);
+        }
+        if (classify_box(&o, &h, wide, k, a, bb, c, d) < 0) {
+            PyErr_SetString(PyExc_ValueError, "_fast.entries: outputs too small");
+            goto done;
         }
     }
-    count = n;
+    for (int t = 0; t < 4; t++)
+        if (PyByteArray_Resize(arr[t], (t == 2 ? 1 : 8) * o.n) < 0) goto done;
+    result = Py_BuildValue("(OOOOO)", arr[0], arr[1], arr[2], arr[3], todo);
 done:
+    for (int t = 0; t < 4; t++) Py_XDECREF(arr[t]);
+    Py_XDECREF(todo);
     PyMem_Free(hp);
-    PyMem_Free(right);
+    PyMem_Free(q);
+    PyMem_Free(cq);
+    PyMem_Free(sag);
+    PyMem_Free(keep);
+    PyMem_Free(idx);
+    PyMem_Free(o.right);
     for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
-    return count < 0 ? NULL : PyLong_FromSsize_t(count);
+    return result;
 }
 
 /* assemble(cc, cp, cm, inside, npieces, out_state, out_blocker, out_starts, out_cand, out_masks)

@@ -50,6 +50,22 @@ static int64_t chord_piece(const double *q, int64_t s, char *keep, double limit,
     }
 }
 
+/* One piece's chord polygon: q (s vertices) -> out (n vertices), sag (n); returns n. The
+   start set: eight vertices, and both ends of every edge longer than long_edge (L1).
+   Scratch: keep (s bytes), idx (s). */
+int64_t chord_polygon(const double *q, int64_t s, double long_edge, double limit, char *keep, int64_t *idx,
+                      double *out, double *sag)
+{
+    int64_t step = s / 8 > 1 ? s / 8 : 1;
+    for (int64_t v = 0; v < s; v++) {
+        int64_t w = v + 1 < s ? v + 1 : 0, u = (v + s - 1) % s, u1 = v;
+        int lv = fabs(q[2 * w] - q[2 * v]) + fabs(q[2 * w + 1] - q[2 * v + 1]) > long_edge;
+        int lu = fabs(q[2 * u1] - q[2 * u]) + fabs(q[2 * u1 + 1] - q[2 * u + 1]) > long_edge;
+        keep[v] = (char)(lv || lu || v % step == 0);
+    }
+    return chord_piece(q, s, keep, limit, idx, out, sag);
+}
+
 /* chords(Q, sizes, long_edge, tolerance, out_R, out_n, out_sag) -> None
 
    Q: float64 K x E x 2 padded vertices; sizes: int64 K; out_R: float64 K x E x 2 (row k's
@@ -90,16 +106,9 @@ PyObject *fast_chords(PyObject *self, PyObject *args)
             PyErr_SetString(PyExc_ValueError, "_fast.chords: a size out of range");
             goto done;
         }
-        int64_t step = s / 8 > 1 ? s / 8 : 1;
-        for (int64_t v = 0; v < s; v++) { /* the start set: eight vertices, both ends of long edges */
-            int64_t w = v + 1 < s ? v + 1 : 0, u = (v + s - 1) % s, u1 = v;
-            int lv = fabs(q[2 * w] - q[2 * v]) + fabs(q[2 * w + 1] - q[2 * v + 1]) > long_edge;
-            int lu = fabs(q[2 * u1] - q[2 * u]) + fabs(q[2 * u1 + 1] - q[2 * u + 1]) > long_edge;
-            keep[v] = (char)(lv || lu || v % step == 0);
-        }
         double *sg = sag + k * E;
         for (Py_ssize_t c = 0; c < E; c++) sg[c] = 0.0;
-        nout[k] = chord_piece(q, s, keep, limit, idx, R + 2 * k * E, sg);
+        nout[k] = chord_polygon(q, s, long_edge, limit, keep, idx, R + 2 * k * E, sg);
     }
     ok = 1;
 done:

@@ -587,7 +587,7 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn)
 }
 
 static PyMethodDef methods[] = {
-    {"grid", py_grid, METH_VARARGS, "Copy a grid index and its packed pieces; returns a handle."},
+    {"grid", py_grid, METH_VARARGS, "Hold a grid index and its packed pieces (read-only); returns a handle."},
     {"segment", (PyCFunction)(void (*)(void))py_segment, METH_FASTCALL,
      "segment(grid, ax, ay, bx, by): 1 or 3 free, 0 not free, -1 undecided."},
     {"point", (PyCFunction)(void (*)(void))py_point, METH_FASTCALL,
@@ -596,8 +596,7 @@ static PyMethodDef methods[] = {
      "orient(ax, ay, bx, by, cx, cy): the float filter's sign of orient2d, 2 if undecided."},
     {"assemble", fast_assemble, METH_VARARGS,
      "assemble(cc, cp, cm, inside, npieces, state, blocker, starts, cand, masks): the grid from its entries (_cells.c)."},
-    {"classify", fast_classify, METH_VARARGS,
-     "classify(...): the grid build's half-planes and cell classification of boxes of cells (_cells.c)."},
+    {"entries", fast_entries, METH_VARARGS, "The grid build's classified entries from packed pieces (cspace/spaces/_cells.c)."},
     {"pair_sums", fast_pair_sums, METH_VARARGS,
      "pair_sums(a_xy, a_off, b_xy, b_off, out_xy, out_count): the C-space build's pair sums (see _build.c)."},
     {"contained", fast_contained, METH_VARARGS,

@@ -80,7 +80,9 @@ static inline int orient(double ax, double ay, double bx, double by, double cx, 
 PyObject *fast_pair_sums(PyObject *self, PyObject *args);                     /* _build.c */
 PyObject *fast_contained(PyObject *self, PyObject *args);                     /* _build.c */
 PyObject *fast_chords(PyObject *self, PyObject *args);                        /* _chords.c */
-PyObject *fast_classify(PyObject *self, PyObject *args);                      /* _cells.c */
+int64_t chord_polygon(const double *q, int64_t s, double long_edge, double limit, char *keep, int64_t *idx,
+                      double *out, double *sag);                          /* _chords.c */
+PyObject *fast_entries(PyObject *self, PyObject *args);                       /* _cells.c */
 PyObject *fast_assemble(PyObject *self, PyObject *args);                      /* _cells.c */
 PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs);  /* _gjk.c */
 

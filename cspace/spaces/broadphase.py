@@ -68,7 +68,9 @@ class GridIndex(CellClassifier):
 
     ``cells`` sets the cell count (default: from the pieces); ``shape`` = (nx, ny)
     fixes the columns and rows instead, to share another grid's cells; ``boxes``: the
-    pieces' boxes (:func:`cspace.kernel.polygon.piece_boxes`) when the caller has them.
+    pieces' boxes (:func:`cspace.kernel.polygon.piece_boxes`) when the caller has them;
+    ``packed``: their vertices one after another and offsets (a PieceSet's ``start`` and
+    ``offsets``), likewise.
 
     >>> g = GridIndex([np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])], (0, 4, 0, 4), cells=16)
     >>> int(g.state_at(3.5, 3.5)), int(g.state_at(0.5, 0.5))
@@ -76,7 +78,8 @@ class GridIndex(CellClassifier):
     """
 
     def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None,
-                 shape: tuple[int, int] | None = None, boxes: tuple[np.ndarray, np.ndarray] | None = None):
+                 shape: tuple[int, int] | None = None, boxes: tuple[np.ndarray, np.ndarray] | None = None,
+                 packed: tuple[np.ndarray, np.ndarray] | None = None):
         xmin, xmax, ymin, ymax = map(float, bounds)
         self.bounds = (xmin, xmax, ymin, ymax)
         n = len(pieces)
@@ -120,7 +123,7 @@ class GridIndex(CellClassifier):
             starts = np.zeros(nx * ny + 1, np.int64)
             self._counts = (nx * ny, 0, 0)
         elif fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
-            cc, cp, cm, inside = self._classify_all(pieces)
+            cc, cp, cm, inside = self._classify_all(pieces, packed)
             state, blocker = np.empty(nx * ny, np.int8), np.empty(nx * ny, np.int64)
             starts, cand, masks = np.empty(nx * ny + 1, np.int64), np.empty(len(cc), np.int64), np.empty(len(cc), np.int64)
             self._counts = fastpath.assemble(cc, cp, cm, inside, n, state, blocker, starts, cand, masks)

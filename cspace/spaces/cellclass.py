@@ -14,8 +14,11 @@ Pieces are classified together in padded (piece, cell, edge) blocks; boxes wider
 SCAN_COLUMNS cells row by row, where each edge's tests flip once along a row (found
 exactly by bisection on the same float expression, started from the column solved in
 reals). Pieces of more than MASK_EDGES edges go through their chord polygons
-(:func:`cspace.kernel.chords.chord_polygons`, in C on the compiled path: the same doubles) and have their masks computed per cell on demand
-(:meth:`CellClassifier.edge_mask`).
+(:func:`cspace.kernel.chords.chord_polygons`) and have their masks computed per cell on
+demand (:meth:`CellClassifier.edge_mask`). On the compiled path, ``_fast.entries``
+(cspace/spaces/_cells.c) does all of it piece by piece from the packed vertices, with the
+same doubles: this numpy route is its oracle, and takes the pieces it leaves (more than
+_BLOCK_EDGES edges, boxes of more than 2^20 cells).
 """
 from __future__ import annotations
 
@@ -54,34 +57,6 @@ def _runs(rows: np.ndarray, jj: np.ndarray, lo: np.ndarray, hi: np.ndarray):
 
 
 
-def _compiled_boxes(rows, cells, Q, sizes, sag, wide, i0, i1, j0, j1, x_off, y_off, cw, ch, m, ids, nx) -> list:
-    """The compiled route of :meth:`CellClassifier._classify_many`: the half-planes of the
-    pieces ``rows`` and every cell of their boxes evaluated by ``_fast.classify`` (the numpy
-    route's arithmetic, in C), in chunks of at most 2^21 cells; parts ``(piece, cell,
-    inside, mask)`` of the kept cells (``ids``: each row's piece; ``nx``: the grid's
-    columns), the entries :meth:`CellClassifier._gathered` makes of the numpy route's."""
-    out = []
-    f64, i64 = np.ascontiguousarray, lambda a: np.ascontiguousarray(a, dtype=np.int64)
-    Q, sizes, wide = f64(Q, dtype=np.float64), i64(sizes), np.ascontiguousarray(wide, dtype=np.uint8)
-    sag = np.zeros(0) if sag is None else f64(sag, dtype=np.float64)
-    i0, i1, j0, j1, ids = i64(i0), i64(i1), i64(j0), i64(j1), i64(ids)
-    # Chunks of consecutive rows of at most 2^21 cells (a bigger row alone).
-    ends = np.cumsum(cells[rows])
-    start = 0
-    while start < len(rows):
-        base = int(ends[start - 1]) if start else 0
-        stop = max(start + 1, int(np.searchsorted(ends, base + (1 << 21), side="right")))
-        cap = int(ends[stop - 1]) - base
-        chunk = i64(rows[start:stop])
-        o = [np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.uint8),
-             np.empty(cap, dtype=np.int64)]
-        n = fastpath.classify_boxes(Q, sizes, sag, wide, chunk, i0, i1, j0, j1, float(x_off), float(y_off),
-                                    float(cw), float(ch), float(m), ids, int(nx), WIDE_MASK, *o)
-        out.append((o[0][:n], o[1][:n], o[2][:n].view(bool), o[3][:n]))
-        start = stop
-    return out
-
-
 class CellClassifier:
     """The cell classification of a grid (a mixin of
     :class:`cspace.spaces.broadphase.GridIndex`): it reads the grid's frame (``x0``,
@@ -92,26 +67,46 @@ class CellClassifier:
 
     compiled = True
 
-    def _classify_all(self, pieces: list[np.ndarray]):
+    def _classify_all(self, pieces: list[np.ndarray], packed: tuple | None = None):
         """Every (cell, piece) pair that may meet: ``(cells, pieces, masks, inside)``,
-        each piece's cells together."""
+        each piece's cells together. ``packed``: the pieces' vertices one after another
+        and their offsets (:class:`cspace.kernel.pieces.PieceSet`'s ``start``, ``offsets``),
+        for the compiled route."""
         cand_cells: list[np.ndarray] = []
         cand_piece: list[np.ndarray] = []
         cand_mask: list[np.ndarray] = []
+        inside_parts = []
+        sizes = [len(p) for p in pieces]
+        todo = range(len(pieces))
+        if fastpath.compiled() and self.compiled and pieces:
+            # In C from the packed vertices, piece by piece (_fast.entries: the padded route's
+            # doubles); it leaves pieces of more than _BLOCK_EDGES edges or 2^20 cells to the
+            # routes below.
+            if packed is None:
+                packed = (np.concatenate(pieces), np.concatenate([[0], np.cumsum(sizes)]))
+            pid, cells_k, inside, masks, todo = fastpath.entries(
+                packed[0], packed[1], self._lo, self._hi, self.ox, self.oy, self.x0, self.y0, self.inv_w, self.inv_h,
+                self.cw, self.ch, self.margin, self.nx, self.ny, MASK_EDGES, _BLOCK_EDGES, 1 << 20,
+                self.cw + self.ch, 0.25 * min(self.cw, self.ch), WIDE_MASK)
+            if not todo:
+                return cells_k, pid, masks, inside
+            cand_cells.append(cells_k)
+            cand_piece.append(pid)
+            inside_parts.append(inside)
+            cand_mask.append(masks)
         # Pieces are classified together, in blocks of (piece, cell) pairs (one numpy
         # pass instead of one per piece), those with masks apart from the wider ones so
         # that a 4-gon is not padded to a margin's 70 edges; huge pieces one by one.
-        inside_parts = []
-        sizes = [len(p) for p in pieces]
-        for group in ([k for k, e in enumerate(sizes) if e <= MASK_EDGES],
-                      [k for k, e in enumerate(sizes) if MASK_EDGES < e <= _BLOCK_EDGES]):
+        for group in ([k for k in todo if sizes[k] <= MASK_EDGES],
+                      [k for k in todo if MASK_EDGES < sizes[k] <= _BLOCK_EDGES]):
             if group:
                 pid, cells_k, inside, masks = self._classify_many(pieces, group)
                 cand_cells.append(cells_k)
                 cand_piece.append(pid)
                 inside_parts.append(inside)
                 cand_mask.append(masks)
-        for k, p in enumerate(pieces):
+        for k in todo:
+            p = pieces[k]
             if sizes[k] <= _BLOCK_EDGES:
                 continue
             cells_k, inside, masks = self._classify(p, with_masks=False)
@@ -207,16 +202,10 @@ class CellClassifier:
         W = np.maximum(i1 - i0 + 1, 0)
         H = np.maximum(j1 - j0 + 1, 0)
         x_off, y_off, cw, ch = self.x0 - self.ox, self.y0 - self.oy, self.cw, self.ch
-        parts, done = [], []
+        parts = []
         narrow_box = W <= SCAN_COLUMNS
-        if fastpath.compiled() and self.compiled:  # every box up to 2^20 cells in C, the same doubles
-            small = (W * H > 0) & (W * H <= 1 << 20)
-            done = _compiled_boxes(np.flatnonzero(small), W * H, Q, sizes, sag, wide, i0, i1, j0, j1,
-                                   x_off, y_off, cw, ch, m, ks, self.nx)
-            narrow_box = narrow_box & ~small
-            H = np.where(small, 0, H)
         if not (narrow_box & (W * H > 0)).any() and not (~narrow_box & (H > 0)).any():
-            return self._joined(done)
+            return self._joined([])
         slot = np.arange(E)
         valid = slot[None, :] < sizes[:, None]
         nxt = np.where(slot[None, :] + 1 < sizes[:, None], slot[None, :] + 1, 0)
@@ -273,7 +262,7 @@ class CellClassifier:
         scan = np.flatnonzero(~narrow_box & (H > 0))
         if len(scan):
             parts += self._scan_rows(scan, i0, i1, j0, H, nrm, c, hi, lo, evaluate)
-        return self._joined(done + ([self._gathered(parts, ks, wide)] if parts else []))
+        return self._joined([self._gathered(parts, ks, wide)] if parts else [])
 
     def _gathered(self, parts: list, ks: list[int], wide: np.ndarray) -> tuple:
         """Entries ``(piece, cell, inside, mask)`` from the numpy route's parts ``(row, i, j,

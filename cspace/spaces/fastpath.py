@@ -87,11 +87,17 @@ def assemble(*args) -> tuple[int, int, int]:
     return _fast.assemble(i64(cc), i64(cp), i64(cm), np.ascontiguousarray(inside, dtype=np.uint8), int(n), *out)
 
 
-def classify_boxes(*args) -> int:
-    """``_fast.classify`` (cspace/spaces/_cells.c): the grid build's half-planes and cell
-    classification of boxes of cells, the numpy route's arithmetic in C
-    (cspace/spaces/cellclass.py calls it when :func:`compiled`)."""
-    return _fast.classify(*args)
+def entries(xy, offsets, lo, hi, *frame) -> tuple:
+    """``_fast.entries`` (cspace/spaces/_cells.c): the grid build's classified entries
+    ``(piece, cell, inside, mask)`` of packed pieces, and the pieces it left to the numpy
+    routes (cspace/spaces/cellclass.py calls it when :func:`compiled`)."""
+    f64, i64 = (lambda a: np.ascontiguousarray(a, dtype=np.float64)), (lambda a: np.ascontiguousarray(a, dtype=np.int64))
+    ox, oy, x0, y0, iw, ih, cw, ch, m, nx, ny, mask_edges, block_edges, max_box, long_edge, tol, wide_mask = frame
+    pid, cell, inside, mask, todo = _fast.entries(
+        f64(xy), i64(offsets), f64(lo), f64(hi), *map(float, (ox, oy, x0, y0, iw, ih, cw, ch, m)),
+        *map(int, (nx, ny, mask_edges, block_edges, max_box)), float(long_edge), float(tol), int(wide_mask))
+    as64 = lambda b: np.frombuffer(b, dtype=np.int64)  # noqa: E731
+    return as64(pid), as64(cell), np.frombuffer(inside, dtype=bool), as64(mask), todo
 
 
 def pair_sums(pa: list, pb: list) -> list | None:
