@@ -62,25 +62,31 @@ def random_pieces(rng, n, spread=10.0):
     return out + [out[0].copy(), out[1] * 0.5 + out[1].mean(axis=0) * 0.5]
 
 
-@pytest.mark.parametrize("far", [False, True])
+def _route(cb, route, monkeypatch):
+    """The prune's candidate route: nested boxes (few pieces), or an STRtree of each piece's
+    first vertex, or of its far vertex (many pieces)."""
+    monkeypatch.setattr(cb, "BOX_PROPOSALS", 1 << 30 if route == "boxes" else 0)
+    monkeypatch.setattr(cb, "FAR_VERTEX_PIECES", 0 if route == "far" else 1 << 30)
+
+
+@pytest.mark.parametrize("route", ["boxes", "first", "far"])
 @pytest.mark.parametrize("seed", range(6))
-def test_containment_pruning_equals_the_scan(seed, far, monkeypatch):
-    # Each piece proposed by its first vertex (small scenes) or its far vertex (many pieces).
+def test_containment_pruning_equals_the_scan(seed, route, monkeypatch):
     import cspace.spaces.cspace_build as cb
 
-    monkeypatch.setattr(cb, "FAR_VERTEX_PIECES", 0 if far else 1 << 30)
+    _route(cb, route, monkeypatch)
     pieces = random_pieces(np.random.default_rng(seed), 150, spread=15.0)
     want = contained_reference(pieces)
     assert want and _contained_pieces(pieces) == want
 
 
-@pytest.mark.parametrize("far", [False, True])
-def test_containment_pruning_of_a_fan_equals_the_scan(far, monkeypatch):
+@pytest.mark.parametrize("route", ["boxes", "first", "far"])
+def test_containment_pruning_of_a_fan_equals_the_scan(route, monkeypatch):
     # Wedges from one centre (a star's spikes, as decomposed) share their inner vertex: among
     # many pieces each stands for itself by its far vertex; nested half-wedges must be found.
     import cspace.spaces.cspace_build as cb
 
-    monkeypatch.setattr(cb, "FAR_VERTEX_PIECES", 0 if far else 1 << 30)
+    _route(cb, route, monkeypatch)
     k = 60
     a = np.linspace(0, 2 * np.pi, k, endpoint=False)
     wedges = [np.array([[0.0, 0.0], [10 * np.cos(t), 10 * np.sin(t)], [10 * np.cos(t + 0.2), 10 * np.sin(t + 0.2)]])

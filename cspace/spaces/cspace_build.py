@@ -104,6 +104,8 @@ def decompose_robot(robot: list[np.ndarray], is_disk: bool = False) -> tuple[lis
 
 # From this many pieces on, the containment prune proposes each piece by its far vertex.
 FAR_VERTEX_PIECES = 4096
+# Up to this many pieces, it proposes pairs by boxes alone (no polygons built).
+BOX_PROPOSALS = 256
 
 
 def _contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None) -> dict[int, int]:
@@ -132,7 +134,13 @@ def _contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndar
     import shapely
 
     sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
-    if (sizes >= 3).all():
+    if n <= BOX_PROPOSALS:
+        # Few pieces: every pair whose boxes nest, by one comparison of all the boxes (at
+        # most n^2 pairs for the exact test; building the trees and polygons for the
+        # point-in-polygon filter below costs more than the exact test of what it drops).
+        qs, ps = np.nonzero((lo[None, :, 0] >= lo[:, None, 0]) & (hi[None, :, 0] <= hi[:, None, 0]) &
+                            (lo[None, :, 1] >= lo[:, None, 1]) & (hi[None, :, 1] <= hi[:, None, 1]))
+    elif (sizes >= 3).all():
         flat = np.concatenate(pieces)
         owner = np.repeat(np.arange(n), sizes)
         rings = shapely.linearrings(flat, indices=owner)
