@@ -467,6 +467,31 @@ def test_tighter_bounds_change_nothing_but_the_work(seed, monkeypatch):
     assert fast.distance == pytest.approx(swept_clearance(path, robot, obstacles), rel=1e-9, abs=1e-12)
 
 
+@pytest.mark.parametrize("seed", range(8))
+def test_closest_position_holds_the_distance(seed):
+    # Where the robot comes closest (read off GJK's witness on the swept set, or the
+    # segment's point nearest the C-obstacle where GJK decides exactly): on the reported
+    # segment, and the robot placed there is at the reported distance from the obstacle,
+    # whose reported point is that far from it (shapely). Some paths touch an obstacle.
+    from cspace.spaces.clearance import path_clearance
+
+    rng = np.random.default_rng(50 + seed)
+    obstacles = [_random_convex(rng, rng.uniform(0, 20, 2), rng.uniform(0.5, 3), int(rng.integers(3, 9))) for _ in range(12)]
+    robot = [_random_convex(rng, (0.0, 0.0), 0.6, 5), _random_convex(rng, (0.3, 0.0), 0.4, 4)] if seed % 4 else []
+    path = rng.uniform(0, 20, (int(rng.integers(2, 12)), 2))
+    if seed % 3 == 0:  # along an obstacle's boundary: distance 0
+        path = np.vstack([path[:2], obstacles[0], path[-1:]])
+    c = path_clearance(path, robot, obstacles)
+    a, b = path[c.segment], path[c.segment + 1]
+    where, q = np.array(c.where), shapely.Point(c.obstacle_point)
+    assert shapely.LineString([a, b]).distance(shapely.Point(where)) <= 1e-12 * (1 + np.abs(path).max())
+    placed = shapely.union_all([shapely.Polygon(r + where) for r in robot]) if robot else shapely.Point(where)
+    nearest = min(shapely.Polygon(o).distance(placed) for o in obstacles)
+    assert nearest == pytest.approx(c.distance, rel=1e-9, abs=1e-9)
+    assert placed.distance(q) == pytest.approx(c.distance, rel=1e-9, abs=1e-9)
+    assert c.distance == pytest.approx(swept_clearance(path, robot, obstacles), rel=1e-9, abs=1e-12)
+
+
 def test_tighter_bounds_prune_a_margin_path():
     # An exact path with a margin hugs the inflated obstacles along many short segments at
     # nearly the same distance: the box bounds leave GJK hundreds of pairs, the tight ones few.

@@ -119,6 +119,36 @@ def gjk_distance_below(A, B, bound: float, *, loop=None) -> Distance | None:
     return _answer_raw(*fast)
 
 
+def witness_weights(A, B, *, loop=None) -> list[tuple[int, float]] | None:
+    """A's closest point to B as weights on A's vertices, ``[(index, weight)]``: GJK's final
+    simplex and its weights (the point :func:`gjk_distance` reports as ``point_a``), where
+    its float loop separates A and B beyond the exact band; None where it does not (touching,
+    overlapping, decided exactly, coordinates far from unit scale). A search over swept
+    sets reads from them where along its motion a piece comes closest.
+
+    >>> A, B = np.array([[0., 0], [2, 0], [2, 1], [0, 1]]), np.array([[1., 3], [3, 3], [2, 4]])
+    >>> w = witness_weights(A, B)
+    >>> sum(t * A[i] for i, t in w).tolist() == gjk_distance(A, B).point_a.tolist() == [1.5, 1.0]
+    True
+    """
+    fast = _compiled(A, B, MAX_ITERATIONS, loop)
+    if fast is not None:
+        pax, pay, pbx, pby, _, inside, simplex, extent = fast[2]
+    else:
+        a, b = as_array(A, copy=False, nonempty=True), as_array(B, copy=False, nonempty=True)
+        ox, oy = a[0].tolist()
+        al = [(x - ox, y - oy) for x, y in a.tolist()]
+        bl = [(x - ox, y - oy) for x, y in b.tolist()]
+        extent = _scale(al, bl)
+        if not SAFE_MIN <= extent < SAFE_MAX:
+            return None
+        pax, pay, pbx, pby, _, inside, simplex = _loop(al, bl, MAX_ITERATIONS)
+    if inside or math.hypot(pax - pbx, pay - pby) <= EXACT_BAND * extent:
+        return None
+    kept, lam = _solve(list(simplex))  # the loop's last solve: the weights of point_a
+    return [(int(v[0]), float(t)) for v, t in zip(kept, lam)]
+
+
 def _compiled(A, B, max_iterations: int, loop):
     """``(a, b, raw)``: the compiled ``loop``'s result on plain (N, 2) float64 arrays A and B
     (a closing repeat of the first vertex dropped, as as_array does), or None where it

@@ -37,7 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..kernel.gjk import gjk_distance, gjk_distance_below
+from ..kernel.gjk import gjk_distance, gjk_distance_below, witness_weights
 from ..kernel.polygon import packed_boxes
 from . import fastpath
 
@@ -239,7 +239,19 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     if arg is None:
         return PathClearance(math.inf, (), (), -1, "exact")
     i, j, k, w = arg
-    where = _closest_position(segs[i], rob[j], obs.pieces[k], obs.loop)
+    # Where: GJK's closest point on the swept set is a weighted sum of placed vertices r + p
+    # (p the segment's start or end); the same weights on the p's give a reference position
+    # whose placed piece holds that point, so lies at the distance found (no C-obstacle built).
+    nv = len(rob[j])
+    swept = placed[j][i * nv:(i + 1 if still[i] else i + 2) * nv]
+    weights = witness_weights(swept, obs.pieces[k], loop=obs.loop)
+    if weights is not None:
+        where = tuple(float(v) for v in sum(t * pts[i + v // nv] for v, t in weights))
+    else:  # touching, or decided exactly: the segment's point nearest the C-obstacle,
+        # and the obstacle's point nearest the piece placed there (where the sweep touches
+        # along a stretch, the sweep's own witness may lie elsewhere on it)
+        where = _closest_position(segs[i], rob[j], obs.pieces[k], obs.loop)
+        w = gjk_distance(rob[j] + np.array(where), obs.pieces[k], loop=obs.loop).point_b
     return PathClearance(float(best), where, tuple(float(v) for v in w), i, "exact")
 
 
