@@ -318,7 +318,7 @@ def test_compiled_entries_leave_huge_pieces_to_the_numpy_routes(monkeypatch):
     c, n = _both_routes(pieces, (0, 10, 0, 10), cells, monkeypatch)
     assert _grids_equal(c, n)
     ps = PieceSet(pieces)
-    g = GridIndex(pieces, (0, 10, 0, 10), cells=cells, packed=(ps.start, ps.offsets))
+    g = GridIndex(pieces, (0, 10, 0, 10), cells=cells, packed=ps)
     assert _grids_equal(g, n)
     assert (n.state == 2).sum() > 1000
 

@@ -22,6 +22,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..kernel.pieces import PieceSet
 from ..kernel.polygon import piece_boxes
 from . import fastpath
 from .cellclass import MASK_EDGES, WIDE_MASK, CellClassifier  # noqa: F401  (the masks: part of the grid's API)
@@ -67,10 +68,9 @@ class GridIndex(CellClassifier):
     """Uniform grid over ``bounds`` classifying cells against convex ``pieces``.
 
     ``cells`` sets the cell count (default: from the pieces); ``shape`` = (nx, ny)
-    fixes the columns and rows instead, to share another grid's cells; ``boxes``: the
-    pieces' boxes (:func:`cspace.kernel.polygon.piece_boxes`) when the caller has them;
-    ``packed``: their vertices one after another and offsets (a PieceSet's ``start`` and
-    ``offsets``), likewise.
+    fixes the columns and rows instead, to share another grid's cells; ``packed``: the
+    pieces as a :class:`cspace.kernel.pieces.PieceSet` when the caller has one (its boxes
+    and packed vertices are used, not computed again).
 
     >>> g = GridIndex([np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])], (0, 4, 0, 4), cells=16)
     >>> int(g.state_at(3.5, 3.5)), int(g.state_at(0.5, 0.5))
@@ -78,13 +78,13 @@ class GridIndex(CellClassifier):
     """
 
     def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None,
-                 shape: tuple[int, int] | None = None, boxes: tuple[np.ndarray, np.ndarray] | None = None,
-                 packed: tuple[np.ndarray, np.ndarray] | None = None):
+                 shape: tuple[int, int] | None = None, packed: PieceSet | None = None):
         xmin, xmax, ymin, ymax = map(float, bounds)
         self.bounds = (xmin, xmax, ymin, ymax)
         n = len(pieces)
         w, h = xmax - xmin, ymax - ymin
-        self._lo, self._hi = boxes if boxes is not None else piece_boxes(pieces)  # each piece's box, in one pass
+        # each piece's box, in one pass
+        self._lo, self._hi = (packed.lo, packed.hi) if packed is not None else piece_boxes(pieces)
         if cells is None:
             # About 256 cells per piece, at least 64 x 64: measured on the bundled scenes
             # (plans of RRTConnect, compiled and pure paths), 1024 per piece and at least

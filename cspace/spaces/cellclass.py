@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from ..kernel.chords import chord_polygons
+from ..kernel.pieces import PieceSet
 from . import fastpath
 
 # Boxes wider than this many cells are classified row by row (GridIndex._scan_rows).
@@ -67,11 +68,10 @@ class CellClassifier:
 
     compiled = True
 
-    def _classify_all(self, pieces: list[np.ndarray], packed: tuple | None = None):
+    def _classify_all(self, pieces: list[np.ndarray], packed: PieceSet | None = None):
         """Every (cell, piece) pair that may meet: ``(cells, pieces, masks, inside)``,
-        each piece's cells together. ``packed``: the pieces' vertices one after another
-        and their offsets (:class:`cspace.kernel.pieces.PieceSet`'s ``start``, ``offsets``),
-        for the compiled route."""
+        each piece's cells together. ``packed``: the pieces packed (the compiled route
+        reads their vertices from it), when the caller has them so."""
         cand_cells: list[np.ndarray] = []
         cand_piece: list[np.ndarray] = []
         cand_mask: list[np.ndarray] = []
@@ -83,9 +83,9 @@ class CellClassifier:
             # doubles); it leaves pieces of more than _BLOCK_EDGES edges or 2^20 cells to the
             # routes below.
             if packed is None:
-                packed = (np.concatenate(pieces), np.concatenate([[0], np.cumsum(sizes)]))
+                packed = PieceSet(pieces, (self._lo, self._hi))
             pid, cells_k, inside, masks, todo = fastpath.entries(
-                packed[0], packed[1], self._lo, self._hi, self.ox, self.oy, self.x0, self.y0, self.inv_w, self.inv_h,
+                packed.start, packed.offsets, self._lo, self._hi, self.ox, self.oy, self.x0, self.y0, self.inv_w, self.inv_h,
                 self.cw, self.ch, self.margin, self.nx, self.ny, MASK_EDGES, _BLOCK_EDGES, 1 << 20,
                 self.cw + self.ch, 0.25 * min(self.cw, self.ch), WIDE_MASK)
             if not todo:

@@ -89,8 +89,7 @@ class CSpace(PointQueries, SegmentQueries):
         self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
         t = time.perf_counter()
         self.packed = PieceSet(self.pieces, self._boxes)  # the prune's boxes of the kept pieces
-        self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells, boxes=(self.packed.lo, self.packed.hi),
-                               packed=(self.packed.start, self.packed.offsets))
+        self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells, packed=self.packed)
         self._coarse = None
         # The compiled fast path's copy of the grid and pieces (None on the pure path): part of the index.
         self._fast = fastpath.grid_handle(self.index, self.packed, self.bounds)

@@ -26,7 +26,7 @@ class SegmentQueries:
         if self._coarse is None:
             cells = self.index.nx * self.index.ny
             self._coarse = (self.index if cells <= SMALL_GRID
-                            else GridIndex(self.pieces, self.bounds, cells=max(cells // 16, 64)))
+                            else GridIndex(self.pieces, self.bounds, cells=max(cells // 16, 64), packed=self.packed))
         return self._coarse
 
     def segment_free(self, a, b=None):
