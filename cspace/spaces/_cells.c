@@ -4,7 +4,7 @@
    order, so the same grid: the local frame's shift, each box's cells, the chord polygons
    of pieces of more than mask_edges edges (_chords.c), the half-planes and the cells.
 
-   Each piece's edge i -> i+1 (padded vertices Q, local frame) is a half-plane
+   Each piece's edge i -> i+1 (its vertices Q in the local frame) is a half-plane
    n . x <= c with n = (e_y, -e_x) / hypot(e_y, -e_x), c = n_x Q_x + n_y Q_y; over a cell
    the signed distance of its corners ranges over d + lo .. d + hi with
    hi = max(n_x, 0) cw + max(n_y, 0) ch, lo = min(n_x, 0) cw + min(n_y, 0) ch (less the
@@ -14,20 +14,21 @@
    not strictly inside. Cells not separated are written (piece id, cell j nx + i, inside,
    mask; WIDE_MASK for wide pieces), piece by piece, row-major: the entries
    CellClassifier._gathered makes of the numpy route's, up to their order (which the
-   assembly does not see). No filter and no rounding argument
-   of its own: the numpy route's doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum and
-   minimum propagate them: no cell is inside or separated by such an edge.
+   assembly does not see). No filter and no rounding argument of its own: the numpy
+   route's doubles. NaN normals (a piece rounded to a point) propagate as numpy's maximum
+   and minimum propagate them: no cell is inside or separated by such an edge.
 
    Two shortcuts change no output: a separated cell is not written, so its remaining
-   edges are skipped; and along a row of cells only the ends are evaluated. Why the last is exact: along a row, d is computed from
-   x_off + i cw by a product and two sums with fixed operands, and rounding is monotone,
-   so each edge's d is a monotone function of i in doubles too. Each edge's "strictly
+   edges are skipped; and along a row of cells only the ends are evaluated. Why the
+   second is exact: along a row, d is computed from x_off + i cw by a product and two
+   sums with fixed operands, and rounding is monotone, so each edge's d is a monotone
+   function of i in doubles too. Each edge's "strictly
    inside" thus holds on a prefix or a suffix of the row, and so does its "strictly
    outside": the inside cells (every edge inside) form one run, and so do the cells not
    separated (no edge outside). The row is scanned from its left end to the first cell
    not separated and from its right end likewise; between them, from the left to the
    first inside cell and from the right to the last; every cell between those two is
-   inside (mask 0) without a test. The entries come out in the same order.
+   inside (mask 0) without a test. The entries come out row-major all the same.
 
    assemble() turns the classified entries into the grid's arrays, as GridIndex's numpy
    route does. */
@@ -105,7 +106,7 @@ static void half_planes(Edges *h, const double *q, int64_t s, const double *sag,
      o->mask[o->n] = wide ? o->wide_mask : (mk), o->n++)
 
 /* The cells of box i0..i1 x j0..j1 that piece id (half-planes h) may meet, row by row,
-   each row scanned from its ends (the header's third shortcut). -1 if o has no room. */
+   each row scanned from its ends (the header's second shortcut). -1 if o has no room. */
 static int classify_box(Out *o, const Edges *h, int wide, int64_t id, int64_t i0, int64_t i1, int64_t j0, int64_t j1)
 {
     for (int64_t j = j0; j <= j1; j++) {
@@ -177,8 +178,8 @@ static void cell_range(double lo, double hi, double m, double x0, double inv, in
    2 x vertices, piece k from offsets[k]; lo, hi: float64 K x 2, their boxes): each piece
    of at most block_edges edges whose box holds 1 .. max_box cells is shifted to the local
    frame (x - ox, y - oy), replaced by its chord polygon when it has more than mask_edges
-   edges (mask wide_mask), and classified as classify() does: the same doubles as the
-   padded route, the same entries up to their order. The entries come back as bytearrays
+   edges (mask wide_mask), and its box classified by classify_box: the same doubles as
+   the numpy route, the same entries up to their order. The entries come back as bytearrays
    (int64, int64, uint8, int64); todo lists the pieces left to the caller (more edges or
    cells than that). */
 PyObject *fast_entries(PyObject *self, PyObject *args)
@@ -197,7 +198,7 @@ PyObject *fast_entries(PyObject *self, PyObject *args)
     PyObject *result = NULL, *todo = NULL, *arr[4] = {NULL, NULL, NULL, NULL};
     double *hp = NULL, *q = NULL, *cq = NULL, *sag = NULL;
     char *keep = NULL;
-    int64_t *idx = NULL;
+    int64_t *idx = NULL, *box = NULL;
     for (; got < 4; got++)
         if (PyObject_GetBuffer(ob[got], &b[got], PyBUF_C_CONTIGUOUS) < 0) goto done;
     const double *xy = b[0].buf, *lo = b[2].buf, *hi = b[3].buf;
@@ -208,19 +209,24 @@ PyObject *fast_entries(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "_fast.entries: inconsistent arrays");
         goto done;
     }
-    /* First pass: each piece's cells, the room they need, the longest piece taken. */
+    /* First pass: each piece's box of cells (i0, i1, j0, j1, and its cell count), the room
+       the pieces taken need, the longest of them. */
+    if (!(box = PyMem_Malloc(sizeof(int64_t) * 5 * (size_t)(K ? K : 1)))) {
+        PyErr_NoMemory();
+        goto done;
+    }
     Py_ssize_t cap = 0, E = 3;
     for (Py_ssize_t k = 0; k < K; k++) {
-        int64_t s = off[k + 1] - off[k], a, bb, c, d;
+        int64_t s = off[k + 1] - off[k], *bx = box + 5 * k;
         if (s < 1) {
             PyErr_SetString(PyExc_ValueError, "_fast.entries: a piece without vertices");
             goto done;
         }
-        cell_range(lo[2 * k], hi[2 * k], o.m, x0, iw, o.gnx, &a, &bb);
-        cell_range(lo[2 * k + 1], hi[2 * k + 1], o.m, y0, ih, ny, &c, &d);
-        int64_t cells = (bb >= a && d >= c) ? (bb - a + 1) * (d - c + 1) : 0;
-        if (s <= block_edges && cells <= max_box) {
-            cap += cells;
+        cell_range(lo[2 * k], hi[2 * k], o.m, x0, iw, o.gnx, &bx[0], &bx[1]);
+        cell_range(lo[2 * k + 1], hi[2 * k + 1], o.m, y0, ih, ny, &bx[2], &bx[3]);
+        bx[4] = (bx[1] >= bx[0] && bx[3] >= bx[2]) ? (bx[1] - bx[0] + 1) * (bx[3] - bx[2] + 1) : 0;
+        if (s <= block_edges && bx[4] <= max_box) {
+            cap += bx[4];
             if (s > E) E = s;
         }
     }
@@ -231,18 +237,16 @@ PyObject *fast_entries(PyObject *self, PyObject *args)
     o.inside = (uint8_t *)PyByteArray_AS_STRING(arr[2]), o.mask = (int64_t *)PyByteArray_AS_STRING(arr[3]);
     o.cap = cap;
     Edges h;
-    if (edges_alloc(&h, &hp, E, o.m) < 0 || !(q = PyMem_Malloc(16 * (size_t)E)) || !(cq = PyMem_Malloc(16 * (size_t)E))
-        || !(sag = PyMem_Malloc(8 * (size_t)E)) || !(keep = PyMem_Malloc((size_t)E)) || !(idx = PyMem_Malloc(8 * (size_t)E))
+    if (edges_alloc(&h, &hp, E, o.m) < 0 || !(q = PyMem_Malloc(16 * (size_t)E))
+        || !(cq = PyMem_Malloc(16 * (size_t)E)) || !(sag = PyMem_Malloc(8 * (size_t)E))
+        || !(keep = PyMem_Malloc((size_t)E)) || !(idx = PyMem_Malloc(8 * (size_t)E))
         || !(o.right = PyMem_Malloc(sizeof(int64_t) * (size_t)(o.gnx + 1)))) {
         PyErr_NoMemory();
         goto done;
     }
     for (Py_ssize_t k = 0; k < K; k++) {
-        int64_t s = off[k + 1] - off[k], a, bb, c, d;
-        cell_range(lo[2 * k], hi[2 * k], o.m, x0, iw, o.gnx, &a, &bb);
-        cell_range(lo[2 * k + 1], hi[2 * k + 1], o.m, y0, ih, ny, &c, &d);
-        int64_t cells = (bb >= a && d >= c) ? (bb - a + 1) * (d - c + 1) : 0;
-        if (s > block_edges || cells > max_box) {
+        int64_t s = off[k + 1] - off[k], *bx = box + 5 * k;
+        if (s > block_edges || bx[4] > max_box) {
             PyObject *v = PyLong_FromSsize_t(k);
             if (!v || PyList_Append(todo, v) < 0) {
                 Py_XDECREF(v);
@@ -251,7 +255,7 @@ PyObject *fast_entries(PyObject *self, PyObject *args)
             Py_DECREF(v);
             continue;
         }
-        if (!cells) continue;
+        if (!bx[4]) continue;
         const double *p = xy + 2 * off[k];
         for (int64_t v = 0; v < s; v++) q[2 * v] = p[2 * v] - ox, q[2 * v + 1] = p[2 * v + 1] - oy;
         int wide = s > mask_edges;
@@ -261,7 +265,7 @@ PyObject *fast_entries(PyObject *self, PyObject *args)
         } else {
             half_planes(&h, q, s, NULL, 0, o.cw, o.ch);
         }
-        if (classify_box(&o, &h, wide, k, a, bb, c, d) < 0) {
+        if (classify_box(&o, &h, wide, k, bx[0], bx[1], bx[2], bx[3]) < 0) {
             PyErr_SetString(PyExc_ValueError, "_fast.entries: outputs too small");
             goto done;
         }
@@ -278,6 +282,7 @@ done:
     PyMem_Free(sag);
     PyMem_Free(keep);
     PyMem_Free(idx);
+    PyMem_Free(box);
     PyMem_Free(o.right);
     for (int k = 0; k < got; k++) PyBuffer_Release(&b[k]);
     return result;
