@@ -38,7 +38,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..kernel.gjk import gjk_distance, gjk_distance_below, witness_weights
-from ..kernel.polygon import packed_boxes
+from ..kernel.polygon import piece_boxes
 from . import fastpath
 
 ANGLE_STEP = 1e-3  # SE(2): radians of turn below which a sub-motion is not split further
@@ -77,12 +77,7 @@ class Nearest:
     def __init__(self, pieces: list[np.ndarray]):
         self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
         self.loop = fastpath.gjk_loop()  # the compiled GJK loop, or None (pure): fixed at construction
-        sizes = [len(p) for p in self.pieces]
-        if sizes and min(sizes) > 0 and all(p.ndim == 2 for p in self.pieces):  # all boxes in two reductions
-            self.lo, self.hi = packed_boxes(np.concatenate(self.pieces), np.cumsum([0] + sizes[:-1]))
-        else:
-            self.lo = np.array([p.min(axis=0) for p in self.pieces]).reshape(-1, 2)
-            self.hi = np.array([p.max(axis=0) for p in self.pieces]).reshape(-1, 2)
+        self.lo, self.hi = piece_boxes(self.pieces)  # all boxes in two reductions
 
     def nearest(self, pts: np.ndarray, cap: float = math.inf):
         """(distance, piece, point on the piece) of the closest piece to conv(pts), or
@@ -215,6 +210,11 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # Each robot piece placed at every path point: a segment's swept point set is two
     # consecutive placements, one contiguous block (a view, no copy).
     placed = [(r[None, :, :] + pts[:, None, :]).reshape(-1, 2) for r in rob]
+
+    def swept(i: int, j: int) -> np.ndarray:  # segment i's placements of robot piece j
+        nv = len(rob[j])
+        return placed[j][i * nv:(i + 1 if still[i] else i + 2) * nv]
+
     while pos < len(queue):
         t = queue[pos]
         pos += 1
@@ -222,9 +222,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
             break
         row, k = int(rows[t]), int(ks[t])
         i, j = divmod(row, nr)
-        nv = len(rob[j])
-        swept = placed[j][i * nv:(i + 1 if still[i] else i + 2) * nv]
-        d = gjk_distance_below(swept, obs.pieces[k], best if arg is not None else math.inf, loop=obs.loop)
+        d = gjk_distance_below(swept(i, j), obs.pieces[k], best if arg is not None else math.inf, loop=obs.loop)
         if d is not None and (d.distance < best or arg is None):
             best, arg = d.distance, (i, j, k, d.point_b)
             if best == 0.0:
@@ -242,11 +240,9 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # Where: GJK's closest point on the swept set is a weighted sum of placed vertices r + p
     # (p the segment's start or end); the same weights on the p's give a reference position
     # whose placed piece holds that point, so lies at the distance found (no C-obstacle built).
-    nv = len(rob[j])
-    swept = placed[j][i * nv:(i + 1 if still[i] else i + 2) * nv]
-    weights = witness_weights(swept, obs.pieces[k], loop=obs.loop)
-    if weights is not None:
-        where = tuple(float(v) for v in sum(t * pts[i + v // nv] for v, t in weights))
+    weights = witness_weights(swept(i, j), obs.pieces[k], loop=obs.loop)
+    if weights is not None:  # vertex v of the swept block is at path point i + v // (piece's vertices)
+        where = tuple(float(v) for v in sum(t * pts[i + v // len(rob[j])] for v, t in weights))
     else:  # touching, or decided exactly: the segment's point nearest the C-obstacle,
         # and the obstacle's point nearest the piece placed there (where the sweep touches
         # along a stretch, the sweep's own witness may lie elsewhere on it)

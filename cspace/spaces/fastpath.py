@@ -113,7 +113,7 @@ def pair_sums(pa: list, pb: list) -> list | None:
     """
     if _fast is None:
         return None
-    if len(pa) == 1 and len(pb) == 1:  # one pair (min_clearance's closest position): the lean call
+    if len(pa) == 1 and len(pb) == 1:  # one pair (min_clearance's single C-obstacles): the lean call
         a, b = np.ascontiguousarray(pa[0], dtype=np.float64), np.ascontiguousarray(pb[0], dtype=np.float64)
         out, count = np.empty((len(a) + len(b), 2)), np.empty(1, dtype=np.int64)
         _fast.pair_sums(a, np.array([0, len(a)], dtype=np.int64), b, np.array([0, len(b)], dtype=np.int64), out, count)
