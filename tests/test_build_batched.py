@@ -124,3 +124,24 @@ def test_piece_set_packing():
     assert np.array_equal(ps.lo, np.array([p.min(axis=0) for p in pieces]))
     assert np.array_equal(ps.hi, np.array([p.max(axis=0) for p in pieces]))
     assert ps._lists == [p.tolist() for p in pieces]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_pruned_cspace_packs_exactly_its_kept_pieces(seed):
+    # The prune hands its packing of the raw pieces to the index's PieceSet, cut down to
+    # the pieces it keeps: pieces outside the bounds and pieces inside another are
+    # dropped here, and the packing must still be the kept pieces' own, in their order.
+    from cspace.spaces.broadphase import GridIndex
+
+    rng = np.random.default_rng(seed)
+    obstacles = random_pieces(rng, 25)
+    obstacles += [p * 0.2 + p.mean(axis=0) * 0.8 for p in obstacles[:5]]  # inside their originals
+    obstacles += [p + 40.0 for p in obstacles[5:9]]  # beyond the bounds
+    cs = CSpace((0, 10, 0, 10), obstacles, [np.array([[0., 0], [0.3, 0], [0, 0.2]])])
+    kinds = {s.name: s.counts for s in cs.stages}["prune"]
+    assert kinds["outside_bounds"] > 0 and kinds["inside_another"] > 0
+    fresh = PieceSet(cs.pieces)
+    assert np.array_equal(cs.packed.start, fresh.start) and np.array_equal(cs.packed.offsets, fresh.offsets)
+    assert np.array_equal(cs.packed.lo, fresh.lo) and np.array_equal(cs.packed.hi, fresh.hi)
+    # the grid's certified margin reads the packed vertices instead of the boxes: the same
+    assert GridIndex(cs.pieces, cs.bounds, packed=cs.packed).margin == GridIndex(cs.pieces, cs.bounds).margin

@@ -16,7 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .polygon import packed_boxes, piece_boxes, ring_neighbours
+from .polygon import piece_boxes, ring_neighbours
 from .predicates import orient2d_cols, orient2d_xy
 
 
@@ -28,24 +28,35 @@ class PieceSet:
     (True, False)
     """
 
-    def __init__(self, pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None):
-        # ``boxes``: the pieces' (lo, hi) (:func:`piece_boxes`) when the caller has them.
-        self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
-        sizes = np.array([len(p) for p in self.pieces], dtype=np.int64)
-        self.offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-        if self.pieces:  # packed in one pass each (a scene may hold 10^5 pieces)
-            self.start = np.concatenate(self.pieces).reshape(-1, 2)
-            if boxes is not None:
-                lo, hi = boxes
-            else:  # the boxes from the packed vertices (piece_boxes' answer, without packing again)
-                lo, hi = packed_boxes(self.start, self.offsets[:-1]) if sizes.min() > 0 else piece_boxes(self.pieces)
+    def __init__(self, pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None,
+                 packing: tuple[np.ndarray, np.ndarray] | None = None):
+        # ``boxes``: the pieces' (lo, hi) (:func:`piece_boxes`) and ``packing`` their
+        # :func:`pack` (float64 vertices, sizes), when the caller has them.
+        if packing is None:
+            self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
+            sizes = np.array([len(p) for p in self.pieces], dtype=np.int64)
+            # packed in one pass each (a scene may hold 10^5 pieces)
+            start = np.concatenate(self.pieces).reshape(-1, 2) if self.pieces else np.zeros((0, 2))
         else:
-            self.start = np.zeros((0, 2))
+            self.pieces = list(pieces)
+            start, sizes = np.ascontiguousarray(packing[0], dtype=np.float64), packing[1]
+        self.offsets = np.zeros(len(sizes) + 1, dtype=np.int64)
+        np.cumsum(sizes, out=self.offsets[1:])
+        self.start = start
+        if boxes is not None:
+            lo, hi = boxes
+        elif not len(sizes):
             lo = hi = np.zeros((0, 2))
+        else:  # the boxes from the packed vertices (piece_boxes' answer, without packing again)
+            lo, hi = piece_boxes(self.pieces, (start, sizes))
         self._sizes = sizes
-        self.owner = np.repeat(np.arange(len(self.pieces)), sizes)
         self.lo, self.hi = lo, hi
         self._scalar = None
+
+    @cached_property
+    def owner(self) -> np.ndarray:
+        """Each edge's piece (made on first use)."""
+        return np.repeat(np.arange(len(self.pieces)), self._sizes)
 
     @cached_property
     def end(self) -> np.ndarray:

@@ -172,21 +172,38 @@ def collinear_extent(points) -> np.ndarray:
     return np.array([lo, hi])
 
 
-def piece_boxes(pieces: list) -> tuple[np.ndarray, np.ndarray]:
+def pack(pieces: list) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces' vertices one piece after another, ``(M, 2)`` float64, and each
+    piece's vertex count (what :class:`cspace.kernel.pieces.PieceSet` stores).
+
+    >>> pts, sizes = pack([np.array([[0., 1], [2, 0], [1, 3]]), np.zeros((0, 2)), np.array([[5., 5], [6, 7]])])
+    >>> pts.shape, sizes.tolist()
+    ((5, 2), [3, 0, 2])
+    """
+    n = len(pieces)
+    sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
+    full = np.flatnonzero(sizes > 0)
+    if not len(full):
+        return np.zeros((0, 2)), sizes
+    pts = np.concatenate([pieces[k] for k in full.tolist()] if len(full) < n else pieces).reshape(-1, 2)
+    return pts.astype(np.float64, copy=False), sizes
+
+
+def piece_boxes(pieces: list, packing: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Each piece's bounding box, ``(lo, hi)`` as two ``(n, 2)`` arrays, in one pass over
     all the vertices (what ``p.min(axis=0)``, ``p.max(axis=0)`` give piece by piece; an
-    empty piece gets lo = +inf, hi = -inf).
+    empty piece gets lo = +inf, hi = -inf). ``packing``: the pieces' :func:`pack`, when
+    the caller has it.
 
     >>> lo, hi = piece_boxes([np.array([[0., 1], [2, 0], [1, 3]]), np.zeros((0, 2)), np.array([[5., 5], [6, 7]])])
     >>> lo.tolist(), hi.tolist()
     ([[0.0, 0.0], [inf, inf], [5.0, 5.0]], [[2.0, 3.0], [-inf, -inf], [6.0, 7.0]])
     """
-    n = len(pieces)
+    pts, sizes = pack(pieces) if packing is None else packing
+    n = len(sizes)
     lo, hi = np.full((n, 2), np.inf), np.full((n, 2), -np.inf)
-    sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
     full = np.flatnonzero(sizes > 0)
     if len(full):
-        pts = np.concatenate([pieces[k] for k in full.tolist()] if len(full) < n else pieces).reshape(-1, 2)
         lo[full], hi[full] = packed_boxes(pts, np.cumsum(sizes[full]) - sizes[full])
     return lo, hi
 

@@ -12,9 +12,11 @@
 */
 #include "_fast.h"
 
-/* One piece: q (s vertices), keep (s flags, the start set) -> out (n vertices), sag (n); returns n. */
+/* One piece: q (s vertices), keep (s flags, the start set) -> out (n vertices), sag (n); returns n.
+   Each chord's unit outward normal and offset (n . x <= c) go to nrm (3 x n: x, y, c) if given:
+   the grid's half-planes of the chord polygon, as half_planes would compute them again. */
 static int64_t chord_piece(const double *q, int64_t s, char *keep, double limit, int64_t *idx, double *out,
-                           double *sag)
+                           double *sag, double *const nrm[3])
 {
     for (;;) {
         int64_t n = 0;
@@ -27,6 +29,7 @@ static int64_t chord_piece(const double *q, int64_t s, char *keep, double limit,
             double h = hypot(dy, -dx);
             double nx = dy / h, ny = -dx / h;
             double cc = nx * q[2 * a] + ny * q[2 * a + 1];
+            if (nrm) nrm[0][c] = nx, nrm[1][c] = ny, nrm[2][c] = cc;
             /* the arc of chord c: its own vertex up to the next kept one (the last: to the end) */
             int64_t stop = c + 1 < n ? b : s;
             double m = -HUGE_VAL;
@@ -50,20 +53,22 @@ static int64_t chord_piece(const double *q, int64_t s, char *keep, double limit,
     }
 }
 
-/* One piece's chord polygon: q (s vertices) -> out (n vertices), sag (n); returns n. The
-   start set: eight vertices, and both ends of every edge longer than long_edge (L1).
-   Scratch: keep (s bytes), idx (s). */
+/* One piece's chord polygon: q (s vertices) -> out (n vertices), sag (n), nrm (its
+   half-planes, if not NULL); returns n. The start set: eight vertices, and both ends of
+   every edge longer than long_edge (L1). Scratch: keep (s bytes), idx (s). */
 int64_t chord_polygon(const double *q, int64_t s, double long_edge, double limit, char *keep, int64_t *idx,
-                      double *out, double *sag)
+                      double *out, double *sag, double *const nrm[3])
 {
     int64_t step = s / 8 > 1 ? s / 8 : 1;
-    for (int64_t v = 0; v < s; v++) {
-        int64_t w = v + 1 < s ? v + 1 : 0, u = (v + s - 1) % s, u1 = v;
+    /* Each edge's length once: edge v (v -> v + 1) long keeps both its ends. */
+    int lu = fabs(q[0] - q[2 * (s - 1)]) + fabs(q[1] - q[2 * (s - 1) + 1]) > long_edge; /* edge s - 1 */
+    for (int64_t v = 0, t = 0; v < s; v++, t = t + 1 < step ? t + 1 : 0) {
+        int64_t w = v + 1 < s ? v + 1 : 0;
         int lv = fabs(q[2 * w] - q[2 * v]) + fabs(q[2 * w + 1] - q[2 * v + 1]) > long_edge;
-        int lu = fabs(q[2 * u1] - q[2 * u]) + fabs(q[2 * u1 + 1] - q[2 * u + 1]) > long_edge;
-        keep[v] = (char)(lv || lu || v % step == 0);
+        keep[v] = (char)(lv | lu | (t == 0)); /* t = v mod step */
+        lu = lv;
     }
-    return chord_piece(q, s, keep, limit, idx, out, sag);
+    return chord_piece(q, s, keep, limit, idx, out, sag, nrm);
 }
 
 /* chords(Q, sizes, long_edge, tolerance, out_R, out_n, out_sag) -> None
@@ -108,7 +113,7 @@ PyObject *fast_chords(PyObject *self, PyObject *args)
         }
         double *sg = sag + k * E;
         for (Py_ssize_t c = 0; c < E; c++) sg[c] = 0.0;
-        nout[k] = chord_polygon(q, s, long_edge, limit, keep, idx, R + 2 * k * E, sg);
+        nout[k] = chord_polygon(q, s, long_edge, limit, keep, idx, R + 2 * k * E, sg, NULL);
     }
     ok = 1;
 done:

@@ -81,7 +81,7 @@ PyObject *fast_pair_sums(PyObject *self, PyObject *args);                     /*
 PyObject *fast_contained(PyObject *self, PyObject *args);                     /* _build.c */
 PyObject *fast_chords(PyObject *self, PyObject *args);                        /* _chords.c */
 int64_t chord_polygon(const double *q, int64_t s, double long_edge, double limit, char *keep, int64_t *idx,
-                      double *out, double *sag);                          /* _chords.c */
+                      double *out, double *sag, double *const nrm[3]);                          /* _chords.c */
 PyObject *fast_entries(PyObject *self, PyObject *args);                       /* _cells.c */
 PyObject *fast_assemble(PyObject *self, PyObject *args);                      /* _cells.c */
 PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs);  /* _gjk.c */

@@ -98,7 +98,8 @@ class GridIndex(CellClassifier):
             cells = int(min(max(per * n, MIN_CELLS), 1 << 20)) if n else 1  # no piece: one FREE cell
             # Large, overlapping pieces (comb sums) would each cover a big share of that
             # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
-            cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist()) if n else 0.0
+            # (Each share is at most 1: with n * cells within the budget, so is cover * cells.)
+            cover = sum(_box_shares(self._lo, self._hi, xmin, xmax, ymin, ymax).tolist()) if n * cells > _PAIR_BUDGET else 0.0
             if cover * cells > _PAIR_BUDGET:
                 cells = max(int(_PAIR_BUDGET / cover), 1 << 12)
         nx = max(1, min(4096, int(round(math.sqrt(cells * w / h)))))
@@ -113,9 +114,13 @@ class GridIndex(CellClassifier):
         # error scales with the scene's extent; the shift itself may round by up to
         # an ulp of the largest coordinate, which the margin also covers.
         self.ox, self.oy = 0.5 * (xmin + xmax), 0.5 * (ymin + ymax)
-        full = np.isfinite(self._lo[:, 0])  # non-empty pieces
-        big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] +
-                  ([float(max(np.abs(self._lo[full]).max(), np.abs(self._hi[full]).max()))] if full.any() else []))
+        # The largest |coordinate| of the bounds and the pieces (their vertices', when packed).
+        if packed is not None:
+            top = [float(max(packed.start.max(), -packed.start.min()))] if len(packed.start) else []
+        else:
+            full = np.isfinite(self._lo[:, 0])  # non-empty pieces
+            top = [float(max(np.abs(self._lo[full]).max(), np.abs(self._hi[full]).max()))] if full.any() else []
+        big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] + top)
         self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
         if not n:  # nothing to classify: every cell FREE
             cp = cm = np.zeros(0, np.int64)

@@ -76,7 +76,6 @@ class CellClassifier:
         cand_piece: list[np.ndarray] = []
         cand_mask: list[np.ndarray] = []
         inside_parts = []
-        sizes = [len(p) for p in pieces]
         todo = range(len(pieces))
         if fastpath.compiled() and self.compiled and pieces:
             # In C from the packed vertices, piece by piece (_fast.entries: the padded route's
@@ -94,6 +93,7 @@ class CellClassifier:
             cand_piece.append(pid)
             inside_parts.append(inside)
             cand_mask.append(masks)
+        sizes = [len(p) for p in pieces]
         # Pieces are classified together, in blocks of (piece, cell) pairs (one numpy
         # pass instead of one per piece), those with masks apart from the wider ones so
         # that a 4-gon is not padded to a margin's 70 edges; huge pieces one by one.

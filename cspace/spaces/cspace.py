@@ -31,7 +31,7 @@ import numpy as np
 from . import fastpath
 from .broadphase import GridIndex
 from ..kernel.pieces import PieceSet
-from ..kernel.polygon import piece_boxes
+from ..kernel.polygon import pack, piece_boxes
 from ..io.scenario import load_scenario
 from ..io.schema import Scenario
 # decompose_obstacles and decompose_robot are public here too (``cspace`` lists them).
@@ -88,7 +88,7 @@ class CSpace(PointQueries, SegmentQueries):
         raw, raw_owner = self._sum()
         self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
         t = time.perf_counter()
-        self.packed = PieceSet(self.pieces, self._boxes)  # the prune's boxes of the kept pieces
+        self.packed = PieceSet(self.pieces, self._boxes, self._packing)  # the prune's boxes and packing
         self.index = GridIndex(self.pieces, self.bounds, cells=grid_cells, packed=self.packed)
         self._coarse = None
         # The compiled fast path's copy of the grid and pieces (None on the pure path): part of the index.
@@ -193,7 +193,8 @@ class CSpace(PointQueries, SegmentQueries):
         t = time.perf_counter()
         xmin, xmax, ymin, ymax = self.bounds
         before = len(pieces)
-        lo, hi = piece_boxes(pieces)  # an empty piece: lo = inf, hi = -inf, dropped
+        pts, sizes = pack(pieces)  # kept for the index's PieceSet
+        lo, hi = piece_boxes(pieces, (pts, sizes))  # an empty piece: lo = inf, hi = -inf, dropped
         keep = np.flatnonzero((lo[:, 0] <= xmax) & (hi[:, 0] >= xmin) & (lo[:, 1] <= ymax) & (hi[:, 1] >= ymin)).tolist()
         outside = before - len(keep)
         pieces = [pieces[k] for k in keep]
@@ -213,8 +214,14 @@ class CSpace(PointQueries, SegmentQueries):
             pairs = [pr for pr, m in zip(pairs, mask) if m]
             owner = owner[mask]
             lo, hi = lo[mask], hi[mask]
+            keep = [k for k, m in zip(keep, mask.tolist()) if m]
+        if len(keep) < before:  # the kept pieces' vertices, from the packing
+            kept = np.zeros(before, dtype=bool)
+            kept[keep] = True
+            pts, sizes = pts[np.repeat(kept, sizes)], sizes[kept]
         self.piece_pairs = pairs
         self._boxes = (lo, hi)
+        self._packing = (pts, sizes)
         self.stages.append(Stage("prune", True, time.perf_counter() - t,
                                  {"pieces_before": before, "outside_bounds": outside,
                                   "inside_another": len(contained), "pieces_after": len(pieces)}))

@@ -84,7 +84,7 @@ def assemble(*args) -> tuple[int, int, int]:
     FREE, MIXED and BLOCKED cells."""
     cc, cp, cm, inside, n, *out = args
     i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
-    return _fast.assemble(i64(cc), i64(cp), i64(cm), np.ascontiguousarray(inside, dtype=np.uint8), int(n), *out)
+    return _fast.assemble(i64(cc), i64(cp), i64(cm), np.ascontiguousarray(inside, dtype=bool).view(np.uint8), int(n), *out)
 
 
 def entries(xy, offsets, lo, hi, *frame) -> tuple:
