@@ -41,7 +41,7 @@ static int canonical(const double *p, int64_t n)
     double x0 = p[0], y0 = p[1];
     int prev_half = -1;
     for (int64_t k = 0; k < n; k++) {
-        int64_t a = (k + n - 1) % n, b = (k + 1) % n;
+        int64_t a = k ? k - 1 : n - 1, b = k + 1 < n ? k + 1 : 0;
         double x = p[2 * k], y = p[2 * k + 1];
         if (y < y0 || (y == y0 && x < x0)) return 0; /* not lowest-then-leftmost first */
         /* orient2d(prev, v, next) = (prev - next) x (v - next) */
@@ -124,7 +124,8 @@ static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, d
     int64_t k = 0, l = 0, n = 0;
     int inexact = 0;
     while (k < na || l < nb) {
-        const double *va = A + 2 * (k % na), *vb = B + 2 * (l % nb);
+        /* k <= na and l <= nb: vertex k % na is k, or 0 at the end (no division per step) */
+        const double *va = A + 2 * (k < na ? k : 0), *vb = B + 2 * (l < nb ? l : 0);
         double sx = va[0] + vb[0], sy = va[1] + vb[1];
         if (sx - va[0] != vb[0] || sx - vb[0] != va[0] || sy - va[1] != vb[1] || sy - vb[1] != va[1]) inexact = 1;
         out[2 * n] = sx, out[2 * n + 1] = sy;
@@ -137,7 +138,7 @@ static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, d
             k++;
             continue;
         }
-        const double *a1 = A + 2 * ((k + 1) % na), *b1 = B + 2 * ((l + 1) % nb);
+        const double *a1 = A + 2 * (k + 1 < na ? k + 1 : 0), *b1 = B + 2 * (l + 1 < nb ? l + 1 : 0);
         int ha = lower(a1[0] - va[0], a1[1] - va[1]), hb = lower(b1[0] - vb[0], b1[1] - vb[1]);
         int c = ha != hb ? (ha < hb ? 1 : -1) : cross_sign(va[0], va[1], a1[0], a1[1], vb[0], vb[1], b1[0], b1[1]);
         if (c == UNDECIDED) return -1;
@@ -147,7 +148,7 @@ static int64_t merge(const double *A, int64_t na, const double *B, int64_t nb, d
     if (inexact) { /* rounded: accepted if every turn is certainly left, else the exact hull */
         int repair = 0;
         for (int64_t v = 0; v < n; v++) {
-            const double *p = out + 2 * ((v + n - 1) % n), *q = out + 2 * v, *r = out + 2 * ((v + 1) % n);
+            const double *p = out + 2 * (v ? v - 1 : n - 1), *q = out + 2 * v, *r = out + 2 * (v + 1 < n ? v + 1 : 0);
             int s = cross_sign(r[0], r[1], p[0], p[1], r[0], r[1], q[0], q[1]);
             if (s == UNDECIDED) return -1;
             repair |= s != 1;

@@ -48,17 +48,20 @@ static inline double prod_err(double a, double b, double p)
     return ((ah * bh - p) + ah * bl + al * bh) + al * bl;
 }
 
-/* Certified sign of (b - a) x (d - c): +1, -1, 0, or UNDECIDED (cross_diff_cols's stages). */
-static inline int cross_sign(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy)
+#if defined(__GNUC__) || defined(__clang__)
+#define ALWAYS_INLINE inline __attribute__((always_inline))
+#define NOINLINE __attribute__((noinline, unused))
+#else
+#define ALWAYS_INLINE inline
+#define NOINLINE
+#endif
+
+/* cross_sign's stages after the filter (out of line: rarely reached). */
+static NOINLINE int cross_sign_rest(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy)
 {
     double ux = bx - ax, uy = by - ay, vx = dx - cx, vy = dy - cy;
     double left = ux * vy, right = uy * vx;
     double det = left - right, detsum = fabs(left) + fabs(right);
-    if (detsum > UNDERFLOW_GUARD && detsum < HUGE_VAL) {
-        double bound = ERRBOUND_A * detsum;
-        if (det > bound) return 1;
-        if (-det > bound) return -1;
-    }
     if (detsum == 0.0 && (ux == 0.0 || vy == 0.0) && (uy == 0.0 || vx == 0.0)) return 0;
     /* Every difference and product exact (far from under- and overflow): one rounding keeps the sign. */
     if (!(isfinite(ux) && isfinite(uy) && isfinite(vx) && isfinite(vy))) return UNDECIDED;
@@ -68,6 +71,22 @@ static inline int cross_sign(double ax, double ay, double bx, double by, double 
         || sum_err(dy, -cy, vy) != 0.0 || prod_err(ux, vy, left) != 0.0 || prod_err(uy, vx, right) != 0.0)
         return UNDECIDED;
     return (det > 0.0) - (det < 0.0);
+}
+
+/* Certified sign of (b - a) x (d - c): +1, -1, 0, or UNDECIDED (cross_diff_cols's stages).
+   The filter inline, the rest (exact zeros, error-free operations) a call. */
+static ALWAYS_INLINE int cross_sign(double ax, double ay, double bx, double by, double cx, double cy, double dx,
+                                     double dy)
+{
+    double ux = bx - ax, uy = by - ay, vx = dx - cx, vy = dy - cy;
+    double left = ux * vy, right = uy * vx;
+    double det = left - right, detsum = fabs(left) + fabs(right);
+    if (detsum > UNDERFLOW_GUARD && detsum < HUGE_VAL) {
+        double bound = ERRBOUND_A * detsum;
+        if (det > bound) return 1;
+        if (-det > bound) return -1;
+    }
+    return cross_sign_rest(ax, ay, bx, by, cx, cy, dx, dy);
 }
 
 /* Certified sign of orient2d(a, b, c) = (a - c) x (b - c): +1, -1, 0, or UNDECIDED. */
