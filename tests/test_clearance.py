@@ -467,6 +467,41 @@ def test_tighter_bounds_change_nothing_but_the_work(seed, monkeypatch):
     assert fast.distance == pytest.approx(swept_clearance(path, robot, obstacles), rel=1e-9, abs=1e-12)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_few_pairs_skip_the_reach_filter_with_the_same_answer(seed, monkeypatch):
+    # Up to FEW_PAIRS (sweep, obstacle) pairs the broad phase keeps every pair; beyond, it
+    # drops those farther than the nearest piece's far corner. The search's stop rule never
+    # reaches a dropped pair, so both give the same result, to the bit (distance, place,
+    # obstacle point, segment), on random scenes, some touching.
+    import cspace.spaces.clearance as cl
+
+    rng = np.random.default_rng(100 + seed)
+    obstacles = [_random_convex(rng, rng.uniform(0, 20, 2), rng.uniform(0.5, 3), int(rng.integers(3, 9))) for _ in range(25)]
+    robot = [_random_convex(rng, (0.0, 0.0), 0.6, 5), _random_convex(rng, (0.3, 0.0), 0.4, 4)] if seed % 3 else []
+    path = rng.uniform(0, 20, (int(rng.integers(2, 12)), 2))
+    if seed % 2:
+        path = np.vstack([path[:3], obstacles[0], path[-2:]])
+    assert len(path) * max(1, len(robot)) * len(obstacles) <= cl.FEW_PAIRS  # the all-pairs route
+    every = cl.path_clearance(path, robot, obstacles)
+    monkeypatch.setattr(cl, "FEW_PAIRS", 0)  # the filtered route
+    filtered = cl.path_clearance(path, robot, obstacles)
+    assert tuple(every) == tuple(filtered)
+    assert every.distance == pytest.approx(swept_clearance(path, robot, obstacles), rel=1e-9, abs=1e-12)
+
+
+def test_piece_boxes_of_one_piece_and_of_empty_ones():
+    # piece_boxes' one-piece branch and its general one give the same boxes; an empty
+    # piece keeps its (inf, -inf) box beside non-empty ones.
+    from cspace.kernel.polygon import piece_boxes
+
+    p = np.array([[0.5, -1.0], [2.0, 0.25], [-3.0, 4.0]])
+    lo, hi = piece_boxes([p])
+    lo2, hi2 = piece_boxes([p, p])
+    assert lo.tolist() == [lo2[0].tolist()] == [[-3.0, -1.0]] and hi.tolist() == [hi2[0].tolist()] == [[2.0, 4.0]]
+    lo3, hi3 = piece_boxes([p, np.zeros((0, 2))])
+    assert lo3[1].tolist() == [np.inf, np.inf] and hi3[1].tolist() == [-np.inf, -np.inf]
+
+
 @pytest.mark.parametrize("seed", range(8))
 def test_closest_position_holds_the_distance(seed):
     # Where the robot comes closest (read off GJK's witness on the swept set, or the

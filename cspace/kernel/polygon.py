@@ -199,8 +199,15 @@ def piece_boxes(pieces: list, packing: tuple[np.ndarray, np.ndarray] | None = No
     >>> lo.tolist(), hi.tolist()
     ([[0.0, 0.0], [inf, inf], [5.0, 5.0]], [[2.0, 3.0], [-inf, -inf], [6.0, 7.0]])
     """
+    if packing is None and len(pieces) == 1 and len(pieces[0]):  # one piece (a robot, often): its reductions
+        p = np.asarray(pieces[0], dtype=np.float64).reshape(-1, 2)
+        return np.minimum.reduce(p, axis=0)[None], np.maximum.reduce(p, axis=0)[None]
     pts, sizes = pack(pieces) if packing is None else packing
     n = len(sizes)
+    if n and sizes.min() > 0:  # no empty piece (the common case): the reductions' own arrays
+        starts = np.zeros(n, dtype=np.int64)
+        np.cumsum(sizes[:-1], out=starts[1:])
+        return packed_boxes(pts, starts)
     lo, hi = np.full((n, 2), np.inf), np.full((n, 2), -np.inf)
     full = np.flatnonzero(sizes > 0)
     if len(full):

@@ -47,6 +47,7 @@ MAX_SPLITS = 20000  # SE(2): sub-motions evaluated at most (then the bound found
 # of the best distance found (see path_clearance).
 TIE = 2.0**-44
 GJK_FIRST = 32  # pairs measured on box bounds before the rest get tight ones
+FEW_PAIRS = 1 << 10  # (sweep, obstacle piece) pairs up to which the broad phase keeps them all
 
 
 class PathClearance(NamedTuple):
@@ -173,7 +174,6 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     rob = [np.asarray(r, dtype=np.float64) for r in robot_pieces] or [np.zeros((1, 2))]
     if not len(pts):
         return PathClearance(math.inf, (), (), -1, "exact")
-    segs = [(pts[i], pts[i + 1]) for i in range(len(pts) - 1)] or [(pts[0], pts[0])]
     best, arg = math.inf, None
     if not len(obs.pieces):
         return PathClearance(math.inf, (), (), -1, "exact")
@@ -181,30 +181,36 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # sweep against every obstacle box, the pairs then visited by increasing box distance
     # (a lower bound) until it reaches the best distance found.
     a, b = (pts[:-1], pts[1:]) if len(pts) > 1 else (pts, pts)  # the segments' ends, as rows
-    rlo = np.array([r.min(axis=0) for r in rob])
-    rhi = np.array([r.max(axis=0) for r in rob])
+    rlo, rhi = piece_boxes(rob)
     lo = (np.minimum(a, b)[:, None, :] + rlo[None, :, :]).reshape(-1, 2)  # (segment, piece) rows
     hi = (np.maximum(a, b)[:, None, :] + rhi[None, :, :]).reshape(-1, 2)
     nr, no = len(rob), len(obs.pieces)
-    step = max(1, (1 << 20) // no)  # bound the (sweeps, obstacles) block
-    cand_lb, cand_row, cand_k = [], [], []
-    for s0 in range(0, len(lo), step):
-        gap = np.maximum(np.maximum(obs.lo[None, :, :] - hi[s0:s0 + step, None, :],
-                                    lo[s0:s0 + step, None, :] - obs.hi[None, :, :]), 0.0)
-        lb = np.hypot(gap[..., 0], gap[..., 1])
-        # Keep, per sweep, the pieces no farther than the nearest piece's far corner could be.
-        row, k = np.nonzero(lb <= lb.min(axis=1, keepdims=True) + _reach(lo[s0:s0 + step], hi[s0:s0 + step],
-                                                                          obs)[:, None])
-        cand_lb.append(lb[row, k])
-        cand_row.append(row + s0)
-        cand_k.append(k)
-    lbs, rows, ks = np.concatenate(cand_lb), np.concatenate(cand_row), np.concatenate(cand_k)
+
+    def box_bounds(s0: int, s1: int) -> np.ndarray:  # sweeps s0..s1 against every obstacle box
+        gap = np.maximum(np.maximum(obs.lo[None, :, :] - hi[s0:s1, None, :], lo[s0:s1, None, :] - obs.hi[None, :, :]), 0.0)
+        return np.hypot(gap[..., 0], gap[..., 1])
+
+    # Candidate pairs as row * no + k (row: sweep, k: obstacle piece); pairs=None: all of them.
+    if len(lo) * no <= FEW_PAIRS:  # few: every pair, in one block (the search's stop rule
+        lbs, pairs = box_bounds(0, len(lo)).ravel(), None  # drops what the filter below would)
+    else:
+        step = max(1, (1 << 20) // no)  # bound the (sweeps, obstacles) block
+        cand_lb, cand = [], []
+        for s0 in range(0, len(lo), step):
+            lb = box_bounds(s0, s0 + step)
+            # Keep, per sweep, the pieces no farther than the nearest piece's far corner could be.
+            keep = np.flatnonzero(lb <= lb.min(axis=1, keepdims=True) + _reach(lo[s0:s0 + step], hi[s0:s0 + step],
+                                                                                obs)[:, None])
+            cand_lb.append(lb.ravel()[keep])
+            cand.append(keep + s0 * no)
+        lbs, pairs = np.concatenate(cand_lb), np.concatenate(cand)
     # Pairs whose lower bound is within TIE x the scene's coordinate scale of the best
     # distance found are not measured (GJK's own error is about 2^-50 x that scale). A path
     # with a margin runs at one distance, to rounding, along many segments, where box
     # bounds leave GJK hundreds of pairs: after GJK_FIRST pairs, the rest get tight bounds.
     # (the largest |coordinate| of a piece is one of its box's: max |p| from the boxes, the same float)
-    slack = TIE * max(float(np.abs(pts).max()), float(np.abs(obs.lo).max()), float(np.abs(obs.hi).max()))
+    # (max |v| over [lo, hi] boxes is max(hi, -lo): the same float, without the |.| arrays)
+    slack = TIE * max(float(pts.max()), -float(pts.min()), float(obs.hi.max()), -float(obs.lo.min()))
     queue, pos, measured = np.argsort(lbs, kind="stable").tolist(), 0, 0
     still = (a == b).all(axis=1).tolist()  # a segment of one point sweeps the piece itself
     # Each robot piece placed at every path point: a segment's swept point set is two
@@ -220,7 +226,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
         pos += 1
         if lbs[t] >= best - slack:
             break
-        row, k = int(rows[t]), int(ks[t])
+        row, k = divmod(t if pairs is None else int(pairs[t]), no)
         i, j = divmod(row, nr)
         d = gjk_distance_below(swept(i, j), obs.pieces[k], best if arg is not None else math.inf, loop=obs.loop)
         if d is not None and (d.distance < best or arg is None):
@@ -232,7 +238,8 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
             rest = np.array(queue[pos:], dtype=np.int64)
             rest = rest[lbs[rest] < best - slack]
             lbs = lbs.copy()
-            lbs[rest] = _tighter_bounds(lbs[rest], rows[rest], ks[rest], a, b, rob, obs)
+            rows, ks = np.divmod(rest if pairs is None else pairs[rest], no)
+            lbs[rest] = _tighter_bounds(lbs[rest], rows, ks, a, b, rob, obs)
             queue, pos = rest[np.argsort(lbs[rest], kind="stable")].tolist(), 0
     if arg is None:
         return PathClearance(math.inf, (), (), -1, "exact")
@@ -242,11 +249,16 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # whose placed piece holds that point, so lies at the distance found (no C-obstacle built).
     weights = witness_weights(swept(i, j), obs.pieces[k], loop=obs.loop)
     if weights is not None:  # vertex v of the swept block is at path point i + v // (piece's vertices)
-        where = tuple(float(v) for v in sum(t * pts[i + v // len(rob[j])] for v, t in weights))
+        ends = pts[i:i + 2].tolist()  # in floats: the same sums (from 0, in order) as on numpy scalars
+        x = y = 0
+        for v, t in weights:
+            px, py = ends[v // len(rob[j])]
+            x, y = x + t * px, y + t * py
+        where = (float(x), float(y))
     else:  # touching, or decided exactly: the segment's point nearest the C-obstacle,
         # and the obstacle's point nearest the piece placed there (where the sweep touches
         # along a stretch, the sweep's own witness may lie elsewhere on it)
-        where = _closest_position(segs[i], rob[j], obs.pieces[k], obs.loop)
+        where = _closest_position((pts[i], pts[min(i + 1, len(pts) - 1)]), rob[j], obs.pieces[k], obs.loop)
         w = gjk_distance(rob[j] + np.array(where), obs.pieces[k], loop=obs.loop).point_b
     return PathClearance(float(best), where, tuple(float(v) for v in w), i, "exact")
 
