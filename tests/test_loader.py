@@ -207,3 +207,28 @@ def test_validity_is_checked_at_a_scale_geos_can_compute(write_toml):
     bow = "[[0, 0], [2e-300, 2e-300], [2e-300, 0], [0, 2e-300]]"
     with pytest.raises(ScenarioError, match=r"robot.polygon: not a simple polygon \(Self-intersection"):
         load_scenario(write_toml(BASE + f"[robot]\npolygon = {bow}\n"))
+
+
+@pytest.mark.parametrize("name", ["parts.toml", "u_robot.toml", "ompl/circles.toml", "se2/tee_slot.toml", "se2/bar_door.toml"])
+def test_probe_batch_matches_a_union_per_pose(name):
+    # CollisionProbe.first_hits places every pose's robot parts in one tree query; the
+    # oracle here is the robot's parts united at each pose (shapely) and queried alone.
+    import shapely
+
+    from conftest import SCENARIOS
+    from cspace.io.probe import CollisionProbe
+
+    sc = load_scenario(os.path.join(SCENARIOS, name))
+    probe = CollisionProbe(sc)
+    rng = np.random.default_rng(7)
+    xmin, xmax, ymin, ymax = sc.bounds
+    poses = [(float(x), float(y), float(t)) if sc.space == "se2" else (float(x), float(y))
+             for x, y, t in zip(rng.uniform(xmin, xmax, 300), rng.uniform(ymin, ymax, 300), rng.uniform(-3, 3, 300))]
+    obstacles = [o.to_shapely() for o in sc.obstacles]
+    want = []
+    for q in poses:
+        parts = sc.robot_at(q[0], q[1], q[2] if len(q) > 2 else 0.0)
+        body = shapely.union_all([shapely.Polygon(p) for p in parts]) if parts else shapely.Point(q[0], q[1])
+        want.append(next((k for k, o in enumerate(obstacles) if body.intersects(o)), None))
+    got = probe.first_hits(poses)
+    assert got == want and any(h is None for h in got) and any(h is not None for h in got)

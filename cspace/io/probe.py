@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernel.union import union
 from .schema import Scenario
 
 
@@ -26,16 +25,38 @@ class CollisionProbe:
         self._tree = shapely.STRtree(self._geoms) if self._geoms else None
 
     def first_hit(self, x: float, y: float, theta: float = 0.0) -> int | None:
-        shapely = self._shapely
-        if self._tree is None:
-            return None
-        if self._sc.robot:
-            body = union([shapely.Polygon(p) for p in self._sc.robot_at(x, y, theta)])
-        else:
-            body = shapely.Point(x, y)
-        hits = self._tree.query(body, predicate="intersects")
-        return int(hits.min()) if len(hits) else None
+        """The first obstacle (lowest index) the robot at (x, y, theta) touches, or None."""
+        return self.first_hits([(x, y, theta)])[0]
 
+    def first_hits(self, poses) -> list[int | None]:
+        """:meth:`first_hit` of each pose ``(x, y)`` or ``(x, y, theta)``, in one tree query:
+        the robot's parts placed at every pose (a part meets an obstacle iff the robot does).
+
+        >>> import os, tempfile
+        >>> from cspace.io.scenario import load_scenario
+        >>> f = os.path.join(tempfile.mkdtemp(), "s.toml")
+        >>> _ = open(f, "w").write("[bounds]\\nxmin=0\\nxmax=4\\nymin=0\\nymax=4\\n[start]\\nx=0.5\\ny=0.5\\n"
+        ...     "[goal]\\nx=3.5\\ny=3.5\\n[[obstacles]]\\npolygon=[[1,1],[3,1],[3,3],[1,3]]\\n")
+        >>> CollisionProbe(load_scenario(f)).first_hits([(0.5, 0.5), (2.0, 2.0), (3.0, 1.0)])
+        [None, 0, 0]
+        """
+        shapely = self._shapely
+        if self._tree is None or not len(poses):
+            return [None] * len(poses)
+        if self._sc.robot:
+            bodies, owner = [], []
+            for k, q in enumerate(poses):
+                for part in self._sc.robot_at(q[0], q[1], q[2] if len(q) > 2 else 0.0):
+                    bodies.append(part)
+                    owner.append(k)
+            geoms = [shapely.Polygon(b) for b in bodies]
+        else:
+            geoms = shapely.points(np.array([(q[0], q[1]) for q in poses], dtype=np.float64))
+            owner = range(len(poses))
+        inp, obs = self._tree.query(geoms, predicate="intersects")
+        first = np.full(len(poses), len(self._geoms))
+        np.minimum.at(first, np.asarray(owner, dtype=np.int64)[inp], obs)
+        return [int(h) if h < len(self._geoms) else None for h in first.tolist()]
 
 
 def _shapely_obstacles(obstacles: list) -> list:

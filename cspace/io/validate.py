@@ -105,27 +105,27 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
         robot_kind=kind, disk_tolerance=tol, space=space, slabs=slabs,
         turning_radius=radius, clearance=clearance, margin=margin,
     )
-    probe = CollisionProbe(sc)
     labelled = [(start, "start"), (goal, "goal")]
     for i, q in enumerate(queries):
         labelled += [(q.start, f"queries[{i}].start"), (q.goal, f"queries[{i}].goal")]
-    for pt, fld in labelled:
-        v.placement(sc, probe, pt, fld)
+    hits = CollisionProbe(sc).first_hits([pt for pt, _ in labelled])  # one query for every pose
+    for (pt, fld), hit in zip(labelled, hits):
+        v.placement(sc, pt, hit, fld)
     return sc
 
 
 class _Validator(ShapeChecks):
     """The field and shape checks, and where starts and goals may be."""
 
-    def placement(self, sc: Scenario, probe: "CollisionProbe", pt: tuple, field: str) -> None:
+    def placement(self, sc: Scenario, pt: tuple, hit: int | None, field: str) -> None:
         """The reference point must be in bounds and the robot there (turned by the
-        pose's theta in SE(2)) must touch no obstacle."""
+        pose's theta in SE(2)) must touch no obstacle (``hit``: the first it touches,
+        :meth:`CollisionProbe.first_hits`)."""
         xmin, xmax, ymin, ymax = sc.bounds
         x, y = pt[0], pt[1]
         theta = pt[2] if len(pt) > 2 else 0.0
         where = f"({x}, {y})" if len(pt) == 2 else f"({x}, {y}, theta {theta})"
         if not (xmin <= x <= xmax and ymin <= y <= ymax):
             raise self.err(field, f"{where} is outside the bounds [{xmin}, {xmax}] x [{ymin}, {ymax}]")
-        hit = probe.first_hit(x, y, theta)
         if hit is not None:
             raise self.err(field, f"{where} puts the robot in collision with obstacles[{hit}]")
