@@ -36,7 +36,7 @@ _MARGIN = 1e-9
 
 # The default grid: cells per piece (pure path; compiled path), and the fewest cells (see GridIndex).
 CELLS_PER_PIECE = 256
-CELLS_PER_PIECE_COMPILED = 128
+CELLS_PER_PIECE_COMPILED = 64
 MIN_CELLS = 1 << 12
 
 # Most (piece, cell) pairs the build classifies, before the grid is coarsened.
@@ -90,9 +90,11 @@ class GridIndex(CellClassifier):
             # (plans of RRTConnect, compiled and pure paths), 1024 per piece and at least
             # 256 x 256 classified 2-4x longer for no faster query: a MIXED cell costs
             # the compiled narrow phase less than the Python call around it, and a
-            # segment walks fewer cells. With the compiled narrow phase, 128 per piece
-            # plans as fast (within 2 % on the bundled scenes, 10-20 seeds; 64 too) and
-            # builds 10-25 % faster; on the pure path 128 plans 15-25 % slower (maze,
+            # segment walks fewer cells. With the compiled narrow phase, 64 per piece
+            # plans as fast or faster (RRTConnect, 12 interleaved seeds against 128 on 12
+            # bundled scenes: 0.87x on ompl/circles, 0.93-0.94x on parts and
+            # random_polygons, the others within 1 %; env2 within 1 % over 5 seeds) and
+            # builds faster; on the pure path 128 plans 15-25 % slower than 256 (maze,
             # office, ompl/normal), a MIXED cell costing a Python call there.
             per = CELLS_PER_PIECE_COMPILED if fastpath.compiled() else CELLS_PER_PIECE
             cells = int(min(max(per * n, MIN_CELLS), 1 << 20)) if n else 1  # no piece: one FREE cell
