@@ -63,11 +63,11 @@ enum { SEPARATED = 0, MEETS = 1, INSIDE = 2 };
 
 /* The cell with corner (cx0, cy0): SEPARATED (one edge has it strictly outside by the
    margin), INSIDE (every edge has it strictly inside by the margin) or MEETS, with *mask
-   the weights of the edges it is not strictly inside. Neither answer depends on the
-   order the edges are taken in, so the edge that separated the last separated cell (its
-   neighbour, mostly) is tried first; then every edge, without a branch: the comparisons
-   accumulate, which pipelines better than an exit per edge (most cells tested lie on the
-   piece's boundary and need every edge anyway). */
+   the weights of the edges it is not strictly inside. The answer does not depend on the
+   order the edges are taken in (any separating edge gives SEPARATED; INSIDE and the mask
+   read every edge), so the edge that separated the last separated cell (its neighbour,
+   mostly) is tried first. Strictly outside implies not strictly inside (in < 0 < out),
+   so the outside test sits in the not-inside branch. */
 static inline int cell_test(Edges *h, double cx0, double cy0, int64_t *mask)
 {
     int64_t e = h->hint;
