@@ -33,6 +33,7 @@ QUICK_ARGS = {
     "bench_minkowski": ["--sizes", "8,64,1024"],
     "bench_gjk": ["--pairs", "3"],
     "bench_scaling": ["--plot", ""],
+    "bench_clearance": ["--reps", "15"],  # its ratios are of 0.2-1 ms builds: 5 medians swing by 0.1x
 }
 # The planner sweep of ``cspace bench``: small, so that the page builds in minutes.
 PLANNER_SWEEP = ["scenarios/bug_trap.toml", "scenarios/maze.toml", "--planners", "RRTConnect,RRTstar",
