@@ -16,7 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .polygon import piece_boxes, ring_neighbours
+from .polygon import pack, piece_boxes, ring_neighbours
 from .predicates import orient2d_cols, orient2d_xy
 
 
@@ -32,14 +32,9 @@ class PieceSet:
                  packing: tuple[np.ndarray, np.ndarray] | None = None):
         # ``boxes``: the pieces' (lo, hi) (:func:`piece_boxes`) and ``packing`` their
         # :func:`pack` (float64 vertices, sizes), when the caller has them.
-        if packing is None:
-            self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
-            sizes = np.array([len(p) for p in self.pieces], dtype=np.int64)
-            # packed in one pass each (a scene may hold 10^5 pieces)
-            start = np.concatenate(self.pieces).reshape(-1, 2) if self.pieces else np.zeros((0, 2))
-        else:
-            self.pieces = list(pieces)
-            start, sizes = np.ascontiguousarray(packing[0], dtype=np.float64), packing[1]
+        self.pieces = list(pieces)
+        start, sizes = pack(pieces) if packing is None else packing  # one pass (a scene may hold 10^5 pieces)
+        start = np.ascontiguousarray(start, dtype=np.float64)
         self.offsets = np.zeros(len(sizes) + 1, dtype=np.int64)
         np.cumsum(sizes, out=self.offsets[1:])
         self.start = start

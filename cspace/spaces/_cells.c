@@ -38,10 +38,11 @@
 static inline double max0(double x) { return (x >= 0.0 || isnan(x)) ? x : 0.0; }
 static inline double min0(double x) { return (x <= 0.0 || isnan(x)) ? x : 0.0; }
 
-/* A piece's half-planes (per edge: outward unit normal, offset, the cell's corner spread
-   hi and lo, mask weight), its edge count and the grid's margin. */
+/* A piece's half-planes (per edge: outward unit normal, offset, the thresholds of strictly
+   inside and strictly outside, mask weight), the last separating edge, its edge count and
+   the grid's margin. */
 typedef struct {
-    double *nx, *ny, *c, *hi, *lo, *in, *out;
+    double *nx, *ny, *c, *in, *out;
     int64_t *w;
     int64_t s, hint;
     double m;
@@ -108,18 +109,18 @@ static void normals(Edges *h, const double *q, int64_t s)
     }
 }
 
-/* The rest of the s half-planes in h (their normals set): each cell's corner spread hi
+/* The rest of the s half-planes in h (their normals set): from each cell's corner spread hi
    and lo (less the chord's sagitta, sag, for chord polygons), the thresholds of strictly
-   inside and strictly outside, and the edges' mask weights, as _classify_many computes them. */
+   inside and strictly outside; and the edges' mask weights, as _classify_many computes them. */
 static void half_planes(Edges *h, int64_t s, const double *sag, int wide, double cw, double ch)
 {
     h->s = s;
     for (int64_t e = 0; e < s; e++) {
-        h->hi[e] = max0(h->nx[e]) * cw + max0(h->ny[e]) * ch;
-        h->lo[e] = min0(h->nx[e]) * cw + min0(h->ny[e]) * ch;
-        if (sag) h->lo[e] -= sag[e];
-        h->in[e] = -h->m - h->hi[e];  /* strictly inside: d <= in */
-        h->out[e] = h->m - h->lo[e];  /* strictly outside: d >= out */
+        double hi = max0(h->nx[e]) * cw + max0(h->ny[e]) * ch;
+        double lo = min0(h->nx[e]) * cw + min0(h->ny[e]) * ch;
+        if (sag) lo -= sag[e];
+        h->in[e] = -h->m - hi;  /* strictly inside: d <= in */
+        h->out[e] = h->m - lo;  /* strictly outside: d >= out */
         h->w[e] = wide ? 0 : (int64_t)((uint64_t)1 << ((e + 1) % s));
     }
     h->hint = 0;
@@ -173,13 +174,13 @@ static int classify_box(Out *o, Edges *h, int wide, int64_t id, int64_t i0, int6
     return 0;
 }
 
-/* Scratch for the half-planes of pieces of up to E edges (8 doubles an edge). */
+/* Scratch for the half-planes of pieces of up to E edges (6 doubles an edge). */
 static int edges_alloc(Edges *h, double **hp, Py_ssize_t E, double m)
 {
-    *hp = PyMem_Malloc(sizeof(double) * 8 * (size_t)(E ? E : 1));
+    *hp = PyMem_Malloc(sizeof(double) * 6 * (size_t)(E ? E : 1));
     if (!*hp) return -1;
     double *p = *hp;
-    *h = (Edges){p, p + E, p + 2 * E, p + 3 * E, p + 4 * E, p + 5 * E, p + 6 * E, (int64_t *)(p + 7 * E), 0, 0, m};
+    *h = (Edges){p, p + E, p + 2 * E, p + 3 * E, p + 4 * E, (int64_t *)(p + 5 * E), 0, 0, m};
     return 0;
 }
 

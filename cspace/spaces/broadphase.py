@@ -116,12 +116,9 @@ class GridIndex(CellClassifier):
         # error scales with the scene's extent; the shift itself may round by up to
         # an ulp of the largest coordinate, which the margin also covers.
         self.ox, self.oy = 0.5 * (xmin + xmax), 0.5 * (ymin + ymax)
-        # The largest |coordinate| of the bounds and the pieces (their vertices', when packed).
-        if packed is not None:
-            top = [float(max(packed.start.max(), -packed.start.min()))] if len(packed.start) else []
-        else:
-            full = np.isfinite(self._lo[:, 0])  # non-empty pieces
-            top = [float(max(np.abs(self._lo[full]).max(), np.abs(self._hi[full]).max()))] if full.any() else []
+        # The largest |coordinate| of the bounds and the pieces: over boxes [lo, hi] it is
+        # max(hi, -lo) (an empty piece's box, lo = inf and hi = -inf, adds nothing).
+        top = [float(max(self._hi.max(), -self._lo.min()))] if n else []
         big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] + top)
         self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
         if not n:  # nothing to classify: every cell FREE

@@ -208,8 +208,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # distance found are not measured (GJK's own error is about 2^-50 x that scale). A path
     # with a margin runs at one distance, to rounding, along many segments, where box
     # bounds leave GJK hundreds of pairs: after GJK_FIRST pairs, the rest get tight bounds.
-    # (the largest |coordinate| of a piece is one of its box's: max |p| from the boxes, the same float)
-    # (max |v| over [lo, hi] boxes is max(hi, -lo): the same float, without the |.| arrays)
+    # (the largest |coordinate| of the pieces is one of their boxes', max(hi, -lo): the same float)
     slack = TIE * max(float(pts.max()), -float(pts.min()), float(obs.hi.max()), -float(obs.lo.min()))
     queue, pos, measured = np.argsort(lbs, kind="stable").tolist(), 0, 0
     still = (a == b).all(axis=1).tolist()  # a segment of one point sweeps the piece itself
