@@ -185,8 +185,11 @@ def car_sweep_check(sc, path, segments_of, radius: float, dangle: float = 2e-3, 
             pose = end
         res["end_gap"] = max(res["end_gap"], math.hypot(pose[0] - b[0], pose[1] - b[1]))
         if tree_obs is not None and (pose[0], pose[1]) != (b[0], b[1]):
-            # The curve's end is joined to the target pose by a straight SE(2) motion.
-            join = sweep_check(sc, np.array([[pose[0], pose[1], math.remainder(pose[2], 2 * math.pi)], list(b)]))
+            # The curve's end is joined to the target pose by a straight SE(2) motion; both
+            # angles wrapped, as the motion turns the shorter way (a chain turning past 2 pi
+            # would otherwise be judged by a join spinning whole turns in place).
+            join = sweep_check(sc, np.array([[pose[0], pose[1], math.remainder(pose[2], 2 * math.pi)],
+                                             [b[0], b[1], math.remainder(b[2], 2 * math.pi)]]))
             if join["collides"]:
                 res["collides"] = True
                 res["certain"] = join["certain"]

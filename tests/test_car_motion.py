@@ -10,7 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import shapely
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from conftest import load_script
@@ -64,6 +64,9 @@ _seg = st.tuples(st.sampled_from("LSR"), st.floats(-4, 4).filter(lambda v: abs(v
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(_tri, min_size=1, max_size=5), st.tuples(st.floats(3, 9), st.floats(3, 9), st.floats(-3.1, 3.1)),
        st.lists(_seg, min_size=1, max_size=3), st.floats(0.5, 3))
+# A chain turning 12 rad (ends at an unwrapped angle): the oracle once joined its end to that
+# angle by spinning two turns in place and called a free curve colliding.
+@example([(4.0, 2.0, 1.5, 0.0)], (5.5, 3.0, -1.0), [("L", -2.0), ("L", -4.0)], 0.5)
 def test_curve_free_never_accepts_a_colliding_curve(tris, q0, segs, radius):
     sc, cs = _scene([_triangle(*t) for t in tris])
     ok = cs.curve_free(q0, segs, radius)
