@@ -6,6 +6,7 @@ simplex, extent; compared by float.hex, so even the sign of a zero counts), and
 gjk_distance's answer with and without ``loop=`` (distance, points, iterations, status).
 Skipped when the extension is not built (or CSPACE_PURE=1), except the pure-path test.
 """
+import math
 import os
 
 import numpy as np
@@ -245,3 +246,112 @@ def test_se2_lower_bound_compiled_equals_pure():
     with fastpath.disabled():
         pure = se2_path_clearance(path, bar, obstacles, angle_step=1e-2)
     assert bits(tuple(fast)) == bits(tuple(pure))
+
+
+# ------------------------------------------- min_clearance's compiled search (_nearest.c)
+
+
+def _scene(rng, n_obstacles: int, grid: bool):
+    """Random convex obstacles on both sides of a corridor, a robot of 0, 1 or 2 convex
+    pieces and a path along the corridor (many pairs at nearly equal distances, so the
+    search improves its best often); on ``grid``, integer coordinates (contacts, equal
+    distances, repeated path points)."""
+    def convex(c, r, k):
+        pts = rng.uniform(-r, r, (k, 2)) + c
+        return convex_hull(np.round(pts) if grid else pts)
+
+    centres = np.c_[rng.uniform(0, 40, n_obstacles), rng.choice([-1, 1], n_obstacles) * rng.uniform(4, 12, n_obstacles)]
+    obstacles = [convex(c, rng.uniform(1, 3), int(rng.integers(3, 9))) for c in centres]
+    robot = [convex((0.0, 0.0), 1.0, 5), convex((0.5, 0.0), 0.5, 4)][: int(rng.integers(0, 3))]
+    n = int(rng.integers(1, 30))
+    path = np.c_[np.sort(rng.uniform(0, 40, n)), rng.uniform(-1, 1, n)]
+    if grid:
+        path = np.round(path)
+        path = np.repeat(path, rng.integers(1, 3, len(path)), axis=0)  # still segments
+    return obstacles, robot, path
+
+
+@needs_c
+@pytest.mark.parametrize("seed", range(12))
+def test_path_clearance_scan_equals_the_pure_search(seed):
+    # The compiled pass over losing pairs (clearance_scan), the compiled boxes and their
+    # gaps leave path_clearance's answer as the pure search finds it, to the bit (distance,
+    # place, obstacle point, segment): on random scenes, few and many pairs (the filtered
+    # route, the tight bounds after GJK_FIRST pairs), integer ones with contacts, ties and
+    # still segments, and pieces given with a closing repeat of their first vertex.
+    from cspace.spaces.clearance import path_clearance
+
+    rng = np.random.default_rng(seed)
+    obstacles, robot, path = _scene(rng, (8, 60, 200)[seed % 3], grid=seed % 4 == 1)
+    if seed % 4 == 2:  # along a wall at one distance: ties on every segment (the tight bounds' case)
+        obstacles = [o + (0.0, 40.0) for o in obstacles] + [np.array([[-5.0, -3.0], [45, 2], [45, 2.5], [-5, -2.5]])]
+        path = np.c_[np.linspace(0, 40, 60), np.linspace(0, 40, 60) * 0.1 - 0.5 + 1.2]  # parallel to the wall
+    if seed % 4 == 3:
+        obstacles = [np.vstack([o, o[:1]]) for o in obstacles]
+        robot = [np.vstack([r, r[:1]]) for r in robot]
+    for moved in (path, path + rng.normal(size=path.shape) * 0.1):
+        fast = path_clearance(moved, robot, obstacles)
+        with fastpath.disabled():
+            pure = path_clearance(moved, robot, obstacles)
+        assert bits(tuple(fast)) == bits(tuple(pure)), (seed, fast, pure)
+
+
+@needs_c
+def test_pack_boxes_and_box_gaps_equal_numpy():
+    from cspace.kernel.polygon import pack, piece_boxes
+
+    rng = np.random.default_rng(3)
+    pieces = [rng.normal(size=(int(k), 2)) * 10.0 ** rng.integers(-3, 4) for k in rng.integers(0, 9, 40)]
+    pieces[5] = np.asfortranarray(pieces[5])  # strides other than (16, 8)
+    pieces[7] = np.zeros((0, 2))
+    xy, off, lo, hi, scale = fastpath.pack_boxes(pieces)
+    pts, sizes = pack(pieces)
+    lo2, hi2 = piece_boxes(pieces)
+    assert bits(xy) == bits(pts) and off.tolist() == [0, *np.cumsum(sizes).tolist()]
+    assert bits(lo) == bits(lo2) and bits(hi) == bits(hi2)
+    assert scale == max(float(hi2.max()), -float(lo2.min()))
+    # not finite float64 (n, 2) arrays: numpy's turn
+    assert fastpath.pack_boxes([np.array([[0.0, np.nan]])]) is None
+    assert fastpath.pack_boxes([np.array([[0, 1]])]) is None
+    assert fastpath.pack_boxes([np.zeros((3, 3))]) is None
+    # the distances between boxes: numpy's doubles, empty pieces' boxes (inf) included
+    a, b = rng.normal(size=(30, 2)) * 5, rng.normal(size=(30, 2)) * 5
+    blo, bhi = np.minimum(a, b), np.maximum(a, b)
+    gap = np.maximum(np.maximum(lo[None] - bhi[:, None], blo[:, None] - hi[None]), 0.0)
+    assert bits(fastpath.box_gaps(blo, bhi, lo, hi)) == bits(np.hypot(gap[..., 0], gap[..., 1]))
+
+
+@needs_c
+def test_clearance_scan_decisions_and_input_checks():
+    # One pair, decided as Python's search decides it: a loss, a new best (its distance and
+    # the obstacle's closest point), a tie (math.hypot decides: a loss), the bounds' stop,
+    # a contact (left to Python); bad arguments raise (never read out of bounds), an id out
+    # of range stops the scan where it stands.
+    from cspace.spaces import _fast
+
+    sq = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    placed = [np.vstack([sq, sq + 1])]  # the square at (0, 0) and at (1, 1): one segment
+    xy, off = np.vstack([sq + 5]), np.array([0, 4], dtype=np.int64)
+    still, lbs, q = np.zeros(1, dtype=bool), np.array([0.0]), np.array([0], dtype=np.int64)
+    args = [placed, 2, still, xy, off, q, None, lbs, 1, 0, 1.0, 0.0, -1, 64, 2.0**-101, 2.0**100, 1e-9, math.hypot]
+
+    def scan(**kw):
+        names = ["placed", "npoints", "still", "xy", "off", "queue", "pairs", "lbs", "no", "pos", "best", "slack"]
+        return _fast.clearance_scan(*[kw.get(n, a) for n, a in zip(names, args)], *args[12:])
+
+    tie = math.hypot(3.0, 3.0)  # from (2, 2) to (5, 5)
+    assert scan(best=1.0) == (1, 1, None)  # a loss against a best of 1
+    assert scan(best=100.0) == (1, 1, (tie, 0, 5.0, 5.0))  # the new best
+    assert scan(best=tie) == (1, 1, None)  # a tie loses
+    assert scan(best=math.nextafter(tie, 9)) == (1, 1, (tie, 0, 5.0, 5.0))
+    assert scan(lbs=np.array([2.0])) == (0, 0, None)  # the bounds stop the search
+    assert scan(xy=np.vstack([sq + 2]), best=100.0) == (0, 0, None)  # touching: Python's exact test
+    assert scan(queue=np.array([3], dtype=np.int64)) == (0, 0, None)  # out of range
+    with pytest.raises(ZeroDivisionError):  # an error in the hypot called is raised
+        _fast.clearance_scan(*args[:10], tie, *args[11:-1], lambda x, y: 1 / 0)
+    with pytest.raises(ValueError):
+        scan(placed=[np.zeros((3, 2))])  # 3 rows for 2 path points
+    with pytest.raises(TypeError):
+        _fast.clearance_scan(*args[:-1])
+    with pytest.raises(ValueError):
+        _fast.box_gaps(np.zeros((2, 2)), np.zeros((2, 2)), np.zeros((1, 2)), np.zeros((1, 2)), np.zeros(3))

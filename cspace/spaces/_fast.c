@@ -610,6 +610,10 @@ static PyMethodDef methods[] = {
      "se2_slow(grid, handle, x, y, c, s): 1 free in the slab, 2 free, 0 not free, -1 undecided."},
     {"gjk", (PyCFunction)(void (*)(void))fast_gjk, METH_FASTCALL,
      "gjk(a, b, max_iterations): the loop of cspace.kernel.gjk._gjk on float64 (n, 2) arrays."},
+    {"clearance_scan", (PyCFunction)(void (*)(void))fast_clearance_scan, METH_FASTCALL,
+     "clearance_scan(...): min_clearance's search passing over losing pairs (_nearest.c)."},
+    {"pack_boxes", fast_pack_boxes, METH_VARARGS, "pack_boxes(pieces): packed points, offsets, boxes, scale (_nearest.c)."},
+    {"box_gaps", fast_box_gaps, METH_VARARGS, "box_gaps(lo, hi, olo, ohi, out): distances between boxes (_nearest.c)."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -1,7 +1,8 @@
 /* Shared by the C files of cspace's optional compiled fast path (cspace.spaces._fast):
    _fast.c (grid queries, SE(2) filter, the module), _build.c (the C-space build's pair
    sums and containment), _cells.c (the grid build's cell classification), _chords.c
-   (chord polygons), _gjk.c (the GJK loop of min_clearance).
+   (chord polygons), _gjk.c (the GJK loop of min_clearance), _nearest.c (min_clearance's
+   search over its pairs).
 
    The one certified predicate they share: the sign of a cross product of two edge
    vectors, decided only where floats certify it (Shewchuk's stage-A filter, the same
@@ -104,5 +105,10 @@ int64_t chord_polygon(const double *q, int64_t s, double long_edge, double limit
 PyObject *fast_entries(PyObject *self, PyObject *args);                       /* _cells.c */
 PyObject *fast_assemble(PyObject *self, PyObject *args);                      /* _cells.c */
 PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs);  /* _gjk.c */
+int gjk_gap(const double *a, Py_ssize_t na, const double *b, Py_ssize_t nb, Py_ssize_t max_it, double safe_min,
+            double safe_max, double *dx, double *dy, double *bx, double *by, double *extent); /* _gjk.c */
+PyObject *fast_clearance_scan(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _nearest.c */
+PyObject *fast_pack_boxes(PyObject *self, PyObject *args);                    /* _nearest.c */
+PyObject *fast_box_gaps(PyObject *self, PyObject *args);                      /* _nearest.c */
 
 #endif

@@ -207,36 +207,11 @@ static int gjk_local(const Py_buffer *v, double ox, double oy, double *out, doub
     return 1;
 }
 
-PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* _loop on local-frame coordinates al (na points) and bl (nb): the final simplex in *S,
+   the iterations in *it; returns 1 when the origin is inside (the loop's inside flag). */
+static int gjk_run(const double *al, Py_ssize_t na, const double *bl, Py_ssize_t nb, Py_ssize_t max_it,
+                   GSimplex *out, Py_ssize_t *it_out)
 {
-    if (nargs != 3) {
-        PyErr_SetString(PyExc_TypeError, "gjk(a, b, max_iterations)");
-        return NULL;
-    }
-    Py_ssize_t max_it = PyLong_AsSsize_t(args[2]);
-    if (max_it == -1 && PyErr_Occurred()) return NULL;
-    Py_buffer va, vb;
-    if (gjk_view(args[0], &va, "a") < 0) return NULL;
-    if (gjk_view(args[1], &vb, "b") < 0) {
-        PyBuffer_Release(&va);
-        return NULL;
-    }
-    Py_ssize_t na = va.shape[0], nb = vb.shape[0];
-    double stack[GJK_STACK], *al = stack;
-    PyObject *result = NULL;
-    if (2 * (na + nb) > GJK_STACK && !(al = PyMem_Malloc(sizeof(double) * 2 * (size_t)(na + nb)))) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    double *bl = al + 2 * na;
-    const double *a0 = va.buf;
-    double ox = a0[0], oy = *(const double *)((const char *)va.buf + va.strides[1]);
-    double extent = 0.0;
-    if (!gjk_local(&va, ox, oy, al, &extent) || !gjk_local(&vb, ox, oy, bl, &extent)) {
-        result = Py_NewRef(Py_None); /* not finite: the pure path's case */
-        goto done;
-    }
-    if (!(extent > 0.0)) extent = 1.0;
     GSimplex S = {1, {{0, 0, al[0] - bl[0], al[1] - bl[1]}}, {1.0}};
     Py_ssize_t it = 0;
     int inside = 0;
@@ -270,6 +245,88 @@ PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
         S.lam[S.n] = 0.0;
         S.n++;
     }
+    *out = S;
+    *it_out = it;
+    return inside;
+}
+
+/* GJK's float answer on the hulls of a (na points, xy interleaved, contiguous) and b, as
+   Python's gjk_distance_below reads it: the local frame at a[0], the loop, then the
+   difference of the closest points (A's minus B's) into *dx, *dy, B's closest point in
+   the input's frame into *bx, *by (gjk.py's point_b), the extent into *extent. Returns 0,
+   or -1 where that answer says nothing (a coordinate not finite, the origin inside, the
+   extent outside [safe_min, safe_max)). */
+int gjk_gap(const double *a, Py_ssize_t na, const double *b, Py_ssize_t nb, Py_ssize_t max_it, double safe_min,
+            double safe_max, double *dx, double *dy, double *bx, double *by, double *extent)
+{
+    double stack[GJK_STACK], *al = stack;
+    if (2 * (na + nb) > GJK_STACK && !(al = malloc(sizeof(double) * 2 * (size_t)(na + nb)))) return -1;
+    double *bl = al + 2 * na, ox = a[0], oy = a[1], m = 0.0;
+    int ok = 1;
+    for (Py_ssize_t i = 0; i < 2 * na; i += 2) {
+        double x = a[i] - ox, y = a[i + 1] - oy;
+        ok &= isfinite(x) && isfinite(y);
+        al[i] = x, al[i + 1] = y;
+        if (fabs(x) > m) m = fabs(x);
+        if (fabs(y) > m) m = fabs(y);
+    }
+    for (Py_ssize_t i = 0; i < 2 * nb; i += 2) {
+        double x = b[i] - ox, y = b[i + 1] - oy;
+        ok &= isfinite(x) && isfinite(y);
+        bl[i] = x, bl[i + 1] = y;
+        if (fabs(x) > m) m = fabs(x);
+        if (fabs(y) > m) m = fabs(y);
+    }
+    int result = -1;
+    if (!(m > 0.0)) m = 1.0;
+    if (ok && m >= safe_min && m < safe_max) {
+        GSimplex S;
+        Py_ssize_t it;
+        if (!gjk_run(al, na, bl, nb, max_it, &S, &it)) {
+            double pax, pay, pbx, pby;
+            gjk_point(&S, al, 0, &pax, &pay);
+            gjk_point(&S, bl, 1, &pbx, &pby);
+            *dx = pax - pbx, *dy = pay - pby, *bx = pbx + ox, *by = pby + oy, *extent = m;
+            result = 0;
+        }
+    }
+    if (al != stack) free(al);
+    return result;
+}
+
+PyObject *fast_gjk(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "gjk(a, b, max_iterations)");
+        return NULL;
+    }
+    Py_ssize_t max_it = PyLong_AsSsize_t(args[2]);
+    if (max_it == -1 && PyErr_Occurred()) return NULL;
+    Py_buffer va, vb;
+    if (gjk_view(args[0], &va, "a") < 0) return NULL;
+    if (gjk_view(args[1], &vb, "b") < 0) {
+        PyBuffer_Release(&va);
+        return NULL;
+    }
+    Py_ssize_t na = va.shape[0], nb = vb.shape[0];
+    double stack[GJK_STACK], *al = stack;
+    PyObject *result = NULL;
+    if (2 * (na + nb) > GJK_STACK && !(al = PyMem_Malloc(sizeof(double) * 2 * (size_t)(na + nb)))) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    double *bl = al + 2 * na;
+    const double *a0 = va.buf;
+    double ox = a0[0], oy = *(const double *)((const char *)va.buf + va.strides[1]);
+    double extent = 0.0;
+    if (!gjk_local(&va, ox, oy, al, &extent) || !gjk_local(&vb, ox, oy, bl, &extent)) {
+        result = Py_NewRef(Py_None); /* not finite: the pure path's case */
+        goto done;
+    }
+    if (!(extent > 0.0)) extent = 1.0;
+    GSimplex S;
+    Py_ssize_t it;
+    int inside = gjk_run(al, na, bl, nb, max_it, &S, &it);
     double pax, pay, pbx, pby;
     gjk_point(&S, al, 0, &pax, &pay);
     gjk_point(&S, bl, 1, &pbx, &pby);

@@ -23,6 +23,10 @@ the distance of the robot at some pose met on the way (an upper bound: then it c
 rise further, as when the path touches): the bound is then within about
 r · angle_step of the true clearance (r the robot's radius), and never above it.
 
+With the compiled fast path, the walk over the pairs runs in C (cspace/spaces/_nearest.c),
+each pair decided as the Python loop below decides it (tests/test_gjk_fast.py: the same
+answers, to the bit); contacts and the exact band return to that loop.
+
 Distances are GJK's, float (error about 2^-50 of the coordinates' scale); the search
 skips pairs that cannot be nearer than the best found by more than 2^-44 of that scale
 (their bounds: the float distance from the segment to O ⊕ (−R)), so the result is within
@@ -37,7 +41,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..kernel.gjk import gjk_distance, gjk_distance_below, witness_weights
+from ..kernel.gjk import EXACT_BAND, MAX_ITERATIONS, gjk_distance, gjk_distance_below, witness_weights
+from ..kernel.scaling import SAFE_MAX, SAFE_MIN
 from ..kernel.polygon import piece_boxes
 from . import fastpath
 
@@ -76,9 +81,19 @@ class Nearest:
     """
 
     def __init__(self, pieces: list[np.ndarray]):
-        self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
         self.loop = fastpath.gjk_loop()  # the compiled GJK loop, or None (pure): fixed at construction
-        self.lo, self.hi = piece_boxes(self.pieces)  # all boxes in two reductions
+        packed = fastpath.pack_boxes(pieces)  # compiled: packed points and boxes in one pass
+        if packed is not None:  # (every piece a finite float64 (n, 2) array, used as it is)
+            self.pieces = list(pieces)
+            self.xy, self.off, self.lo, self.hi, self.scale = packed
+        else:
+            self.pieces = [np.ascontiguousarray(p, dtype=np.float64) for p in pieces]
+            self.lo, self.hi = piece_boxes(self.pieces)  # all boxes in two reductions
+            self.xy = self.off = None
+            # the largest |coordinate| of the pieces is one of their boxes', max(hi, -lo)
+            self.scale = max(float(self.hi.max()), -float(self.lo.min())) if len(self.pieces) else -math.inf
+        # the compiled pass over losing pairs of path_clearance (with the packed points), or None
+        self.scan = fastpath.clearance_scan() if self.xy is not None else None
 
     def nearest(self, pts: np.ndarray, cap: float = math.inf):
         """(distance, piece, point on the piece) of the closest piece to conv(pts), or
@@ -181,12 +196,14 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # sweep against every obstacle box, the pairs then visited by increasing box distance
     # (a lower bound) until it reaches the best distance found.
     a, b = (pts[:-1], pts[1:]) if len(pts) > 1 else (pts, pts)  # the segments' ends, as rows
-    rlo, rhi = piece_boxes(rob)
+    rlo, rhi = _boxes(rob)
     lo = (np.minimum(a, b)[:, None, :] + rlo[None, :, :]).reshape(-1, 2)  # (segment, piece) rows
     hi = (np.maximum(a, b)[:, None, :] + rhi[None, :, :]).reshape(-1, 2)
     nr, no = len(rob), len(obs.pieces)
 
     def box_bounds(s0: int, s1: int) -> np.ndarray:  # sweeps s0..s1 against every obstacle box
+        if obs.scan is not None:  # compiled: the same doubles
+            return fastpath.box_gaps(lo[s0:s1], hi[s0:s1], obs.lo, obs.hi)
         gap = np.maximum(np.maximum(obs.lo[None, :, :] - hi[s0:s1, None, :], lo[s0:s1, None, :] - obs.hi[None, :, :]), 0.0)
         return np.hypot(gap[..., 0], gap[..., 1])
 
@@ -208,10 +225,9 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     # distance found are not measured (GJK's own error is about 2^-50 x that scale). A path
     # with a margin runs at one distance, to rounding, along many segments, where box
     # bounds leave GJK hundreds of pairs: after GJK_FIRST pairs, the rest get tight bounds.
-    # (the largest |coordinate| of the pieces is one of their boxes', max(hi, -lo): the same float)
-    slack = TIE * max(float(pts.max()), -float(pts.min()), float(obs.hi.max()), -float(obs.lo.min()))
-    queue, pos, measured = np.argsort(lbs, kind="stable").tolist(), 0, 0
-    still = (a == b).all(axis=1).tolist()  # a segment of one point sweeps the piece itself
+    slack = TIE * max(float(pts.max()), -float(pts.min()), obs.scale)
+    queue, pos, measured = np.argsort(lbs, kind="stable"), 0, 0
+    still = (a == b).all(axis=1)  # a segment of one point sweeps the piece itself
     # Each robot piece placed at every path point: a segment's swept point set is two
     # consecutive placements, one contiguous block (a view, no copy).
     placed = [(r[None, :, :] + pts[:, None, :]).reshape(-1, 2) for r in rob]
@@ -220,8 +236,30 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
         nv = len(rob[j])
         return placed[j][i * nv:(i + 1 if still[i] else i + 2) * nv]
 
+    def tighten(queue, pos, lbs):  # the pairs left, on tight bounds, in their order
+        rest = queue[pos:]
+        rest = rest[lbs[rest] < best - slack]
+        lbs = lbs.copy()
+        rows, ks = np.divmod(rest if pairs is None else pairs[rest], no)
+        lbs[rest] = _tighter_bounds(lbs[rest], rows, ks, a, b, rob, obs)
+        return rest[np.argsort(lbs[rest], kind="stable")], 0, lbs
+
     while pos < len(queue):
-        t = queue[pos]
+        if obs.scan is not None:  # compiled: the pairs whose answer is GJK's float one
+            pos, n, won = obs.scan(placed, len(pts), still, obs.xy, obs.off, queue, pairs, lbs, no, pos, best, slack,
+                                   GJK_FIRST - measured if measured < GJK_FIRST else -1, MAX_ITERATIONS, SAFE_MIN,
+                                   SAFE_MAX, EXACT_BAND, math.hypot)
+            if won is not None:
+                best, t, bx, by = won
+                row, k = divmod(t, no)
+                arg = (*divmod(row, nr), k, np.array((bx, by)))
+            measured += n
+            if n and measured == GJK_FIRST:
+                queue, pos, lbs = tighten(queue, pos, lbs)
+                continue
+            if pos == len(queue):
+                break
+        t = int(queue[pos])
         pos += 1
         if lbs[t] >= best - slack:
             break
@@ -234,12 +272,7 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
                 break
         measured += 1
         if measured == GJK_FIRST:
-            rest = np.array(queue[pos:], dtype=np.int64)
-            rest = rest[lbs[rest] < best - slack]
-            lbs = lbs.copy()
-            rows, ks = np.divmod(rest if pairs is None else pairs[rest], no)
-            lbs[rest] = _tighter_bounds(lbs[rest], rows, ks, a, b, rob, obs)
-            queue, pos = rest[np.argsort(lbs[rest], kind="stable")].tolist(), 0
+            queue, pos, lbs = tighten(queue, pos, lbs)
     if arg is None:
         return PathClearance(math.inf, (), (), -1, "exact")
     i, j, k, w = arg
@@ -260,6 +293,12 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
         where = _closest_position((pts[i], pts[min(i + 1, len(pts) - 1)]), rob[j], obs.pieces[k], obs.loop)
         w = gjk_distance(rob[j] + np.array(where), obs.pieces[k], loop=obs.loop).point_b
     return PathClearance(float(best), where, tuple(float(v) for v in w), i, "exact")
+
+
+def _boxes(pieces: list) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces' boxes (:func:`cspace.kernel.polygon.piece_boxes`), compiled where built."""
+    packed = fastpath.pack_boxes(pieces)
+    return piece_boxes(pieces) if packed is None else packed[2:4]
 
 
 def _tighter_bounds(lbs, rows, ks, a, b, rob, obs) -> np.ndarray:

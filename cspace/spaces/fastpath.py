@@ -77,6 +77,52 @@ def gjk_loop():
     return None if _fast is None else _fast.gjk
 
 
+def clearance_scan():
+    """``_fast.clearance_scan`` (cspace/spaces/_nearest.c): min_clearance's search passing
+    over the pairs that cannot beat the best distance, in C, or None on the pure path
+    (:func:`cspace.spaces.clearance.path_clearance` then measures every pair itself)."""
+    return None if _fast is None else _fast.clearance_scan
+
+
+def pack_boxes(pieces: list):
+    """``(xy, off, lo, hi, scale)``: convex pieces packed (piece k in rows off[k] to
+    off[k + 1] of xy), their boxes as :func:`cspace.kernel.polygon.piece_boxes` gives them,
+    and the largest |coordinate| of the boxes, in one compiled pass; None on the pure path
+    or for pieces that are not finite float64 (n, 2) arrays.
+
+    >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+    >>> out = pack_boxes([sq, np.zeros((0, 2))])
+    >>> out is None or (out[1].tolist(), out[2].tolist(), out[3].tolist(), out[4]) == (
+    ...     [0, 4, 4], [[4.0, 4.0], [np.inf, np.inf]], [[6.0, 6.0], [-np.inf, -np.inf]], 6.0)
+    True
+    """
+    if _fast is None:
+        return None
+    out = _fast.pack_boxes(pieces if type(pieces) is list else list(pieces))
+    if out is None:
+        return None
+    xy, off, lo, hi, scale = out
+    f64 = lambda b: np.frombuffer(b, dtype=np.float64).reshape(-1, 2)  # noqa: E731
+    return f64(xy), np.frombuffer(off, dtype=np.int64), f64(lo), f64(hi), scale
+
+
+def box_gaps(lo: np.ndarray, hi: np.ndarray, olo: np.ndarray, ohi: np.ndarray) -> np.ndarray | None:
+    """The distances between boxes ``(lo[r], hi[r])`` and ``(olo[k], ohi[k])`` as an (n, m)
+    array, 0 where they meet (``_fast.box_gaps``, the doubles of numpy's
+    ``hypot(max(olo - hi, lo - ohi, 0))``), or None on the pure path.
+
+    >>> g = box_gaps(np.array([[0., 0]]), np.array([[1., 1]]), np.array([[4., 5], [0, 0]]), np.array([[6., 6], [2, 2]]))
+    >>> g is None or g.tolist() == [[5.0, 0.0]]
+    True
+    """
+    if _fast is None:
+        return None
+    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+    out = np.empty((len(lo), len(olo)))
+    _fast.box_gaps(f64(lo), f64(hi), f64(olo), f64(ohi), out)
+    return out
+
+
 def assemble(*args) -> tuple[int, int, int]:
     """``_fast.assemble`` (cspace/spaces/_cells.c): the grid's state, blockers, candidates,
     masks and starts from its classified entries, as GridIndex's numpy route assembles
