@@ -34,10 +34,10 @@ FREE, MIXED, BLOCKED = 0, 1, 2
 _MARGIN = 1e-9
 
 
-# The default grid: cells per piece (pure path; compiled path), and the fewest cells (see GridIndex).
-CELLS_PER_PIECE = 256
-CELLS_PER_PIECE_COMPILED = 64
-MIN_CELLS = 1 << 12
+# The default grid: cells per piece and the fewest cells, on the pure path and on the
+# compiled one (see GridIndex).
+CELLS_PER_PIECE, MIN_CELLS = 256, 1 << 12
+CELLS_PER_PIECE_COMPILED, MIN_CELLS_COMPILED = 32, 1 << 11
 
 # Most (piece, cell) pairs the build classifies, before the grid is coarsened.
 _PAIR_BUDGET = float(1 << 22)
@@ -86,18 +86,19 @@ class GridIndex(CellClassifier):
         # each piece's box, in one pass
         self._lo, self._hi = (packed.lo, packed.hi) if packed is not None else piece_boxes(pieces)
         if cells is None:
-            # About 256 cells per piece, at least 64 x 64: measured on the bundled scenes
+            # Pure path: about 256 cells per piece, at least 64 x 64, measured on the bundled scenes
             # (plans of RRTConnect, compiled and pure paths), 1024 per piece and at least
             # 256 x 256 classified 2-4x longer for no faster query: a MIXED cell costs
             # the compiled narrow phase less than the Python call around it, and a
-            # segment walks fewer cells. With the compiled narrow phase, 64 per piece
-            # plans as fast or faster (RRTConnect, 12 interleaved seeds against 128 on 12
-            # bundled scenes: 0.87x on ompl/circles, 0.93-0.94x on parts and
-            # random_polygons, the others within 1 %; env2 within 1 % over 5 seeds) and
-            # builds faster; on the pure path 128 plans 15-25 % slower than 256 (maze,
+            # segment walks fewer cells. With the compiled narrow phase, 32 per piece and
+            # at least 2048 cells plan as fast or faster than 64 and 4096 (RRTConnect, 10
+            # interleaved seeds, wall time with the build, on 14 bundled scenes: 0.89-0.99x
+            # on the small ones, where the build is a third of the plan; maze, ompl/normal
+            # and ompl/thin within 3 %, ompl/env2 and ompl/thick within 1 % over 4 seeds),
+            # and build faster; on the pure path 128 plans 15-25 % slower than 256 (maze,
             # office, ompl/normal), a MIXED cell costing a Python call there.
-            per = CELLS_PER_PIECE_COMPILED if fastpath.compiled() else CELLS_PER_PIECE
-            cells = int(min(max(per * n, MIN_CELLS), 1 << 20)) if n else 1  # no piece: one FREE cell
+            per, least = (CELLS_PER_PIECE_COMPILED, MIN_CELLS_COMPILED) if fastpath.compiled() else (CELLS_PER_PIECE, MIN_CELLS)
+            cells = int(min(max(per * n, least), 1 << 20)) if n else 1  # no piece: one FREE cell
             # Large, overlapping pieces (comb sums) would each cover a big share of that
             # grid: cap the (piece, cell) pairs the classification visits at ~2^22.
             # (Each share is at most 1: with n * cells within the budget, so is cover * cells.)

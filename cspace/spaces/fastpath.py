@@ -29,7 +29,7 @@ ENABLED: bool = _fast is not None
 
 
 def grid_handle(index, packed, bounds):
-    """A handle on a copy of ``index`` (a :class:`cspace.spaces.broadphase.GridIndex`) and
+    """A handle on the arrays of ``index`` (a :class:`cspace.spaces.broadphase.GridIndex`) and
     ``packed`` (its :class:`cspace.kernel.pieces.PieceSet`) for the compiled queries, or None
     on the pure path.
 
@@ -43,15 +43,13 @@ def grid_handle(index, packed, bounds):
     """
     if _fast is None:
         return None
-    # The handle holds these arrays (no copy): the grid's and the pieces' own, read-only.
-    arrays = (index.state, index.blocker, index._starts, index._cand, packed.offsets,
-              packed.start if len(packed) else np.zeros((0, 2)))
+    # The handle holds these arrays (no copy): the grid's and the pieces' own, read-only, as
+    # GridIndex and PieceSet make them (C-contiguous; int8 states, int64 indices, float64
+    # vertices: _fast.grid checks each one's byte length and refuses a strided one).
+    arrays = (index.state, index.blocker, index._starts, index._cand, packed.offsets, packed.start)
     for a in arrays:
         a.flags.writeable = False
-    f64, i64 = (lambda a: np.ascontiguousarray(a, dtype=np.float64)), (lambda a: np.ascontiguousarray(a, dtype=np.int64))
-    st, bl, sts, ca, of, xy = arrays
-    return _fast.grid(np.ascontiguousarray(st).view(np.uint8), i64(bl), i64(sts), i64(ca), i64(of), f64(xy),
-                      index.nx, index.ny, index.x0, index.y0, index.inv_w, index.inv_h, index.cw, index.ch,
+    return _fast.grid(*arrays, index.nx, index.ny, index.x0, index.y0, index.inv_w, index.inv_h, index.cw, index.ch,
                       index.margin, *map(float, bounds))
 
 
