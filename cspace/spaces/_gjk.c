@@ -190,13 +190,14 @@ static int gjk_view(PyObject *obj, Py_buffer *view, const char *name)
     return 0;
 }
 
-/* The local-frame coordinates of a view into out (x - ox, y - oy); 0 if one is not finite. */
-static int gjk_local(const Py_buffer *v, double ox, double oy, double *out, double *extent)
+/* The local-frame coordinates (x - ox, y - oy) of n points, the point i at base + i s0
+   (its y at + s1), into out, the largest |coordinate| raised into *extent; 0 if one is
+   not finite. */
+static int local_frame(const char *base, Py_ssize_t s0, Py_ssize_t s1, Py_ssize_t n, double ox, double oy,
+                       double *out, double *extent)
 {
-    const char *base = v->buf;
-    Py_ssize_t s0 = v->strides[0], s1 = v->strides[1];
     double m = *extent;
-    for (Py_ssize_t i = 0; i < v->shape[0]; i++) {
+    for (Py_ssize_t i = 0; i < n; i++) {
         double x = *(const double *)(base + i * s0) - ox, y = *(const double *)(base + i * s0 + s1) - oy;
         if (!(isfinite(x) && isfinite(y))) return 0;
         out[2 * i] = x, out[2 * i + 1] = y;
@@ -205,6 +206,12 @@ static int gjk_local(const Py_buffer *v, double ox, double oy, double *out, doub
     }
     *extent = m;
     return 1;
+}
+
+/* local_frame of a view's points. */
+static int gjk_local(const Py_buffer *v, double ox, double oy, double *out, double *extent)
+{
+    return local_frame(v->buf, v->strides[0], v->strides[1], v->shape[0], ox, oy, out, extent);
 }
 
 /* _loop on local-frame coordinates al (na points) and bl (nb): the final simplex in *S,
@@ -262,21 +269,7 @@ int gjk_gap(const double *a, Py_ssize_t na, const double *b, Py_ssize_t nb, Py_s
     double stack[GJK_STACK], *al = stack;
     if (2 * (na + nb) > GJK_STACK && !(al = malloc(sizeof(double) * 2 * (size_t)(na + nb)))) return -1;
     double *bl = al + 2 * na, ox = a[0], oy = a[1], m = 0.0;
-    int ok = 1;
-    for (Py_ssize_t i = 0; i < 2 * na; i += 2) {
-        double x = a[i] - ox, y = a[i + 1] - oy;
-        ok &= isfinite(x) && isfinite(y);
-        al[i] = x, al[i + 1] = y;
-        if (fabs(x) > m) m = fabs(x);
-        if (fabs(y) > m) m = fabs(y);
-    }
-    for (Py_ssize_t i = 0; i < 2 * nb; i += 2) {
-        double x = b[i] - ox, y = b[i + 1] - oy;
-        ok &= isfinite(x) && isfinite(y);
-        bl[i] = x, bl[i + 1] = y;
-        if (fabs(x) > m) m = fabs(x);
-        if (fabs(y) > m) m = fabs(y);
-    }
+    int ok = local_frame((const char *)a, 16, 8, na, ox, oy, al, &m) && local_frame((const char *)b, 16, 8, nb, ox, oy, bl, &m);
     int result = -1;
     if (!(m > 0.0)) m = 1.0;
     if (ok && m >= safe_min && m < safe_max) {
