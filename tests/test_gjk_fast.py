@@ -351,6 +351,8 @@ def test_clearance_scan_decisions_and_input_checks():
         _fast.clearance_scan(*args[:10], tie, *args[11:-1], lambda x, y: 1 / 0)
     with pytest.raises(ValueError):
         scan(placed=[np.zeros((3, 2))])  # 3 rows for 2 path points
+    with pytest.raises(ValueError):
+        scan(placed=[np.zeros((4, 2), dtype=np.int64)])  # 8-byte items, but not float64
     with pytest.raises(TypeError):
         _fast.clearance_scan(*args[:-1])
     with pytest.raises(ValueError):

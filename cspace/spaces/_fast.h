@@ -96,6 +96,15 @@ static inline int orient(double ax, double ay, double bx, double by, double cx, 
     return cross_sign(cx, cy, ax, ay, cx, cy, bx, by);
 }
 
+/* Is the buffer an (n, 2) array of native float64 (any n, any strides)? Its format may
+   carry a byte-order prefix ('@', '=' or '<'). */
+static inline int xy_view(const Py_buffer *v)
+{
+    const char *f = v->format ? v->format : "B";
+    if (*f == '@' || *f == '=' || *f == '<') f++;
+    return v->ndim == 2 && v->shape[1] == 2 && v->itemsize == 8 && strcmp(f, "d") == 0;
+}
+
 /* The routines of the other files, registered in _fast.c's method table. */
 PyObject *fast_pair_sums(PyObject *self, PyObject *args);                     /* _build.c */
 PyObject *fast_contained(PyObject *self, PyObject *args);                     /* _build.c */

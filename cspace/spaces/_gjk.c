@@ -180,9 +180,7 @@ static inline Py_ssize_t gjk_support(const double *pts, Py_ssize_t n, double dx,
 static int gjk_view(PyObject *obj, Py_buffer *view, const char *name)
 {
     if (PyObject_GetBuffer(obj, view, PyBUF_RECORDS_RO) < 0) return -1;
-    const char *f = view->format ? view->format : "B";
-    if (*f == '@' || *f == '=' || *f == '<') f++;
-    if (view->ndim != 2 || view->shape[1] != 2 || view->shape[0] < 1 || view->itemsize != 8 || strcmp(f, "d") != 0) {
+    if (!xy_view(view) || view->shape[0] < 1) {
         PyErr_Format(PyExc_ValueError, "_fast.gjk: %s must be a non-empty (n, 2) float64 array", name);
         PyBuffer_Release(view);
         return -1;

@@ -83,7 +83,7 @@ PyObject *fast_clearance_scan(PyObject *self, PyObject *const *args, Py_ssize_t 
     if (!pv) return PyErr_NoMemory();
     for (; got < nr; got++) {
         if (PyObject_GetBuffer(PyList_GET_ITEM(placed, got), &pv[got], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) goto done;
-        if (pv[got].itemsize != 8 || pv[got].ndim != 2 || pv[got].shape[1] != 2 || pv[got].shape[0] % npoints) {
+        if (!xy_view(&pv[got]) || pv[got].shape[0] % npoints) {
             PyErr_SetString(PyExc_ValueError, "clearance_scan: placed[j] must be (npoints * nv, 2) float64");
             PyBuffer_Release(&pv[got]);
             goto done;
@@ -162,9 +162,7 @@ PyObject *fast_pack_boxes(PyObject *self, PyObject *args)
             result = Py_NewRef(Py_None);
             goto done;
         }
-        const char *f = v[got].format ? v[got].format : "B";
-        if (*f == '@' || *f == '=' || *f == '<') f++;
-        if (v[got].ndim != 2 || v[got].shape[1] != 2 || v[got].itemsize != 8 || strcmp(f, "d") != 0) {
+        if (!xy_view(&v[got])) {
             PyBuffer_Release(&v[got]);
             result = Py_NewRef(Py_None);
             goto done;

@@ -202,8 +202,8 @@ def path_clearance(path, robot_pieces: list, obstacle_pieces: list) -> PathClear
     nr, no = len(rob), len(obs.pieces)
 
     def box_bounds(s0: int, s1: int) -> np.ndarray:  # sweeps s0..s1 against every obstacle box
-        if obs.scan is not None:  # compiled: the same doubles
-            return fastpath.box_gaps(lo[s0:s1], hi[s0:s1], obs.lo, obs.hi)
+        if (gaps := fastpath.box_gaps(lo[s0:s1], hi[s0:s1], obs.lo, obs.hi)) is not None:  # compiled: the same doubles
+            return gaps
         gap = np.maximum(np.maximum(obs.lo[None, :, :] - hi[s0:s1, None, :], lo[s0:s1, None, :] - obs.hi[None, :, :]), 0.0)
         return np.hypot(gap[..., 0], gap[..., 1])
 
