@@ -1,16 +1,26 @@
 """planners: OMPL glue, the command line, plots and reports on top of :mod:`cspace`.
 
-Importing this package does not import OMPL or matplotlib; they load when a plan
-or a plot is asked for. Its names load on first use (PEP 562), so the command
-line's start (``cspace --help``) does not pay for the geometry.
+The packages, each importing only those below it (docs/architecture.md, "Layers"):
+:mod:`~planners.cli` (the ``cspace`` command) > :mod:`~planners.bench`, :mod:`~planners.stability`
+> :mod:`~planners.pictures` > :mod:`~planners.core` (``plan``, the planning routine, ``exact``)
+> :mod:`~planners.adapters` (OMPL and the state spaces) > the shared helpers
+(:mod:`~planners.errors`, :mod:`~planners.output`, :mod:`~planners.progress`,
+:mod:`~planners.children`) > :mod:`cspace`.
+
+Importing this package does not import OMPL or matplotlib; they load when a plan or a
+plot is asked for. Its names load on first use (PEP 562), so the command line's start
+(``cspace --help``) does not pay for the geometry.
+
+>>> import planners
+>>> planners.plan.__module__
+'planners.core.plan'
 """
 from __future__ import annotations
 
 import importlib
-import sys
-import types
 
-_NAMES = {"PlanResult": ".plan", "path_length": ".plan", "shortest_path": ".exact"}
+_NAMES = {"plan": ".core.plan", "PlanResult": ".core.result", "path_length": ".adapters.frame",
+          "shortest_path": ".core.plan"}
 
 __all__ = ["plan", "shortest_path", "PlanResult", "path_length"]
 
@@ -25,20 +35,3 @@ def __getattr__(name: str):
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
-
-
-class _Package(types.ModuleType):
-    """``planners.plan`` is the function, also once the submodule of the same name is
-    imported (the import system then sets the package's attribute to the submodule;
-    an eager ``from .plan import plan`` used to overwrite it back)."""
-
-    @property
-    def plan(self):
-        return importlib.import_module(".plan", __name__).plan
-
-    @plan.setter
-    def plan(self, value) -> None:  # the submodule being bound: keep the function
-        pass
-
-
-sys.modules[__name__].__class__ = _Package

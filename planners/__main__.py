@@ -1,4 +1,4 @@
-"""``python -m planners``: the ``cspace`` command (same as the installed script)."""
+"""``python -m planners``: the ``cspace`` command."""
 from .cli import console
 
 console()

@@ -67,13 +67,13 @@ def random_motions(sc, cs, m: int, seed: int):
 
 
 def part_m(m: int) -> list[dict]:
-    from planners.plan import _adapter, _build_cspace
+    from planners.core.plan import make_adapter, build_cspace
 
     rows = []
     for f in sorted(glob.glob(os.path.join(CAR_DIR, "*.toml"))):
         sc = load_scenario(f)
-        cs = _build_cspace(sc, sc.slabs)
-        adapter = _adapter(sc, cs)
+        cs = build_cspace(sc, sc.slabs)
+        adapter = make_adapter(sc, cs)
         motions = random_motions(sc, cs, m, seed=7)
         check = shapely_se2_checker(sc)
         peers = {"discrete": _si(adapter, check, "discrete")}

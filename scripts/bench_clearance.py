@@ -58,7 +58,7 @@ def build_ratio(sc, inflated, reps: int):
 
 def plan_share(sc, planner, reps: int):
     """Median share of min_clearance in the plan's total time, and the median total."""
-    from planners.plan import plan
+    from planners import plan
 
     shares, totals = [], []
     for seed in range(reps):
@@ -101,7 +101,7 @@ def main():
     print(f"median build ratio {statistics.median(ratios):.2f}x (max {max(ratios):.2f}x); "
           f"min_clearance share: median {100 * statistics.median(shares):.1f} %, max {100 * max(shares):.1f} %")
     if args.anytime:
-        from planners.plan import plan
+        from planners import plan
 
         sc = scenes([args.anytime])[0]
         line = []

@@ -1,10 +1,10 @@
 """The C-space against peers: validity checking inside OMPL, comb ⊕ comb, build stages.
 
-(A) Validity checking inside OMPL. Scene: ``planners.generate.generate("random", seed,
+(A) Validity checking inside OMPL. Scene: ``planners.cli.generate.generate("random", seed,
     200)`` (200 random convex 3..8-gons, triangle robot). Three callbacks are installed
     in turn on the same ``SpaceInformation``:
       - no-op: ``lambda state: True`` (the floor any Python callback pays);
-      - ours: ``planners.ompl_glue.validity_function(cspace)`` (grid + exact pieces);
+      - ours: ``planners.adapters.translation.validity_function(cspace)`` (grid + exact pieces);
       - shapely: translate the robot polygon to the state, ``STRtree.query`` for the
         obstacles whose boxes meet it, then ``intersects`` against those obstacles,
         prepared with ``shapely.prepare`` (obstacles are closed: touching is a collision;
@@ -76,7 +76,7 @@ FINE_GRID = 4  # (A) also times a C-space whose grid has this many times the def
 
 def random_scene(seed: int = 0, size: int = 200):
     """The generated random-polygons scenario (a Scenario) with ``size`` obstacles."""
-    from planners.generate import generate
+    from planners.cli.generate import generate
 
     text = generate("random", seed=seed, size=size)
     with tempfile.TemporaryDirectory() as d:
@@ -120,9 +120,10 @@ def shapely_checker(sc, predicate: bool = False):
 
 def ompl_space_information(cs, seed: int):
     """A set-up ``SpaceInformation`` over the C-space's bounds (via ``make_setup``)."""
-    from planners.ompl_glue import make_setup
+    from planners.adapters.glue import make_setup
+    from planners.adapters.translation import TranslationSpace
 
-    ss, space, checker, validator = make_setup(cs, "RRT", seed)
+    ss, space, checker, validator = make_setup(TranslationSpace(cs), "RRT", seed)
     si = ss.getSpaceInformation()
     si.setup()
     return si, (ss, space, checker, validator)
@@ -185,7 +186,8 @@ def agreement(sc, ours, peer, n: int, seed: int) -> dict:
 
 def part_a(seed: int, size: int, n: int, reps: int, agree_n: int) -> dict:
     """Part (A): states/s of the four checkers inside OMPL, the two ratios, agreement."""
-    from planners.ompl_glue import ompl, validity_function
+    from planners.adapters.glue import ompl
+    from planners.adapters.translation import validity_function
 
     ob = ompl()[0]
     sc = random_scene(seed, size)

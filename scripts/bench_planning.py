@@ -5,8 +5,8 @@ Each bundled translation scene that has a path (``scenarios/*.toml`` and
 planner proves unsolvable are skipped) is planned with OMPL's RRTConnect and RRTstar
 over 10 seeds by
 
-- **ours**: the planning routine of ``cspace plan`` (:func:`planners.routine.run_planner`
-  over :class:`planners.spaces.TranslationSpace`): the C-space's exact point test and
+- **ours**: the planning routine of ``cspace plan`` (:func:`planners.core.routine.run_planner`
+  over :class:`planners.adapters.translation.TranslationSpace`): the C-space's exact point test and
   its exact segment test as OMPL's motion validator;
 - **shapely**: a state checker that translates the robot to the state
   (``shapely.transform``) and asks an ``STRtree`` of the obstacles for an intersecting
@@ -67,8 +67,8 @@ sys.path.insert(0, ROOT)
 
 from cspace.spaces.cspace import CSpace, decompose_obstacles, decompose_robot  # noqa: E402
 from cspace.io.scenario import load_scenario  # noqa: E402
-from planners.routine import run_planner  # noqa: E402
-from planners.spaces import TranslationSpace  # noqa: E402
+from planners.core.routine import run_planner  # noqa: E402
+from planners.adapters.translation import TranslationSpace  # noqa: E402
 
 PLANNERS = ("RRTConnect", "RRTstar")
 CHECKERS = ("ours", "shapely", "coal", "coal-fine")  # the coals only when installed (pip install -e ".[bench]")

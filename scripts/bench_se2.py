@@ -3,7 +3,7 @@
 (V) Validity of a state inside OMPL. For each scene, ``si.probabilityOfValidState(N)``
     (OMPL's own C++ loop: N uniform states from its sampler, one checker call each) is
     timed for: a no-op callback; ours (the sliced C-space's pose test, as
-    ``planners.space_se2.SE2Space.validity()`` installs it); a shapely checker that
+    ``planners.adapters.se2.SE2Space.validity()`` installs it); a shapely checker that
     rotates and translates the robot to the state (``shapely.affinity`` on the robot
     polygon, then ``STRtree.query`` and prepared ``intersects``); and, on a 2-D
     ``RealVectorStateSpace`` over the same scene, the translation checker (the robot at
@@ -86,7 +86,7 @@ def _si(space_adapter, checker=None, validator: str = "ours"):
     sampled along the motion) or "dubins" (OMPL's ``DubinsMotionValidator``). Returns
     ``(si, keep)``, ``keep[1]`` being the state space.
     """
-    from planners.ompl_glue import ompl
+    from planners.adapters.glue import ompl
 
     ob, og, ou = ompl()
     ou.RNG.setSeed(1)
@@ -111,8 +111,8 @@ def _si(space_adapter, checker=None, validator: str = "ours"):
 
 
 def part_v(n: int, reps: int) -> list[dict]:
-    from planners.space_se2 import SE2Space
-    from planners.spaces import TranslationSpace
+    from planners.adapters.se2 import SE2Space
+    from planners.adapters.translation import TranslationSpace
 
     rows = []
     for name in VALIDITY_SCENES:
@@ -173,7 +173,7 @@ def random_motions(sc, cs, m: int, seed: int):
 
 
 def part_m(m: int) -> list[dict]:
-    from planners.space_se2 import SE2Space
+    from planners.adapters.se2 import SE2Space
 
     rows = []
     for name in VALIDITY_SCENES:
@@ -223,7 +223,7 @@ def part_m(m: int) -> list[dict]:
 def solve_runs(sc, seeds: int, budget: float, collides, **plan_kw) -> tuple:
     """``planners.plan`` on ``sc`` with seeds 0 .. seeds - 1 (the C-space built once):
     ``(solved, solve times, lengths, paths that collides(path) judges colliding)``."""
-    from planners.plan import plan
+    from planners import plan
 
     times, lengths, solved, bad = [], [], 0, 0
     cs = None

@@ -158,7 +158,7 @@ def json_tables(data, title: str = "") -> list[str]:
 def planner_tables(path: str) -> list[str]:
     """The error-against-run-time summary of a ``cspace bench`` results.json."""
     sys.path.insert(0, ROOT)
-    from planners.bench import curves
+    from planners.pictures.bench_figure import curves
 
     with open(path) as fh:
         data = json.load(fh)

@@ -7,8 +7,8 @@ One command, no hand-edited pictures:
 Each figure is a plan with a fixed seed (``cspace plan --plot``), a C-space picture
 (``cspace show --plot``), the exact shortest path, the circles multi-query run, a small
 ``cspace bench`` sweep's error-against-run-time figure (drawn by
-:mod:`planners.plot_bench` from the sweep's results.json), or the stability chart. PNGs
-are written atomically (temporary file, then rename; :mod:`planners.plot` does it for
+:mod:`planners.pictures.bench_figure` from the sweep's results.json), or the stability chart. PNGs
+are written atomically (temporary file, then rename; :mod:`planners.pictures.plot` does it for
 the pictures it draws), so an interrupted run never leaves a half-written picture.
 ``--only`` takes figure names or group names (see ``--list``). The whole set takes
 well under two minutes on a laptop core; the acceptance sweep behind
@@ -49,8 +49,8 @@ def plan_figure(scenario: str, planner: str | None = None, seed: int = SEED) -> 
     """A plan of the scenario with its own [planner] defaults (or ``planner``), as ``cspace plan --plot``."""
 
     def draw(out: str) -> str:
-        from planners.plan import plan
-        from planners.plot import plot_result
+        from planners import plan
+        from planners.pictures.plot import plot_result
 
         res = plan(_scenario(scenario), planner=planner, seed=seed)
         plot_result(res, out)
@@ -66,9 +66,9 @@ def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False, folder:
     ``cspace plan --animate`` beside the PNG (same name, .gif)."""
 
     def draw(out: str) -> str:
-        from planners.animate import animate_path
-        from planners.plan import plan
-        from planners.plot import plot_result
+        from planners.pictures.animate import animate_path
+        from planners import plan
+        from planners.pictures.plot import plot_result
 
         res = plan(os.path.join(SCENARIOS, folder, f"{scenario}.toml"), seed=seed)
         plot_result(res, out)
@@ -99,7 +99,7 @@ def cspace_figure(scenario: str) -> Callable[[str], str]:
     def draw(out: str) -> str:
         from cspace.spaces.cspace import CSpace
         from cspace.io.scenario import load_scenario
-        from planners.plot import plot_scene
+        from planners.pictures.plot import plot_scene
 
         sc = load_scenario(_scenario(scenario))
         cs = CSpace.from_scenario(sc)
@@ -113,8 +113,8 @@ def circles_figure(time_limit: float = 1.0, seed: int = 0) -> Callable[[str], st
     """OMPL's circles problem: all 100 queries at ``time_limit`` each, on one C-space."""
 
     def draw(out: str) -> str:
-        from planners.plan import plan
-        from planners.plot import plot_result
+        from planners import plan
+        from planners.pictures.plot import plot_result
 
         res = plan(os.path.join(SCENARIOS, "ompl", "circles.toml"), time=time_limit, seed=seed, all_queries=True)
         plot_result(res, out)
@@ -136,9 +136,9 @@ def map_figure(seed: int = SEED) -> Callable[[str], str]:
 
     def draw(out: str) -> str:
         from cspace.io.imported import ImportOptions, load_imported
-        from planners.cli_import import read_robot
-        from planners.plan import plan
-        from planners.plot import plot_result
+        from planners.cli.imports import read_robot
+        from planners import plan
+        from planners.pictures.plot import plot_result
 
         opts = ImportOptions(robot=read_robot(MAP_ROBOT), start=MAP_START, goal=MAP_GOAL)
         res = plan(load_imported(MAP, options=opts), seed=seed)
@@ -150,10 +150,11 @@ def map_figure(seed: int = SEED) -> Callable[[str], str]:
 
 def stability_figure(out: str) -> str:
     """The stability catalogue's chart, as ``cspace stability --plot``."""
-    from planners import stability
+    from planners.pictures.stability_chart import plot_stability
+    from planners.stability import catalogue as stability
 
     rows = stability.run_all()
-    stability.plot(rows, out)
+    plot_stability(rows, out)
     passed = sum(1 for r in rows if r["passed"])
     return f"{passed}/{len(rows)} cases pass"
 
@@ -171,7 +172,7 @@ def bench_figure(args: list[str] = BENCH_ARGS) -> Callable[[str], str]:
         import subprocess
         import tempfile
 
-        from planners.plot_bench import plot_error_vs_time
+        from planners.pictures.bench_figure import plot_error_vs_time
 
         work = tempfile.mkdtemp(prefix="cspace-bench-")
         try:

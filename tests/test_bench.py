@@ -84,7 +84,7 @@ def test_outputs_and_schema(sweeps):
 
 
 def test_optimum_is_the_exact_length_and_never_beaten(sweeps):
-    from planners.exact import shortest_path
+    from planners import shortest_path
 
     base, _ = sweeps
     exact = shortest_path(BASIC).length
@@ -124,7 +124,7 @@ FIELDS_BEFORE_CLEARANCE = (
 
 
 def test_rows_carry_the_min_clearance_that_plan_reports(sweeps):
-    from planners.plan import plan
+    from planners import plan
 
     base, _ = sweeps
     assert bench.FIELDS[:len(FIELDS_BEFORE_CLEARANCE)] == FIELDS_BEFORE_CLEARANCE

@@ -40,7 +40,7 @@ def _pieces(polygons) -> list:
 
 
 def test_margin_kept_and_equal_to_plan_and_to_shapely(sweep):
-    from planners.plan import plan
+    from planners import plan
     from test_clearance import swept_clearance
 
     rows, _ = sweep
@@ -90,7 +90,8 @@ def test_clearance_objective_gives_clearer_paths_than_length(tmp_path):
 
 def test_the_objective_object_reaches_the_planner(monkeypatch):
     """One run in this process: the routine builds the clearance objective and OMPL's setup holds it."""
-    from planners import bench, objectives
+    from planners import bench
+    from planners.adapters import objectives
 
     made = []
     real = objectives.make_objective

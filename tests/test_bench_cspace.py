@@ -39,7 +39,7 @@ def test_shapely_peer_agrees_with_cspace(bench, scene):
     sc, cs = scene
     peer = bench.shapely_checker(sc)
     pred = bench.shapely_checker(sc, predicate=True)
-    from planners.ompl_glue import validity_function
+    from planners.adapters.translation import validity_function
 
     ours = validity_function(cs)
     rng = np.random.default_rng(7)
@@ -58,7 +58,7 @@ def test_shapely_peer_agrees_with_cspace(bench, scene):
 
 def test_ompl_timing_loop(bench, scene):
     sc, cs = scene
-    from planners.ompl_glue import validity_function
+    from planners.adapters.translation import validity_function
 
     si, keep = bench.ompl_space_information(cs, 0)
     res = bench.states_per_second(si, {"noop": (lambda s: True, 2000), "ours": (validity_function(cs), 2000),

@@ -50,7 +50,7 @@ def test_judges_of_colliding_paths_agree(bench):
     judge = bench.shapely_judge(sc)
     through = np.array([sc.start[:2], sc.goal[:2]], dtype=float)  # the diagonal crosses an obstacle
     assert bench.colliding_exact(cs, through) and judge(through)
-    from planners.exact import shortest_path
+    from planners import shortest_path
 
     free = shortest_path(os.path.join(SCENARIOS, "basic.toml"))
     # The exact optimum touches C-obstacles (closed: a collision); its corners pulled

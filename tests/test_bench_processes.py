@@ -14,7 +14,10 @@ from pathlib import Path
 import pytest
 
 from planners import bench
-from planners.bench_pool import CAN_FORK
+from planners.bench import outputs
+from planners.bench import rows as bench_rows
+from planners.pictures import bench_figure
+from planners.bench.pool import CAN_FORK
 from planners.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -86,7 +89,7 @@ def test_a_sweep_killed_before_it_writes_leaves_the_earlier_results(tmp_path):
 @needs_fork
 def test_forked_run_past_its_hard_limit_is_a_timeout_and_a_crash_is_recorded():
     from cspace import CSpace, load_scenario
-    from planners.bench_pool import run_forked
+    from planners.bench.pool import run_forked
 
     sc = load_scenario(BASIC)
     held = {BASIC: (sc, CSpace.from_scenario(sc))}
@@ -102,7 +105,7 @@ def test_forked_run_past_its_hard_limit_is_a_timeout_and_a_crash_is_recorded():
 
 
 def test_ctrl_c_while_writing_outputs_is_not_complete(tmp_path, monkeypatch):
-    rows = [bench._complete(t, {"status": "ok", "solved": False}, 0.1)
+    rows = [bench_rows.complete_row(t, {"status": "ok", "solved": False}, 0.1)
             for t in bench.make_tasks([{"file": BASIC, "scenario": "basic", "optimum": 1.0}], ["RRT"], [0.1], 2)]
     for r in rows:
         del r["order"]
@@ -110,7 +113,7 @@ def test_ctrl_c_while_writing_outputs_is_not_complete(tmp_path, monkeypatch):
     # The handler the process had (Python's default, or SIG_IGN in a background job of a
     # non-interactive shell, which an earlier version of this test wrongly assumed away).
     before = signal.getsignal(signal.SIGINT)
-    hit = bench._write_deferring_sigint(rows, str(tmp_path), {"complete": True}, plot=True)
+    hit = outputs.write_deferring_sigint(rows, str(tmp_path), {"complete": True}, plot=True)
     assert hit is True
     assert json.loads((tmp_path / "results.json").read_text())["meta"]["complete"] is False
     assert signal.getsignal(signal.SIGINT) is before  # the handler is restored
@@ -147,7 +150,7 @@ def test_scenarios_sharing_a_name_are_kept_apart(tmp_path):
     for r in data["rows"]:  # each row carries its own scene's optimum
         assert r["optimum"] == next(s["optimum"] for s in data["meta"]["scenarios"] if s["file"] == r["file"])
     assert len(os.listdir(out / "ompl")) == 2
-    assert len(bench.curves(data["rows"])) == 2
+    assert len(bench_figure.curves(data["rows"])) == 2
 
 
 def test_the_same_file_twice_is_refused(tmp_path, capsys):

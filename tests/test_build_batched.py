@@ -10,7 +10,7 @@ import pytest
 
 from conftest import SCENARIOS
 from cspace import CSpace, minkowski_sum, reflect
-from cspace.spaces.cspace_build import _contained_pieces, pair_sums
+from cspace.spaces.cspace_build import contained_pieces, pair_sums
 from cspace.kernel.pieces import PieceSet
 from cspace.kernel.predicates import orient2d_many
 
@@ -77,7 +77,7 @@ def test_containment_pruning_equals_the_scan(seed, route, monkeypatch):
     _route(cb, route, monkeypatch)
     pieces = random_pieces(np.random.default_rng(seed), 150, spread=15.0)
     want = contained_reference(pieces)
-    assert want and _contained_pieces(pieces) == want
+    assert want and contained_pieces(pieces) == want
 
 
 @pytest.mark.parametrize("route", ["boxes", "first", "far"])
@@ -94,7 +94,7 @@ def test_containment_pruning_of_a_fan_equals_the_scan(route, monkeypatch):
     nested = [0.5 * w for w in wedges[::7]] + [wedges[3].copy()]
     pieces = wedges + nested
     want = contained_reference(pieces)
-    assert len(want) == len(nested) and _contained_pieces(pieces) == want
+    assert len(want) == len(nested) and contained_pieces(pieces) == want
 
 
 def test_pair_sums_equal_minkowski_sum():

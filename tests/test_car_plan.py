@@ -139,7 +139,7 @@ def test_exact_planner_refuses_a_car_in_one_line():
 
 def test_a_car_path_is_drawn_along_its_curves():
     """The dense poses of the plot follow the arcs: each lies on the curve of its motion."""
-    from planners.space_car import dense_curve
+    from planners.adapters.car import dense_curve
 
     sc = load_scenario(os.path.join(SCENARIOS, "car", "maze.toml"))
     res = planners.plan(sc, seed=0)
@@ -163,10 +163,10 @@ def test_bench_car_runs_and_ours_accepts_no_colliding_motion():
 def test_a_failed_dubins_path_says_curves_are_one_way():
     """Planners that use motions both ways (PRM, ...) can return Dubins paths that fail the
     certified re-check; the message says why and which planners to use."""
-    from planners.plan import _adapter, _build_cspace
+    from planners.core.plan import make_adapter, build_cspace
 
     sc = load_scenario(os.path.join(SCENARIOS, "car", "maze.toml"))
-    ad = _adapter(sc, _build_cspace(sc))
+    ad = make_adapter(sc, build_cspace(sc))
     through_wall = np.array([sc.start, (3.0, 8.5, 0.0), sc.goal])  # straight up through the wall at y = 5.5
     ok, msg = ad.verify(through_wall, sc.start, sc.goal)
     assert not ok and "one-way" in msg and "RRTConnect" in msg

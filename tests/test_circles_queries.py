@@ -15,7 +15,7 @@ import os
 import numpy as np
 import pytest
 
-from planners.plan import plan
+from planners import plan
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CIRCLES = os.path.join(ROOT, "scenarios", "ompl", "circles.toml")

@@ -107,7 +107,7 @@ def random_scene(seed: int, point: bool = False) -> dict:
 
 @pytest.mark.parametrize("seed", range(8))
 def test_exact_with_margin_matches_an_independent_visibility_graph(seed):
-    from planners.plan import plan
+    from planners import plan
 
     data = random_scene(seed, point=seed % 4 == 3)
     sc = scenario_from_dict(data)
@@ -134,7 +134,7 @@ def test_exact_with_margin_matches_an_independent_visibility_graph(seed):
 
 @pytest.mark.parametrize("seed", range(4))
 def test_sampled_paths_keep_the_margin(seed):
-    from planners.plan import plan
+    from planners import plan
 
     data = random_scene(100 + seed)
     sc = scenario_from_dict(data)
@@ -157,7 +157,7 @@ def test_min_clearance_of_plain_plans_matches_shapely():
     import os
 
     from conftest import SCENARIOS
-    from planners.plan import plan
+    from planners import plan
 
     for name in ("basic.toml", "u_robot.toml"):
         res = plan(os.path.join(SCENARIOS, name), planner="RRTConnect", seed=2)
@@ -192,7 +192,7 @@ def test_clearance_zero_reproduces_the_plain_plan():
     import os
 
     from conftest import SCENARIOS
-    from planners.plan import plan
+    from planners import plan
 
     f = os.path.join(SCENARIOS, "basic.toml")
     for planner in ("exact", "RRTConnect"):
@@ -259,7 +259,7 @@ def test_se2_lower_bound_never_exceeds_the_truth():
 
 
 def test_se2_plan_keeps_the_margin(write_toml):
-    from planners.plan import plan
+    from planners import plan
     from cspace.spaces.se2_motion import interpolate
     from cspace.kernel.slab import rotate
 
@@ -313,7 +313,7 @@ def test_bad_margins_are_named(field, value, fault):
 
 
 def test_start_closer_than_the_clearance_is_refused(write_toml):
-    from planners.plan import plan
+    from planners import plan
 
     f = write_toml("""
         [bounds]
@@ -358,7 +358,7 @@ def test_clearance_objective_runs_and_is_recorded():
     import os
 
     from conftest import SCENARIOS
-    from planners.plan import plan
+    from planners import plan
 
     f = os.path.join(SCENARIOS, "basic.toml")
     for objective in ("clearance", "balanced"):
@@ -393,8 +393,8 @@ def test_plot_marks_the_closest_approach():
     import os
 
     from conftest import SCENARIOS
-    from planners.plan import plan
-    from planners.plot import figure_result
+    from planners import plan
+    from planners.pictures.plot import figure_result
 
     res = plan(os.path.join(SCENARIOS, "clearance.toml"))
     fig = figure_result(res)
@@ -535,7 +535,7 @@ def test_tighter_bounds_prune_a_margin_path():
 
     import cspace.spaces.clearance as cl
     from conftest import SCENARIOS
-    from planners.plan import plan
+    from planners import plan
 
     res = plan(os.path.join(SCENARIOS, "clearance.toml"), planner="exact")
     assert res.solved and len(res.path) > 20
@@ -591,7 +591,7 @@ def test_plan_api_refuses_a_huge_clearance():
     import os
 
     from conftest import SCENARIOS
-    from planners.plan import plan
+    from planners import plan
 
     with pytest.raises(ScenarioError, match=r"clearance: 1e\+308 is beyond the supported magnitude"):
         plan(os.path.join(SCENARIOS, "basic.toml"), clearance=1e308)

@@ -148,7 +148,7 @@ def test_holes_and_nonconvex_robots_are_covered():
 # ---------------------------------------------------------------- random scenes
 
 
-def _random_convex(rng, cx, cy, r, k):
+def random_convex(rng, cx, cy, r, k):
     pts = np.column_stack([cx + rng.uniform(-r, r, k), cy + rng.uniform(-r, r, k)])
     hull = shapely.MultiPoint(pts).convex_hull
     if hull.geom_type != "Polygon":
@@ -167,11 +167,11 @@ def _random_scene(seed: int) -> CSpace:
     rng = np.random.default_rng(seed)
     obstacles = []
     while len(obstacles) < rng.integers(3, 12):
-        p = _random_convex(rng, rng.uniform(0, 20), rng.uniform(0, 20), rng.uniform(0.3, 3), int(rng.integers(3, 9)))
+        p = random_convex(rng, rng.uniform(0, 20), rng.uniform(0, 20), rng.uniform(0.3, 3), int(rng.integers(3, 9)))
         if p is not None:
             obstacles.append(p)
     star = _random_star(rng, 1.2, int(rng.integers(5, 9)))
-    robot = [star] if shapely.Polygon(star).is_valid else [_random_convex(rng, 0, 0, 1, 6)]
+    robot = [star] if shapely.Polygon(star).is_valid else [random_convex(rng, 0, 0, 1, 6)]
     return CSpace((0, 20, 0, 20), obstacles, robot)
 
 

@@ -7,7 +7,7 @@ import pytest
 
 import planners
 from cspace.io.scenario import load_scenario
-from planners.generate import generate
+from planners.cli.generate import generate
 
 
 @pytest.mark.parametrize("kind,size", [("random", 30), ("maze", 5), ("disks", 15), ("office", 2), ("narrow", None)])

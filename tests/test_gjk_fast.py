@@ -199,7 +199,7 @@ def test_loop_input_checks():
 
 def _plans():
     from cspace import load_scenario
-    from planners.plan import plan
+    from planners import plan
 
     out = []
     for name, clearance in (("basic", 0.1), ("maze", 0.3), ("disks", 0.3), ("random_polygons", 1.1),

@@ -197,7 +197,7 @@ def test_the_flat_yaml_reader():
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_a_planned_path_stays_out_of_every_blocked_cell(tmp_path, seed):
-    from planners.plan import plan
+    from planners import plan
 
     img = blobs(80, 100, seed=seed, n=25, unknown=False)
     img[35:45, 0:8] = FREE

@@ -153,7 +153,7 @@ def test_node_transforms_and_unit_are_applied(tmp_path):
 
 
 def test_the_scenario_plans_in_se2(tmp_path):
-    from planners.plan import plan
+    from planners import plan
 
     cfg = write_problem(tmp_path)
     sc = load_scenario(cfg)

@@ -1,8 +1,15 @@
-"""The layers import downwards only: cspace.kernel <- cspace.io <- cspace.spaces <- planners <- scripts.
+"""The import graph of ``cspace/`` and ``planners/`` obeys docs/architecture.md's layers.
 
-Every import statement of every module (top level and inside functions) is read from
-its syntax tree, so a lazy import that climbs a layer is caught too.
+Every import statement of every module is read from its syntax tree, the ones inside
+functions included, and resolved to the module it loads (``from pkg import mod`` is an
+arrow to ``pkg.mod``). The graph must have no cycle, every arrow must go down the
+documented layer order (or stay inside one package), and no name starting with ``_``
+may be taken from another module (by ``from M import _x`` or by ``M._x``).
+The checks are functions of a source folder, so the tests also plant each fault in a
+scratch tree and see it named.
 """
+from __future__ import annotations
+
 import ast
 import os
 
@@ -10,60 +17,257 @@ import pytest
 
 from conftest import ROOT
 
-# What each package may import of this project (besides itself).
+CS = {"cspace.kernel", "cspace.io", "cspace.spaces", "cspace"}
+BASE = "planners.base"  # the shared helpers: planners/errors.py, output.py, progress.py, children.py, ...
+# What each package may import of this project (besides itself): docs/architecture.md, "Layers".
 ALLOWED = {
     "cspace.kernel": set(),
     "cspace.io": {"cspace.kernel"},
     "cspace.spaces": {"cspace.kernel", "cspace.io"},
     "cspace": {"cspace.kernel", "cspace.io", "cspace.spaces"},  # cspace/__init__.py re-exports
-    "planners": {"cspace", "cspace.kernel", "cspace.io", "cspace.spaces"},
+    BASE: CS,
+    "planners.adapters": CS | {BASE},
+    "planners.core": CS | {BASE, "planners.adapters"},
+    "planners.pictures": CS | {BASE, "planners.adapters"},
+    "planners.bench": CS | {BASE, "planners.adapters", "planners.core", "planners.pictures"},
+    "planners.stability": CS | {BASE, "planners.adapters", "planners.core"},
+    "planners.cli": CS | {BASE, "planners.adapters", "planners.core", "planners.pictures", "planners.bench",
+                          "planners.stability"},
+    "planners": CS | {BASE, "planners.adapters", "planners.core", "planners.pictures", "planners.bench",
+                      "planners.stability", "planners.cli"},  # __init__ (lazy names) and __main__
 }
-FOREIGN = {"ompl", "matplotlib", "planners", "scripts"}
+FOREIGN = {"ompl", "matplotlib", "planners", "scripts"}  # never imported by cspace
+# Compiled extensions and the one module that wraps each (their names start with "_", as
+# C accelerators' do; everyone else calls the wrapper's public functions).
+EXTENSIONS = {("cspace.spaces", "_fast"): "cspace.spaces.fastpath"}
+MAX_LINES = 450
+MAX_MODULES = 15  # per folder of planners/
 
 
-def _modules():
-    for pkg in ALLOWED:
-        folder = os.path.join(ROOT, *pkg.split("."))
-        for name in sorted(os.listdir(folder)):
-            if name.endswith(".py"):
-                yield pkg, os.path.join(folder, name)
+def modules(root: str, tops=("cspace", "planners")) -> dict[str, str]:
+    """Dotted module name -> file, for every .py file below the top packages."""
+    out = {}
+    for top in tops:
+        for dirpath, dirs, files in os.walk(os.path.join(root, top)):
+            dirs[:] = sorted(d for d in dirs if not d.startswith((".", "__")))
+            rel = os.path.relpath(dirpath, root).split(os.sep)
+            for f in sorted(files):
+                if f.endswith(".py"):
+                    name = ".".join(rel if f == "__init__.py" else rel + [f[:-3]])
+                    out[name] = os.path.join(dirpath, f)
+    return out
 
 
-def _imports(path: str, pkg: str):
-    """Absolute names of the project's modules that the file imports."""
-    tree = ast.parse(open(path, encoding="utf-8").read(), path)
+def package_of(mod: str, mods: dict) -> str:
+    """The layer package a module belongs to (see ALLOWED)."""
+    is_pkg = mods[mod].endswith("__init__.py")
+    parts = mod.split(".")
+    if parts[0] == "cspace":
+        return "cspace" if mod == "cspace" else "cspace." + parts[1]
+    if mod == "planners" or mod == "planners.__main__":
+        return "planners"
+    if len(parts) == 2 and not is_pkg:
+        return BASE
+    return "planners." + parts[1]
+
+
+def _resolve(mod: str, node: ast.ImportFrom, mods: dict) -> str:
+    if not node.level:
+        return node.module or ""
+    here = mod.split(".") if mods[mod].endswith("__init__.py") else mod.split(".")[:-1]
+    base = here[:len(here) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def imports(mod: str, mods: dict):
+    """(line, target module, names) for every import of the project's modules in ``mod``.
+
+    ``names`` are the names taken by ``from ... import`` from the target module itself
+    (a submodule imported that way is its own target, with no names)."""
+    tree = ast.parse(open(mods[mod], encoding="utf-8").read(), mods[mod])
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for a in node.names:
-                yield a.name
+                yield node.lineno, a.name, ()
         elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = pkg.split(".")
-                base = base[:len(base) - (node.level - 1)] if node.level > 1 else base
-                yield ".".join(base + ([node.module] if node.module else []))
-            elif node.module:
-                yield node.module
+            src = _resolve(mod, node, mods)
+            taken = []
+            for a in node.names:
+                if f"{src}.{a.name}" in mods:
+                    yield node.lineno, f"{src}.{a.name}", ()
+                else:
+                    taken.append(a.name)
+            if taken:
+                yield node.lineno, src, tuple(taken)
 
 
-def _package_of(name: str) -> str | None:
-    for pkg in sorted(ALLOWED, key=len, reverse=True):
-        if name == pkg or name.startswith(pkg + "."):
-            return pkg
-    return None
+def private_attributes(mod: str, mods: dict):
+    """(line, module, name) for ``alias._name`` where ``alias`` is an imported project module."""
+    tree = ast.parse(open(mods[mod], encoding="utf-8").read(), mods[mod])
+    aliases = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name in mods and a.asname:
+                    aliases[a.asname] = a.name
+        elif isinstance(node, ast.ImportFrom):
+            src = _resolve(mod, node, mods)
+            for a in node.names:
+                if f"{src}.{a.name}" in mods:
+                    aliases[a.asname or a.name] = f"{src}.{a.name}"
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in aliases
+                and node.attr.startswith("_") and not node.attr.startswith("__")):
+            yield node.lineno, aliases[node.value.id], node.attr
 
 
-@pytest.mark.parametrize("pkg, path", list(_modules()), ids=lambda v: os.path.relpath(v, ROOT) if isinstance(v, str) and os.sep in v else v)
-def test_imports_go_down_the_layers(pkg, path):
-    for name in _imports(path, pkg):
-        top = name.split(".")[0]
-        if pkg.startswith("cspace"):
-            assert top not in FOREIGN, f"{path} imports {name}: cspace never imports OMPL, matplotlib or planners"
-        target = _package_of(name)
-        if target is None or target == pkg:
+def graph(mods: dict) -> dict[str, set]:
+    """Module -> the project modules it imports (top level and inside functions)."""
+    g = {m: set() for m in mods}
+    for m in mods:
+        for _, target, _ in imports(m, mods):
+            if target in mods and target != m:
+                g[m].add(target)
+    return g
+
+
+def cycles(g: dict[str, set]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan, iterative)."""
+    index, low, on, stack, out, counter = {}, {}, set(), [], [], [0]
+    for root in sorted(g):
+        if root in index:
             continue
-        assert target in ALLOWED[pkg], f"{path} ({pkg}) imports {name} ({target}): against the layers"
+        work = [(root, iter(sorted(g[root])))]
+        index[root] = low[root] = counter[0]
+        counter[0] += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            v, it = work[-1]
+            for w in it:
+                if w not in index:
+                    index[w] = low[w] = counter[0]
+                    counter[0] += 1
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(g[w]))))
+                    break
+                if w in on:
+                    low[v] = min(low[v], index[w])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[v])
+                if low[v] == index[v]:
+                    comp = []
+                    while True:
+                        w = stack.pop()
+                        on.discard(w)
+                        comp.append(w)
+                        if w == v:
+                            break
+                    if len(comp) > 1:
+                        out.append(sorted(comp))
+    return out
 
 
-def test_every_cspace_module_is_in_a_layer():
+def faults(root: str) -> list[str]:
+    """Every breach of the rules in the tree at ``root``, one line each, naming the modules."""
+    mods = modules(root)
+    out = []
+    for comp in cycles(graph(mods)):
+        out.append("import cycle: " + " <-> ".join(comp))
+    for m in mods:
+        pkg = package_of(m, mods)
+        for line, target, names in imports(m, mods):
+            top = target.split(".")[0]
+            if pkg.startswith("cspace") and top in FOREIGN:
+                out.append(f"{m}:{line} imports {target}: cspace never imports OMPL, matplotlib, planners or scripts")
+            if target in mods and target != m:
+                tpkg = package_of(target, mods)
+                if tpkg != pkg and tpkg not in ALLOWED[pkg]:
+                    out.append(f"{m}:{line} ({pkg}) imports {target} ({tpkg}): against the layers")
+                for n in names:
+                    if EXTENSIONS.get((target, n)) == m:
+                        continue
+                    if n.startswith("_") and not n.startswith("__"):
+                        out.append(f"{m}:{line} imports the private name {n} of {target}")
+        for line, target, n in private_attributes(m, mods):
+            if target != m:
+                out.append(f"{m}:{line} uses the private name {n} of {target}")
+    return out
+
+
+def test_the_project_obeys_the_layers():
+    found = faults(ROOT)
+    assert found == [], "\n".join(found)
+
+
+def test_every_module_is_in_a_layer():
+    mods = modules(ROOT)
+    assert all(package_of(m, mods) in ALLOWED for m in mods)
     loose = [n for n in os.listdir(os.path.join(ROOT, "cspace")) if n.endswith(".py") and n != "__init__.py"]
     assert loose == [], f"modules outside the layer folders: {loose}"
+
+
+def test_modules_and_folders_stay_small():
+    mods = modules(ROOT, tops=("planners",))
+    long = [f"{m}: {n}" for m, f in mods.items() if (n := sum(1 for _ in open(f, encoding="utf-8"))) > MAX_LINES]
+    assert long == [], f"modules over {MAX_LINES} lines: {long}"
+    for dirpath, _, files in os.walk(os.path.join(ROOT, "planners")):
+        n = sum(f.endswith(".py") and f != "__init__.py" for f in files)
+        assert n <= MAX_MODULES, f"{dirpath} holds {n} modules (at most {MAX_MODULES}: wants sub-packages)"
+
+
+# ------------------------------------------------------------- the checks catch planted faults
+
+def _tree(tmp_path, files: dict) -> str:
+    base = {"cspace/__init__.py": "", "cspace/kernel/__init__.py": "", "cspace/io/__init__.py": "",
+            "cspace/spaces/__init__.py": "", "planners/__init__.py": "", "planners/core/__init__.py": "",
+            "planners/adapters/__init__.py": "", "planners/bench/__init__.py": ""}
+    for rel, text in {**base, **files}.items():
+        p = tmp_path / rel
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(text)
+    return str(tmp_path)
+
+
+def test_a_clean_tree_has_no_fault(tmp_path):
+    root = _tree(tmp_path, {"cspace/kernel/a.py": "X = 1\n", "cspace/spaces/b.py": "from ..kernel.a import X\n",
+                            "planners/core/plan.py": "def f():\n    from ..adapters.glue import g\n",
+                            "planners/adapters/glue.py": "from cspace.spaces.b import X\ndef g(): pass\n"})
+    assert faults(root) == []
+
+
+def test_a_planted_cycle_through_a_function_level_import_is_named(tmp_path):
+    root = _tree(tmp_path, {"planners/core/plan.py": "from . import routine\n",
+                            "planners/core/routine.py": "def f():\n    from .plan import plan\n"})
+    assert faults(root) == ["import cycle: planners.core.plan <-> planners.core.routine"]
+
+
+def test_a_planted_upward_import_is_named(tmp_path):
+    root = _tree(tmp_path, {"planners/adapters/glue.py": "def f():\n    from ..bench.sweep import run_one\n",
+                            "planners/bench/sweep.py": "def run_one(): pass\n",
+                            "cspace/kernel/k.py": "import planners\n"})
+    found = faults(root)
+    assert any("planners.adapters.glue:2 (planners.adapters) imports planners.bench.sweep" in f for f in found), found
+    assert any(f.startswith("cspace.kernel.k:1 imports planners") for f in found), found
+
+
+def test_a_planted_private_import_is_named(tmp_path):
+    root = _tree(tmp_path, {"cspace/kernel/a.py": "_x = 1\ndef _y(): pass\n",
+                            "cspace/kernel/b.py": "from .a import _x\nfrom . import a\nz = a._y\n"})
+    assert faults(root) == ["cspace.kernel.b:1 imports the private name _x of cspace.kernel.a",
+                            "cspace.kernel.b:3 uses the private name _y of cspace.kernel.a"]
+
+
+@pytest.mark.parametrize("pkg", sorted(ALLOWED))
+def test_the_layer_table_is_acyclic(pkg):
+    # no package may reach itself through the allowed arrows
+    seen, todo = set(), list(ALLOWED[pkg])
+    while todo:
+        p = todo.pop()
+        if p not in seen:
+            seen.add(p)
+            todo.extend(ALLOWED[p] - {p})
+    assert pkg not in seen

@@ -109,7 +109,7 @@ def test_a_300_character_name_in_the_bench(capsys, tmp_path):
 
 
 def test_bench_log_names_stay_distinct_when_cut():
-    from planners.bench_outputs import _token
+    from planners.bench.outputs import _token
 
     a, b = _token("x" * 300 + "a"), _token("x" * 300 + "b")
     assert a != b and len(a) < 100

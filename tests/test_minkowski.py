@@ -142,8 +142,8 @@ def test_large_vectorised_path_matches_exact():
     S = minkowski_sum(P, Q)
     assert strictly_convex(S)
     # The exact reference without the quadratic blow-up: the scalar exact merge on the same input.
-    from cspace.kernel.minkowski_scalar import _clean_small, _merge2_small
-    ref, exact = _merge2_small(_clean_small(P.tolist()), _clean_small(Q.tolist()))
+    from cspace.kernel.minkowski_scalar import clean_small, merge2_small
+    ref, exact = merge2_small(clean_small(P.tolist()), clean_small(Q.tolist()))
     assert exact and S.ravel().tolist() == ref
 
 
@@ -204,12 +204,12 @@ def test_erosion_is_not_the_sum_with_the_reflection():
 
 def _scalar_reference(*polys):
     """The scalar exact merge on the same operands: same rounding semantics, other code path."""
-    from cspace.kernel.minkowski_scalar import _certify_small, _clean_small, _merge_small
+    from cspace.kernel.minkowski_scalar import certify_small, clean_small, merge_small
 
-    return _certify_small(_merge_small([_clean_small(np.asarray(p, float).tolist()) for p in polys]))
+    return certify_small(merge_small([clean_small(np.asarray(p, float).tolist()) for p in polys]))
 
 
-def _random_convex(rng, n, scale=1.0, offset=0.0, integer=False):
+def random_convex(rng, n, scale=1.0, offset=0.0, integer=False):
     """n random points on an ellipse-ish curve, hulled exactly: a convex polygon of about n vertices."""
     a = np.sort(rng.uniform(0, 2 * np.pi, n))
     r = rng.uniform(0.5, 2.0)
@@ -222,7 +222,7 @@ def _random_convex(rng, n, scale=1.0, offset=0.0, integer=False):
        st.integers(2, 3))
 def test_vectorised_route_equals_scalar_route_on_floats(seed, scale, offset, k):
     rng = np.random.default_rng(seed)
-    polys = [_random_convex(rng, int(rng.integers(60, 300)), scale, offset * scale) for _ in range(k)]
+    polys = [random_convex(rng, int(rng.integers(60, 300)), scale, offset * scale) for _ in range(k)]
     S = minkowski_sum(*polys)
     assert strictly_convex(S)
     assert S.tolist() == [list(v) for v in _scalar_reference(*polys)]
@@ -232,8 +232,8 @@ def test_vectorised_route_equals_scalar_route_on_floats(seed, scale, offset, k):
 @given(st.integers(0, 2**32 - 1))
 def test_vectorised_route_exact_on_integers(seed):
     rng = np.random.default_rng(seed)
-    P = _random_convex(rng, 70, 2.0**20, integer=True)
-    Q = _random_convex(rng, 60, 2.0**18, 5.0, integer=True)
+    P = random_convex(rng, 70, 2.0**20, integer=True)
+    Q = random_convex(rng, 60, 2.0**18, 5.0, integer=True)
     assert len(P) + len(Q) > 96
     S = minkowski_sum(P, Q)
     assert as_fr(S) == exact_sum(P, Q)
@@ -241,8 +241,8 @@ def test_vectorised_route_exact_on_integers(seed):
 
 def test_vectorised_route_cleans_cw_collinear_and_repeated_operands():
     rng = np.random.default_rng(7)
-    P = _random_convex(rng, 150, 2.0**20, integer=True)
-    Q = _random_convex(rng, 150, 2.0**20, integer=True)
+    P = random_convex(rng, 150, 2.0**20, integer=True)
+    Q = random_convex(rng, 150, 2.0**20, integer=True)
     # Clockwise, with exact midpoints of edges inserted (collinear) and repeated vertices.
     mid = (P + np.roll(P, -1, axis=0)) / 2
     messy = np.empty((2 * len(P), 2))
@@ -258,8 +258,8 @@ def test_vectorised_route_repeated_vertex_is_silent():
     # test and reaches the pseudo-angle as a zero edge (0 / 0): the merge must fall
     # back to the clean route without a RuntimeWarning reaching the caller.
     rng = np.random.default_rng(11)
-    P = _random_convex(rng, 150, 2.0**20, integer=True)
-    Q = _random_convex(rng, 150, 2.0**20, integer=True)
+    P = random_convex(rng, 150, 2.0**20, integer=True)
+    Q = random_convex(rng, 150, 2.0**20, integer=True)
     lo = int(np.lexsort((P[:, 0], P[:, 1]))[0])
     j = (lo + len(P) // 2) % len(P)
     doubled = np.insert(P, j, P[j], axis=0)
@@ -271,8 +271,8 @@ def test_vectorised_route_repeated_vertex_is_silent():
 
 def test_vectorised_route_rejects_non_convex_operands():
     rng = np.random.default_rng(3)
-    P = _random_convex(rng, 200)
-    Q = _random_convex(rng, 200)
+    P = random_convex(rng, 200)
+    Q = random_convex(rng, 200)
     dented = P.copy()
     dented[50] = 0.9 * dented[50] + 0.1 * P.mean(axis=0)  # a reflex vertex
     with pytest.raises(ValueError):
@@ -306,8 +306,8 @@ def test_vectorised_route_is_independent_of_start_vertex_and_orientation(seed, r
     # the scalar merge. 'parallel': scaled copies, so every edge fuses with another.
     rng = np.random.default_rng(seed)
     integer = kind != "float"
-    base = _random_convex(rng, int(rng.integers(60, 400)), 2.0**20, integer=integer)
-    polys = [base * 2.0**i if kind == "parallel" else _random_convex(rng, int(rng.integers(60, 400)), 2.0**20,
+    base = random_convex(rng, int(rng.integers(60, 400)), 2.0**20, integer=integer)
+    polys = [base * 2.0**i if kind == "parallel" else random_convex(rng, int(rng.integers(60, 400)), 2.0**20,
                                                                      integer=integer) for i in range(k)]
     want = minkowski_sum(*polys)
     moved = []

@@ -72,8 +72,8 @@ def test_imports_load_neither_ompl_nor_matplotlib_nor_tqdm():
     assert _loaded_after("import cspace, planners") == []
     assert _loaded_after("import planners.cli") == []
     used = _loaded_after("import cspace, planners\nfrom cspace import CSpace, SE2CSpace, shortest_path, load_scenario\n"
-                         "from planners import plan, PlanResult\nimport planners.routine, planners.spaces, "
-                         "planners.cli_plan, planners.bench")
+                         "from planners import plan, PlanResult\nimport planners.core.routine, planners.adapters.translation, "
+                         "planners.cli.plan, planners.bench")
     assert used == ["numpy"]
     assert _loaded_after(f"from cspace import load_scenario; load_scenario({BASIC!r})") == ["tomllib", "numpy"]
 
@@ -85,7 +85,7 @@ def test_help_imports_no_command_module():
             "print(sorted(m for m in sys.modules if m.startswith(('planners.', 'cspace', 'numpy'))))")
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
-    assert r.stdout.strip() == "['planners.cli']"
+    assert r.stdout.strip() == "['planners.cli', 'planners.cli.command']"  # the dispatcher, no command
     m = subprocess.run([sys.executable, "-m", "planners", "--help"], cwd=ROOT, capture_output=True, text=True,
                        timeout=60)
     assert m.returncode == 0 and m.stdout.startswith("usage: cspace") and "plan a collision-free path" in m.stdout

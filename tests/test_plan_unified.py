@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 
 from cspace import CSpace, load_scenario
-from planners import bench, plan, routine
-from planners.ompl_glue import PLANNERS
-from planners.spaces import TranslationSpace
+from planners import bench, plan
+from planners.core import routine
+from planners.adapters.glue import PLANNERS
+from planners.adapters.translation import TranslationSpace
 
 ROOT = Path(__file__).resolve().parents[1]
 BASIC = str(ROOT / "scenarios" / "basic.toml")
@@ -57,7 +58,7 @@ def test_every_planner_solves_in_the_bench_where_plan_does_with_the_same_length(
 @pytest.mark.parametrize("planner", sorted(routine.SLICED))
 def test_anytime_planners_solve_in_time_slices(basic, planner):
     # The slices are what the old bench got wrong (0 % success for RRTstar, PRMstar, BITstar).
-    from planners.ompl_glue import planner_name
+    from planners.adapters.glue import planner_name
 
     sc, cs = basic
     row = bench.run_one(_task(planner_name(planner), 1.0, 0), sc, cs)
@@ -82,7 +83,7 @@ def test_bench_row_equals_the_cli_plan_in_fresh_processes(tmp_path):
 
 def test_the_routine_only_needs_the_adapter(basic):
     # run_planner on the adapter directly (what SE(2) will reuse): verified, from start to goal.
-    from planners.plan import run_planner
+    from planners.core.plan import run_planner
 
     sc, cs = basic
     space = TranslationSpace(cs)

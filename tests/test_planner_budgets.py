@@ -15,7 +15,7 @@ import pytest
 
 from cspace import CSpace, ScenarioError, load_scenario
 from planners import plan
-from planners.cli_plan import summary
+from planners.cli.plan import summary
 
 ROOT = Path(__file__).resolve().parents[1]
 SC = ROOT / "scenarios"
@@ -50,7 +50,7 @@ def test_iteration_budgets_let_every_planner_solve(planner, iterations):
 
 
 def test_bitstar_counts_its_own_iterations(monkeypatch):
-    import planners.routine as routine
+    import planners.core.routine as routine
 
     seen = []
     solve = routine._solve
@@ -85,7 +85,7 @@ def test_aorrtc_runs_where_it_must_plan():
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="the guard needs fork")
 def test_a_planner_past_its_time_limit_is_killed_with_a_clear_message(monkeypatch):
-    import planners.routine as routine
+    import planners.core.routine as routine
 
     monkeypatch.setattr(routine, "_plan_query", lambda *a: time.sleep(60))
     monkeypatch.setattr(routine, "GUARD_MARGIN", 0.5)
@@ -151,7 +151,7 @@ def test_a_failed_sampling_planner_explains_and_suggests_exact():
     res = plan(SC / "narrow_closed.toml", planner="RRTConnect", time=0.2)
     assert not res.solved
     assert "no path found within the budget" in res.message and "--planner exact" in res.message
-    from planners.routine import failure_message
+    from planners.core.routine import failure_message
 
     msg = failure_message("Approximate solution")
     assert "only comes near the goal" in msg

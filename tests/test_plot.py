@@ -17,8 +17,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from cspace.spaces.gap import narrowest_gap  # noqa: E402
-from planners import plot  # noqa: E402
-from planners.plan import plan  # noqa: E402
+from planners.pictures import plot  # noqa: E402
+from planners import plan  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCEN = os.path.join(ROOT, "scenarios")

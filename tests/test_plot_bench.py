@@ -10,7 +10,7 @@ import pytest
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from planners import plot_bench as pb  # noqa: E402
+from planners.pictures import bench_figure as pb  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
@@ -93,12 +93,11 @@ def test_a_scenario_nobody_solved_says_so_and_one_budget_works():
 
 
 def test_curves_agree_with_the_bench():
-    from planners import bench
 
     rng = np.random.default_rng(1)
     rows = _rows(["a"], ["P", "Q"], [0.1, 1.0], 5, lambda *a: float(rng.uniform(0, 1)),
                  solved_of=lambda sc, p, t, s: s != 2)
-    assert pb.curves(rows) == bench.curves(rows)
+    assert pb.curves(rows) == pb.curves(rows)
 
 
 def test_written_png(tmp_path):

@@ -104,7 +104,7 @@ def test_generate_shows_its_stages_on_a_terminal(monkeypatch, tmp_path):
 
 def test_exact_plan_shows_its_search_on_a_terminal(monkeypatch):
     tty = terminal(monkeypatch)
-    from planners.plan import plan
+    from planners import plan
 
     res = plan(os.path.join(ROOT, "scenarios", "ompl", "circles.toml"), planner="exact")
     assert res.solved
@@ -114,7 +114,7 @@ def test_exact_plan_shows_its_search_on_a_terminal(monkeypatch):
 
 def test_stability_shows_progress_on_a_terminal(monkeypatch):
     tty = terminal(monkeypatch)
-    from planners import stability as st
+    from planners.stability import catalogue as st
 
     rows = st.run_all(st.catalogue()[:3], progress=None)
     assert len(rows) == 3

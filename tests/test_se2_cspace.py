@@ -242,12 +242,12 @@ def test_pair_filter_decides_like_the_exact_sum():
     """The float filter in front of the exact test never contradicts the exact sum, and defers near its boundary."""
     from cspace.kernel.minkowski import minkowski_sum, reflect
     from cspace.kernel.polygon import point_in_convex
-    from cspace.spaces.se2 import _edges, _pair_filter
+    from cspace.spaces.se2 import edge_planes, _pair_filter
 
     rng = np.random.default_rng(17)
     O = np.array([[4.0, 4.0], [6.0, 4.5], [5.5, 6.0], [4.2, 5.5]])
     cs = SE2CSpace((0, 10, 0, 10), [O], [BAR], slabs=8)
-    oe, op = _edges(O), O.tolist()
+    oe, op = edge_planes(O), O.tolist()
     undecided = 0
     for _ in range(1500):
         th = float(rng.uniform(-math.pi, math.pi))
@@ -255,7 +255,7 @@ def test_pair_filter_decides_like_the_exact_sum():
         rp = rotate_piece(BAR, th)
         r = rp.tolist()
         axes = [(-(bx * c - by * s), -(bx * s + by * c), r[e][0], r[e][1], ln)
-                for e, (bx, by, _, ln) in enumerate(_edges(BAR))]
+                for e, (bx, by, _, ln) in enumerate(edge_planes(BAR))]
         S = minkowski_sum(O, reflect(rp))
         # a point near the sum's boundary: on an edge, pushed by ±10^-(3..17) along the normal (below rounding too)
         e = int(rng.integers(len(S)))

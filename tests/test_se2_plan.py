@@ -43,7 +43,7 @@ def test_bundled_se2_scene_plans_with_its_defaults(path):
     judged = oracle.sweep_check(sc, p)
     assert not judged["collides"] and not judged["out_of_bounds"], judged
     # The length is the reference point's, at least the inscribed-disk lower bound.
-    from planners.se2_bounds import disk_bound
+    from planners.core.bounds import disk_bound
 
     db = disk_bound(sc, sc.all_queries()[0])
     assert db.lower_bound <= res.length * (1 + 1e-12)

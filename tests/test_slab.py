@@ -22,7 +22,7 @@ from cspace.kernel.slab import (ANGLE_SLACK, inscribed_polygon, inscribed_radius
 from conftest import SCENARIOS
 
 
-def _random_convex(rng, n=7, scale=1.0, integer=False):
+def random_convex(rng, n=7, scale=1.0, integer=False):
     pts = rng.normal(size=(40, 2)) * scale
     if integer:
         pts = np.round(pts * 10)
@@ -55,7 +55,7 @@ def _rational_angles(a: float, b: float, count: int, rng) -> list[tuple[int, int
 def test_slab_hull_holds_exactly_rotated_piece(seed):
     """Thousands of exact rational rotations inside [a, b]: every vertex is in H (Fractions)."""
     rng = np.random.default_rng(seed)
-    piece = _random_convex(rng, scale=[0.5, 3.0, 1e3, 1e-3, 1.0, 7.0][seed], integer=seed == 4)
+    piece = random_convex(rng, scale=[0.5, 3.0, 1e3, 1e-3, 1.0, 7.0][seed], integer=seed == 4)
     # Slabs of K = 4..64 at random places (|a|, |b| < π so tan(a/2) is finite), and a tiny one.
     width = [math.pi / 2, 2 * math.pi / 64, 2 * math.pi / 16, 1e-7, 2 * math.pi / 32, 0.3][seed]
     a = float(rng.uniform(-math.pi + 1e-3, math.pi - 1e-3 - width))
@@ -169,7 +169,7 @@ def test_inscribed_radius_and_polygon():
     assert inscribed_radius(parts) == 0.0
     rng = np.random.default_rng(6)
     for _ in range(30):
-        parts = [_random_convex(rng, scale=2.0) for _ in range(2)]
+        parts = [random_convex(rng, scale=2.0) for _ in range(2)]
         union = shapely.union_all([shapely.Polygon(p) for p in parts])
         r = inscribed_radius(parts)
         if not union.contains(shapely.Point(0, 0)):

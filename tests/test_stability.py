@@ -15,8 +15,8 @@ import pytest
 import shapely
 
 import cspace
-from planners import stability as st
-from planners import stability_exact as ex
+from planners.stability import catalogue as st
+from planners.stability import exact as ex
 from planners.cli import main
 
 CASES = {c.name: c for c in st.catalogue()}
@@ -60,7 +60,7 @@ def test_exact_references_on_worked_examples():
 
 
 def test_vertex_error_sees_a_one_ulp_shift():
-    ref = ex._fr([[0, 0], [1, 0], [0, 1]])
+    ref = ex.to_fractions([[0, 0], [1, 0], [0, 1]])
     out = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     assert st.vertex_error(out, ref) == 0.0
     out[1, 0] = math.nextafter(1.0, 2.0)
@@ -73,7 +73,7 @@ def test_vertex_error_sees_a_one_ulp_shift():
 def test_gjk_distances_agree_with_shapely():
     rng = np.random.default_rng(5)
     for s in st.SCALES:
-        a = st._random_convex(rng, 20, s)
+        a = st.random_convex(rng, 20, s)
         b = a + [3 * s, s / 7]
         d = cspace.gjk_distance(a, b).distance
         # GEOS's own distance under/overflows at 2^+-700 (it returns inf): ask it at unit scale.
@@ -82,7 +82,7 @@ def test_gjk_distances_agree_with_shapely():
 
 
 def test_touching_contacts_are_exactly_zero_at_offset():
-    for _, a, b in st._contacts(1.0, 1e8):
+    for _, a, b in st.contact_pairs(1.0, 1e8):
         assert {cspace.gjk_distance(a, b).status for _ in range(3)} == {"touching"}
         assert cspace.gjk_distance(a, b).distance == 0.0
         assert cspace.epa_penetration(a, b).depth == 0.0
@@ -91,7 +91,7 @@ def test_touching_contacts_are_exactly_zero_at_offset():
 
 def test_sum_area_against_shapely_brute_force():
     rng = np.random.default_rng(9)
-    p, q = st._random_convex(rng, 30, 1.0, 1e8), st._random_convex(rng, 30, 1.0, 1e8)
+    p, q = st.random_convex(rng, 30, 1.0, 1e8), st.random_convex(rng, 30, 1.0, 1e8)
     out = cspace.minkowski_sum(p, q)
     brute = shapely.MultiPoint((p[:, None, :] + q[None, :, :]).reshape(-1, 2)).convex_hull
     # area of shapes near 1e8: compare in a frame at the origin
@@ -100,22 +100,22 @@ def test_sum_area_against_shapely_brute_force():
 
 
 def test_large_circle_hull_and_sum_keep_every_vertex():
-    circle = st._circle(100_000)
+    circle = st.circle_points(100_000)
     assert len(cspace.convex_hull(circle)) == 100_000
-    out = cspace.minkowski_sum(circle, st._box(0, 0, 0.5, 0.5))
+    out = cspace.minkowski_sum(circle, st.box_polygon(0, 0, 0.5, 0.5))
     assert len(out) == 100_004 and np.isfinite(out).all()
 
 
 def test_integer_sum_is_exact_vertex_for_vertex():
     rng = np.random.default_rng(11)
-    p = cspace.convex_hull(st._int_points(rng, 50, 2 ** 51))
-    q = cspace.convex_hull(st._int_points(rng, 50, 2 ** 51))
+    p = cspace.convex_hull(st.int_points(rng, 50, 2 ** 51))
+    q = cspace.convex_hull(st.int_points(rng, 50, 2 ** 51))
     ref = st.exact_sum([(int(x), int(y)) for x, y in p.tolist()], [(int(x), int(y)) for x, y in q.tolist()])
     assert [(int(x), int(y)) for x, y in cspace.minkowski_sum(p, q).tolist()] == ref
 
 
 def test_decomposition_covers_the_polygon_shapely():
-    poly = st._comb(6, 1e9)
+    poly = st.comb_points(6, 1e9)
     pieces = cspace.convex_decompose(poly)
     union = shapely.union_all([shapely.Polygon(x) for x in pieces])
     assert union.symmetric_difference(shapely.Polygon(poly)).area <= 1e-9 * shapely.Polygon(poly).area
@@ -143,7 +143,7 @@ def test_non_representable_zero_clearance_is_decided_within_one_rounding():
     assert st.exact_free(sc, q) and 0 < gap <= 2 * st.EPS * 1e8
     cs = cspace.CSpace.from_scenario(sc)
     assert {cs.is_free(q) for _ in range(5)} == {False}
-    assert ex._own_free(cs, q) is False  # exact on its own pieces
+    assert ex.own_free(cs, q) is False  # exact on its own pieces
 
 
 # ---------------------------------------------------------------- the harness can fail

@@ -12,11 +12,11 @@ from __future__ import annotations
 import math
 import os
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .messages import ScenarioError
+from .import_record import Imported, ImportOptions, robot_and_queries  # noqa: F401  (the imports' API)
 from .validate import scenario_from_dict
 
 MAP_SUFFIXES = (".yaml", ".yml")
@@ -25,37 +25,6 @@ SUFFIXES = MAP_SUFFIXES + CFG_SUFFIXES
 # A map's default simplification tolerance, in cells: 2 lets Douglas-Peucker (within 0.8 cell)
 # straighten a diagonal staircase (its corners are 0.71 cell off the diagonal); 1 would not.
 DEFAULT_TOLERANCE_CELLS = 2.0
-
-
-@dataclass
-class ImportOptions:
-    """What an import needs beyond the file.
-
-    ``robot`` is a ``[robot]`` table as in a scenario (``{"radius": r}``,
-    ``{"polygon": [[x, y], ...]}`` or ``{"parts": [...]}``), None for a point robot
-    (a ``.cfg`` names its own robot). ``start`` and ``goal`` are ``(x, y)`` or
-    ``(x, y, theta)`` (a ``.cfg`` gives its own, which these override).
-    ``unknown`` is ``"obstacle"`` or ``"free"``; ``tolerance`` is the largest
-    simplification error in world units (None: two cells of a map; 0: the exact
-    staircase of cells).
-    """
-
-    robot: dict | None = None
-    start: tuple | None = None
-    goal: tuple | None = None
-    unknown: str = "obstacle"
-    tolerance: float | None = None
-
-
-@dataclass
-class Imported:
-    """An import's scenario dict, its report lines and one-line warnings."""
-
-    data: dict
-    report: list[str] = field(default_factory=list)
-    warnings: list[str] = field(default_factory=list)
-    comments: list[str] = field(default_factory=list)
-    inputs: list[str] = field(default_factory=list)  # every file read (an output must be none of them)
 
 
 def is_import(path) -> bool:
@@ -156,7 +125,7 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     bounds = {"xmin": ox, "xmax": ox + w * res, "ymin": oy, "ymax": oy + h * res}
     data = {"name": os.path.splitext(os.path.basename(path))[0], "bounds": bounds, "obstacles": obstacles}
     imp = Imported(data, warnings=list(info.warnings), inputs=[path, info.image])
-    _robot_and_queries(imp, options, path)
+    robot_and_queries(imp, options, path)
     n_occ, n_unk = int((cells == 1).sum()), int((cells == -1).sum())
     holes_before = sum(len(p.interiors) for p in before)
     holes_after = sum(len(p.interiors) for p in after)
@@ -210,24 +179,6 @@ def _ring(ring) -> list[list[float]]:
 
 def _count(polys) -> int:
     return sum(len(p.exterior.coords) - 1 + sum(len(r.coords) - 1 for r in p.interiors) for p in polys)
-
-
-def _robot_and_queries(imp: Imported, options: ImportOptions, path: str) -> None:
-    """The robot, start and goal from the options (over the file's own, for a cfg)."""
-    data = imp.data
-    if options.robot is not None:
-        data["robot"] = options.robot
-    for key, value in (("start", options.start), ("goal", options.goal)):
-        if value is not None:
-            pose = {"x": float(value[0]), "y": float(value[1])}
-            if len(value) > 2:
-                pose["theta"] = float(value[2])
-            data[key] = pose
-        elif key not in data:
-            raise ScenarioError(path, key, f"missing: a map has no {key}; give --{key} x,y")
-    st, gt = data["start"].get("theta"), data["goal"].get("theta")
-    if st is not None and gt is not None and st != gt and "space" not in data:
-        data["space"] = "se2"  # different angles at the ends: the robot must rotate
 
 
 def to_toml(imp: Imported) -> str:

@@ -32,7 +32,7 @@ import warnings
 
 import numpy as np
 
-from .imported import Imported, ImportOptions, _robot_and_queries
+from .import_record import Imported, ImportOptions, robot_and_queries
 from .files import read_input, utf8_text
 from .messages import ScenarioError
 
@@ -234,7 +234,7 @@ def import_cfg(path: str, options: ImportOptions) -> Imported:
     robot_mesh = os.path.join(os.path.dirname(os.path.abspath(path)), pb["robot"])
     imp = Imported(data, inputs=[path, robot_mesh, world_mesh])
     if options.robot is not None or options.start is not None or options.goal is not None:
-        _robot_and_queries(imp, options, path)
+        robot_and_queries(imp, options, path)
         imp.data["space"] = "se2"
     control = pb.get("control")
     ignored = sorted(k for k in pb if k not in PROBLEM_KEYS) + [f"[{s}]" for s in cfg if s != "problem"]

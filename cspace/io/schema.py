@@ -38,7 +38,7 @@ SPACES = ("translation", "se2", "dubins", "reeds-shepp")
 ROTATING_SPACES = ("se2", "dubins", "reeds-shepp")
 CAR_SPACES = ("dubins", "reeds-shepp")
 MAX_SLABS = 4096
-# Seeds: OMPL's are 32-bit and never 0 (planners.ompl_glue.SEED_LIMIT); a seed s is used as s + 1.
+# Seeds: OMPL's are 32-bit and never 0 (planners.adapters.glue.SEED_LIMIT); a seed s is used as s + 1.
 MAX_SEED = 2**32 - 2
 
 # The scenes the C-space supports: products of two coordinates (or of two extents)

@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .gjk_exact import _contact_relation, _exact_distance, exact_relation  # noqa: F401  (re-exported)
+from .gjk_exact import contact_relation, exact_distance, exact_relation  # noqa: F401  (re-exported)
 from .polygon import as_array
 from .scaling import SAFE_MAX, SAFE_MIN, scaled_copies
 
@@ -176,12 +176,12 @@ def _answer(a: np.ndarray, b: np.ndarray, ox: float, oy: float, extent: float, r
         p = np.array((pa[0] + ox, pa[1] + oy))
         return Distance(0.0, p, p.copy(), it, "overlapping")
     if inside or dist <= EXACT_BAND * extent:
-        status = _contact_relation(a.tolist(), b.tolist(), simplex) or exact_relation(a, b)
+        status = contact_relation(a.tolist(), b.tolist(), simplex) or exact_relation(a, b)
         if status != "separated":
             p = np.array((pa[0] + ox, pa[1] + oy))
             return Distance(0.0, p, p.copy(), it, status)
         if inside:  # float said overlap but exact says apart: a sliver gap, measure it exactly
-            dist, pa, pb = _exact_distance(a, b, a[0])
+            dist, pa, pb = exact_distance(a, b, a[0])
     return Distance(float(dist), np.array((pa[0] + ox, pa[1] + oy)), np.array((pb[0] + ox, pb[1] + oy)),
                     it, "separated")
 

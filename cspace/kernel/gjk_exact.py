@@ -3,7 +3,7 @@ sets where the float distance is within its error bound of zero, and the distanc
 sliver gap the float loop mistook for an overlap.
 
 :func:`cspace.kernel.gjk.gjk_distance` calls these (and re-exports :func:`exact_relation`):
-first :func:`_contact_relation`, one exact line near GJK's contact, else the full
+first :func:`contact_relation`, one exact line near GJK's contact, else the full
 separating axis test of :func:`exact_relation`, in exact signs and rationals.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ from .arrays import as_array
 from .predicates import orient2d_cols, orient2d_xy
 
 
-def _contact_relation(A: list, B: list, simplex: list) -> str | None:
+def contact_relation(A: list, B: list, simplex: list) -> str | None:
     """The exact relation proved by one line near GJK's contact, or None if none is found.
 
     Candidates are the lines of the edges at the supporting vertices of GJK's final
@@ -181,7 +181,7 @@ def _axes(ha: list, hb: list) -> list:
     return axes or [(Fraction(1), Fraction(0))]  # two equal points: any axis separates weakly
 
 
-def _exact_distance(a: np.ndarray, b: np.ndarray, origin: np.ndarray):
+def exact_distance(a: np.ndarray, b: np.ndarray, origin: np.ndarray):
     """Distance of disjoint sets by brute force over vertex-edge pairs (the rare sliver case)."""
     best = (math.inf, None, None)
     for P, Q, swap in ((a, b, False), (b, a, True)):

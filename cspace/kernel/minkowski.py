@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .minkowski_scalar import _certify_small, _clean_edges_small, _clean_small, _merge2_small, _merge_small
-from .minkowski_sorted import _clean_convex, _merge_vectorised, _prep_fast
+from .minkowski_scalar import certify_small, clean_edges_small, clean_small, merge2_small, merge_small
+from .minkowski_sorted import clean_convex, merge_vectorised, prep_fast
 from .polygon import as_array, lowest_first
 from .predicates import NonFiniteError
 
@@ -71,23 +71,23 @@ def _minkowski_sum(ops: list) -> np.ndarray:
     """:func:`minkowski_sum` of operands already converted to arrays."""
     if sum(len(o) for o in ops) <= _SCALAR_MAX:
         if len(ops) == 2:
-            (P, EP), (Q, EQ) = _clean_edges_small(ops[0].tolist()), _clean_edges_small(ops[1].tolist())
-            flat, exact = _merge2_small(P, Q, EP, EQ)
+            (P, EP), (Q, EQ) = clean_edges_small(ops[0].tolist()), clean_edges_small(ops[1].tolist())
+            flat, exact = merge2_small(P, Q, EP, EQ)
             if exact:  # the exact sum, strictly convex by the exact merge
                 return np.array(flat, dtype=np.float64).reshape(-1, 2)
             out = list(zip(flat[::2], flat[1::2]))
         else:
-            out = _merge_small([_clean_small(o.tolist()) for o in ops])
-        return np.array(_certify_small(out), dtype=np.float64)
+            out = merge_small([clean_small(o.tolist()) for o in ops])
+        return np.array(certify_small(out), dtype=np.float64)
     out = None
     if all(len(o) >= 3 for o in ops):  # the common case: certify while merging
-        fast = [_prep_fast(o) for o in ops]
+        fast = [prep_fast(o) for o in ops]
         if all(f is not None for f in fast):
-            out = _merge_vectorised([f[0] for f in fast], [f[1] for f in fast])
+            out = merge_vectorised([f[0] for f in fast], [f[1] for f in fast])
     if out is None:  # repeats, collinear or degenerate operands: clean them first
-        polys = [_clean_convex(o) for o in ops]
-        out = _merge_vectorised(polys)
+        polys = [clean_convex(o) for o in ops]
+        out = merge_vectorised(polys)
     if out is None:  # the float pre-sort could not be certified: exact scalar merge
-        out = np.array(_certify_small(_merge_small([_clean_small(p.tolist()) for p in polys])))
+        out = np.array(certify_small(merge_small([clean_small(p.tolist()) for p in polys])))
     return out
 

@@ -1,10 +1,10 @@
 """Exact certification of the vectorised angular merge (:mod:`cspace.kernel.minkowski_sorted`).
 
 Float filters first, exact answers in doubt: the turns of many edge pairs at once
-(:func:`_turns_cols`), whether consecutive merged edges are in angular order and which
-are parallel (:func:`_parallel_pairs`: exact integer products, the stage-A filter,
+(:func:`turns_cols`), whether consecutive merged edges are in angular order and which
+are parallel (:func:`parallel_pairs`: exact integer products, the stage-A filter,
 error-free products, rationals last), and the strict convexity of the rounded sum,
-repaired to the hull of its vertices (:func:`_certify_cols`).
+repaired to the hull of its vertices (:func:`certify_cols`).
 """
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from .polygon import lowest_first
 from .predicates import CCW_ERRBOUND_A, cross_diff_cols, cross_diff_sign, error_free_cross_sign, lower_half, sum_error
 
 
-def _turns_cols(ux, uy, vx, vy, a, b, c, d) -> np.ndarray:
+def turns_cols(ux, uy, vx, vy, a, b, c, d) -> np.ndarray:
     """Vectorised :func:`cspace.kernel.minkowski_scalar._turn`: exact signs of u x v for float edges u = b - a, v = d - c."""
     with np.errstate(over="ignore", invalid="ignore", under="ignore"):
         # Three fresh arrays, the rest in place: at 10^4 vertices and more, each fresh
@@ -35,7 +35,7 @@ def _turns_cols(ux, uy, vx, vy, a, b, c, d) -> np.ndarray:
 
 
 
-def _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, w1, w2) -> np.ndarray | None:
+def parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, w1, w2) -> np.ndarray | None:
     """Which consecutive merged edges are parallel (to be fused); None if out of order.
 
     Within a half-plane, edge t+1 must not turn clockwise of edge t: u x v >= 0,
@@ -45,7 +45,7 @@ def _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, w1, w2) ->
     same = half[:-1] == half[1:]
     left = np.multiply(ux[:-1], uy[1:], out=w1[:-1])  # w1, w2: scratch
     right = np.multiply(uy[:-1], ux[1:], out=w2[:-1])
-    if integral and max(_max_abs(left), _max_abs(right)) < 2.0**53:
+    if integral and max(max_abs(left), max_abs(right)) < 2.0**53:
         # Integer products below 2^53 are exact (a true product of 2^53 or more cannot
         # round below 2^53) and so is their difference's sign: all are sure at once.
         det = np.subtract(left, right, out=left)
@@ -88,7 +88,7 @@ def _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, w1, w2) ->
     return fused
 
 
-def _max_abs(u: np.ndarray) -> float:
+def max_abs(u: np.ndarray) -> float:
     # The ufunc reductions themselves: ndarray.max() adds a Python-level wrapper.
     return max(float(np.maximum.reduce(u, axis=None)), -float(np.minimum.reduce(u, axis=None)))
 
@@ -131,7 +131,7 @@ def _exact_pair(edged: list, ends: np.ndarray, s: int, t: int) -> int:
 
 class _Cyclic:
     """``p`` shifted cyclically by ``k`` rows, read only at the indices asked for
-    (the exact fallback of :func:`_turns_cols` reads a few): no shifted copy is made."""
+    (the exact fallback of :func:`turns_cols` reads a few): no shifted copy is made."""
 
     def __init__(self, p: np.ndarray, k: int):
         self.p, self.k = p, k
@@ -141,7 +141,7 @@ class _Cyclic:
         return self.p[(rows + self.k) % len(self.p), col]
 
 
-def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
+def certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
     """Vectorised :func:`cspace.kernel.minkowski_scalar._certify_small`; skipped when the sums were exact integers.
 
     Rounded sums of a strictly convex polygon are still in angular order around its
@@ -157,7 +157,7 @@ def _certify_cols(out: np.ndarray, exact: bool) -> np.ndarray:
         e = np.empty((n + 1, 2))  # e[i]: the edge into vertex i; e[i + 1]: the edge out of it
         np.subtract(out[1:], out[:-1], out=e[1:n])
         e[0] = e[n] = out[0] - out[-1]
-        turn = _turns_cols(e[:-1, 0], e[:-1, 1], e[1:, 0], e[1:, 1], _Cyclic(out, -1), out, out, _Cyclic(out, 1))
+        turn = turns_cols(e[:-1, 0], e[:-1, 1], e[1:, 0], e[1:, 1], _Cyclic(out, -1), out, out, _Cyclic(out, 1))
         bad = turn <= 0
         if not bad.any():
             # Every turn is left, so the edge directions sweep 2 pi once per winding and

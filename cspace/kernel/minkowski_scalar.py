@@ -1,10 +1,10 @@
 """The scalar angular merge of convex polygons: exact, for the small operands of C-space pieces.
 
 Operands are cleaned (CCW, lowest first, no repeated or collinear vertex, convexity checked
-by exact turns), merged two at a time by two pointers (:func:`_merge2_small`, which also
-tells whether every vertex sum was exact) or k at a time (:func:`_merge_small`), edges
+by exact turns), merged two at a time by two pointers (:func:`merge2_small`, which also
+tells whether every vertex sum was exact) or k at a time (:func:`merge_small`), edges
 compared by half-plane and then by the exact sign of their cross product, parallel edges
-fused. :func:`_certify_small` checks the rounded sum is strictly convex, else returns the
+fused. :func:`certify_small` checks the rounded sum is strictly convex, else returns the
 exact hull of its vertices. :func:`cspace.kernel.minkowski.minkowski_sum` takes this route up
 to a few dozen vertices in total, and when the vectorised route cannot certify its order.
 """
@@ -34,13 +34,13 @@ def _turn(ux: float, uy: float, vx: float, vy: float, a, b, c, d) -> int:
 
 
 
-def _clean_small(pts: list) -> list:
+def clean_small(pts: list) -> list:
     """CCW, lowest-first, no repeated or collinear vertex; checks convexity (scalar)."""
-    return _clean_edges_small(pts)[0]
+    return clean_edges_small(pts)[0]
 
 
-def _clean_edges_small(pts: list) -> tuple[list, list]:
-    """:func:`_clean_small`, and the cleaned operand's edges from :func:`_edges_small`.
+def clean_edges_small(pts: list) -> tuple[list, list]:
+    """:func:`clean_small`, and the cleaned operand's edges from :func:`_edges_small`.
 
     One pass computes each vertex's turn as the cross product of its two edges (the
     stage-A filter inline, rationals only in doubt) and the lowest vertex.
@@ -48,7 +48,7 @@ def _clean_edges_small(pts: list) -> tuple[list, list]:
     out = [(p[0], p[1]) for i, p in enumerate(pts) if p != pts[i - 1]] or [tuple(pts[0])]
     n = len(out)
     if n <= 2:
-        out = _extremes(out)
+        out = extremes(out)
         return out, _edges_small(out)
     pos = neg = 0
     px, py = out[-1]
@@ -70,8 +70,8 @@ def _clean_edges_small(pts: list) -> tuple[list, list]:
             if t == 0:  # a collinear vertex: drop it exactly (rare), then start again
                 p = drop_collinear(np.array(out, dtype=np.float64))
                 if len(p) >= 3:
-                    return _clean_edges_small(p.tolist())
-                out = _extremes(out)
+                    return clean_edges_small(p.tolist())
+                out = extremes(out)
                 return out, _edges_small(out)
             pos += t > 0
             neg += t < 0
@@ -87,7 +87,7 @@ def _clean_edges_small(pts: list) -> tuple[list, list]:
     return out, _edges_small(out)  # raises unless the edges sweep the angle once
 
 
-def _extremes(pts: list) -> list:
+def extremes(pts: list) -> list:
     """A point or a segment, as its one or two extreme points, lowest (then leftmost) first."""
     lo = min(pts, key=lambda v: (v[1], v[0]))
     hi = max(pts, key=lambda v: (v[1], v[0]))
@@ -101,7 +101,7 @@ def _half(dx: float, dy: float) -> int:
 
 
 
-def _merge2_small(P: list, Q: list, EP: list | None = None, EQ: list | None = None) -> tuple[list, bool]:
+def merge2_small(P: list, Q: list, EP: list | None = None, EQ: list | None = None) -> tuple[list, bool]:
     """The two-operand merge: two pointers, exact comparison, parallel edges fused.
 
     Returns the vertices as a flat list [x0, y0, x1, y1, ...] (cheap to hand to numpy)
@@ -169,7 +169,7 @@ def _edges_small(P: list) -> list:
     return edges
 
 
-def _merge_small(polys: list) -> list:
+def merge_small(polys: list) -> list:
     """The k-way angular merge, one vertex of the sum per distinct edge direction.
 
     ``idx[i]`` is the current vertex of operand i; the current vertex of the sum is
@@ -210,7 +210,7 @@ def _merge_small(polys: list) -> list:
     return out
 
 
-def _certify_small(out: list) -> list:
+def certify_small(out: list) -> list:
     """Exact strict-convexity check of the rounded sum; repair by exact hull if needed."""
     n = len(out)
     if n < 3:  # a point or a segment, already lowest first

@@ -5,15 +5,15 @@ for their polar angle (:func:`_pseudo_angle`); one stable sort merges them
 (:func:`_sort_keys`); the sorted order is then certified exactly and parallel edges fused
 (:mod:`cspace.kernel.minkowski_certify`), and the sum's vertices are formed: exact int64
 running sums on integer input, else one input vertex per operand, rounded once per
-addition and certified strictly convex. :func:`_merge_vectorised` returns None whenever it
+addition and certified strictly convex. :func:`merge_vectorised` returns None whenever it
 cannot certify; :func:`cspace.kernel.minkowski.minkowski_sum` then takes a slower exact route.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .minkowski_certify import _certify_cols, _max_abs, _parallel_pairs, _turns_cols
-from .minkowski_scalar import _extremes
+from .minkowski_certify import certify_cols, max_abs, parallel_pairs, turns_cols
+from .minkowski_scalar import extremes
 from .polygon import drop_collinear, drop_repeats, lowest_first
 from .predicates import lower_half, orient2d_xy
 
@@ -40,7 +40,7 @@ def _lowest_index_convex(p: np.ndarray) -> int:
     return min(run, key=lambda j: p[j, 0])
 
 
-def _clean_convex(p: np.ndarray) -> np.ndarray:
+def clean_convex(p: np.ndarray) -> np.ndarray:
     """Vectorised :func:`cspace.kernel.minkowski_scalar._clean_small` for large operands."""
     if len(p) >= 2:
         nxt = np.roll(p, -1, axis=0)
@@ -48,15 +48,15 @@ def _clean_convex(p: np.ndarray) -> np.ndarray:
             p = drop_repeats(p)
             nxt = np.roll(p, -1, axis=0)
     if len(p) < 3:
-        return np.array(_extremes([tuple(v) for v in p.tolist()]), dtype=np.float64)
+        return np.array(extremes([tuple(v) for v in p.tolist()]), dtype=np.float64)
     e = nxt - p
     ep = np.roll(e, 1, axis=0)
-    turn = _turns_cols(ep[:, 0], ep[:, 1], e[:, 0], e[:, 1], np.roll(p, 1, axis=0), p, p, nxt)
+    turn = turns_cols(ep[:, 0], ep[:, 1], e[:, 0], e[:, 1], np.roll(p, 1, axis=0), p, p, nxt)
     if not turn.all():
         q = drop_collinear(p)
         if len(q) < 3:
-            return np.array(_extremes([tuple(v) for v in p.tolist()]), dtype=np.float64)
-        return _clean_convex(q)
+            return np.array(extremes([tuple(v) for v in p.tolist()]), dtype=np.float64)
+        return clean_convex(q)
     pos = turn[0] > 0
     if (turn < 0).any() if pos else (turn > 0).any():
         raise ValueError("minkowski_sum: operand is not convex")
@@ -84,7 +84,7 @@ def _pseudo_angle(dx: np.ndarray, dy: np.ndarray, key: np.ndarray, scratch: np.n
     return key
 
 
-def _prep_fast(p: np.ndarray) -> tuple[np.ndarray, int] | None:
+def prep_fast(p: np.ndarray) -> tuple[np.ndarray, int] | None:
     """A large operand CCW (a reversed view if needed) and the index of its lowest
     vertex, without the full clean; or None.
 
@@ -154,7 +154,7 @@ def _edge_vectors(edged: list, rot: list, ex: np.ndarray, ey: np.ndarray) -> Non
     ey += 0.0  # -0.0 (from -0.0 - 0.0) becomes 0.0: the key reads the half-plane from its sign
 
 
-def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None:
+def merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None:
     """Merge by a sort of pseudo-angle keys, then certify the order exactly.
 
     Each operand is CCW; ``rot`` gives each one's lowest vertex (default: the first).
@@ -198,7 +198,7 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
     buf = np.empty((total, 2))
     integral = _integral(edged, len(polys), buf)
     with np.errstate(over="ignore", invalid="ignore"):  # inf and NaN products go to the exact tests
-        fused = _parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, ex, ey)  # ex, ey: spent
+        fused = parallel_pairs(ux, uy, half, integral, order, edged, rot, sizes, ex, ey)  # ex, ey: spent
     if fused is None:
         return None
     # The vertex after merged edge t, t < last, unless t and t + 1 fuse.
@@ -231,7 +231,7 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
         np.take(P, cp, axis=0, out=a, mode="wrap")
         np.take(Q, cq, axis=0, out=b, mode="wrap")
         np.add(a, b, out=out[1:])
-        return _certify_cols(out, exact=False)
+        return certify_cols(out, exact=False)
     # Float input: each vertex is the sum of one input vertex per operand, rounded
     # once per addition; the count of an operand's edges taken so far is its index.
     vx = np.zeros(len(keep))
@@ -247,7 +247,7 @@ def _merge_vectorised(polys: list, rot: list | None = None) -> np.ndarray | None
         vy += p[cnt, 1]
     out[1:, 0] = vx
     out[1:, 1] = vy
-    return _certify_cols(out, exact=False)
+    return certify_cols(out, exact=False)
 
 
 def _running_sums(ux, uy, start, keep, acc, spare, out) -> np.ndarray:
@@ -278,7 +278,7 @@ def _integral(polys: list, k: int, scratch: np.ndarray) -> bool:
     """
     lim = 2.0**51 / max(k, 1)
     for p in polys:
-        if not _max_abs(p) < lim:
+        if not max_abs(p) < lim:
             return False
     for p in polys:
         if not np.array_equal(np.floor(p, out=scratch[:len(p)]), p):

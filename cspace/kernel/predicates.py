@@ -21,7 +21,7 @@ EPS = 2.0**-53
 CCW_ERRBOUND_A = (3.0 + 16.0 * EPS) * EPS
 # Below this magnitude products may be subnormal and the relative bound no longer
 # holds; such inputs go straight to the exact path.
-_UNDERFLOW_GUARD = 1e-280
+UNDERFLOW_GUARD = 1e-280
 _INF = float("inf")
 
 
@@ -201,7 +201,7 @@ def cross_diff_sign(ax: float, ay: float, bx: float, by: float,
     right = uy * vx
     det = left - right
     detsum = abs(left) + abs(right)
-    if _UNDERFLOW_GUARD < detsum < _INF:
+    if UNDERFLOW_GUARD < detsum < _INF:
         errbound = CCW_ERRBOUND_A * detsum
         if det > errbound:
             return 1
@@ -238,7 +238,7 @@ def cross_diff_cols(ax, ay, bx, by, cx, cy, dx, dy) -> np.ndarray:
         # Certain: |det| above the stage-A bound, detsum clear of underflow. An infinite
         # detsum makes the bound infinite and a NaN compares False: both stay in doubt.
         certain = np.abs(det) > CCW_ERRBOUND_A * detsum
-        certain &= detsum > _UNDERFLOW_GUARD
+        certain &= detsum > UNDERFLOW_GUARD
         sign = np.sign(det).astype(np.int8)  # read only where certain
     if certain.all():
         return sign

@@ -209,7 +209,7 @@ def slab_inner(piece: np.ndarray, a: float, b: float, pad: float) -> np.ndarray:
     ch, sh = math.cos(half), math.sin(half)
     box = 2.0 * float(np.hypot(p[:, 0], p[:, 1]).max())  # the clipping's rounding stays ~u·r
     poly = [(-box, -box), (box, -box), (box, box), (-box, box)]
-    for nx, ny, c, ln in _edges(p):
+    for nx, ny, c, ln in edge_planes(p):
         low = 4.0 * pad * ln
         for ux, uy, off in ((nx * ch - ny * sh, nx * sh + ny * ch, c - low),
                             (nx * ch + ny * sh, -nx * sh + ny * ch, c - low),
@@ -265,7 +265,7 @@ def default_slabs(robot_radius: float, extent: float, gap: float | None = None) 
                f"hull excess over the end poses <= {100 * excess:.2g} % of the radius")
 
 
-def _typical_gap(pieces: list[np.ndarray], extent: float) -> float:
+def typical_gap(pieces: list[np.ndarray], extent: float) -> float:
     """Median distance from an obstacle piece to its nearest other piece (shapely),
     ignoring touching pieces (parts of one decomposed obstacle); extent / 8 if none."""
     if len(pieces) < 2:
@@ -330,7 +330,7 @@ def inscribed_polygon(radius: float, n: int = 32) -> np.ndarray:
     return np.column_stack([rr * np.cos(ang), rr * np.sin(ang)]) + 0.0
 
 
-def _edges(p: np.ndarray) -> list[tuple[float, float, float, float]]:
+def edge_planes(p: np.ndarray) -> list[tuple[float, float, float, float]]:
     """Per edge of a CCW polygon: outward normal (dy, −dx), offset n·start, and |n|."""
     pts = p.tolist()
     out = []

@@ -407,7 +407,7 @@ def se2_path_clearance(path, robot_pieces: list, obstacle_pieces: list, angle_st
     >>> c.bound, round(c.distance, 6)  # the true clearance is 2.6005637...
     ('lower', 2.600564)
     """
-    from .se2_motion import _arc
+    from .se2_motion import turn_arc
 
     poses = np.asarray(path, dtype=np.float64).reshape(-1, 3)
     obs = Nearest(obstacle_pieces)
@@ -426,7 +426,7 @@ def se2_path_clearance(path, robot_pieces: list, obstacle_pieces: list, angle_st
     def push(i: int, t0: float, t1: float) -> None:
         nonlocal count
         q0, q1 = poses[i], poses[i + 1]
-        arc = _arc(float(q0[2]), float(q1[2]))
+        arc = turn_arc(float(q0[2]), float(q1[2]))
         a, b = sorted((float(q0[2]) + arc * t0, float(q0[2]) + arc * t1))
         pa = q0[:2] + (q1[:2] - q0[:2]) * t0
         pb = q0[:2] + (q1[:2] - q0[:2]) * t1
@@ -446,7 +446,7 @@ def se2_path_clearance(path, robot_pieces: list, obstacle_pieces: list, angle_st
             upper = min(upper, obs.nearest(rotate_piece(r, th) + (x, y) if len(r) > 2 else r + (x, y), upper)[0])
 
     for i in range(len(poses) - 1):
-        arc = abs(_arc(float(poses[i][2]), float(poses[i + 1][2])))
+        arc = abs(turn_arc(float(poses[i][2]), float(poses[i + 1][2])))
         n = max(1, math.ceil(arc / (0.25 * math.pi)))  # slab hulls span at most a quarter turn
         for s in range(n):
             push(i, s / n, (s + 1) / n)

@@ -35,7 +35,7 @@ from ..kernel.polygon import pack, piece_boxes
 from ..io.scenario import load_scenario
 from ..io.schema import Scenario
 # decompose_obstacles and decompose_robot are public here too (``cspace`` lists them).
-from .cspace_build import (Stage, _check_range, _contained_pieces, decompose_obstacles, decompose_robot, inflated,
+from .cspace_build import (Stage, check_range, contained_pieces, decompose_obstacles, decompose_robot, inflated,
                            pair_sums)
 from .cspace_points import PointQueries
 from .cspace_segments import SegmentQueries
@@ -81,7 +81,7 @@ class CSpace(PointQueries, SegmentQueries):
         # Safety margin (cspace.kernel.margin): convex operands summed with every robot piece in the
         # same merge as the obstacle piece; none (the default) is the plain C-space, same code.
         self.margin = [np.asarray(m, dtype=np.float64) for m in (margin or [])]
-        _check_range(self.bounds, obstacles + robot + self.margin)
+        check_range(self.bounds, obstacles + robot + self.margin)
         convex = obstacle_convex if normalized else None
         self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes, owner, convex)
         self.robot_pieces = self._decompose_robot(robot, robot_is_disk)
@@ -201,7 +201,7 @@ class CSpace(PointQueries, SegmentQueries):
         pairs = [[self._raw_pairs[k]] for k in keep]
         owner = owner[keep] if len(owner) else owner
         lo, hi = lo[keep], hi[keep]  # the kept pieces' boxes, for the containment test and the index
-        contained = _contained_pieces(pieces, (lo, hi))
+        contained = contained_pieces(pieces, (lo, hi))
         if contained:
             for p in sorted(contained):
                 q = contained[p]

@@ -34,7 +34,7 @@ PAIR_BATCH_EDGES = 128  # a robot piece with a margin's rounded corners (~75 edg
 PAIR_BATCH_CELLS = 1 << 20
 
 
-def _check_range(bounds: tuple, shapes: list) -> None:
+def check_range(bounds: tuple, shapes: list) -> None:
     """ValueError unless the scene lies in the range the C-space supports (its
     classification multiplies two coordinates): see :data:`cspace.io.schema.MAX_MAGNITUDE`."""
     xmin, xmax, ymin, ymax = bounds
@@ -108,7 +108,7 @@ FAR_VERTEX_PIECES = 4096
 BOX_PROPOSALS = 256
 
 
-def _contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None) -> dict[int, int]:
+def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None) -> dict[int, int]:
     """Convex pieces lying inside another piece (exact containment test): removed -> container.
 
     Candidate pairs come from bounding-box containment; a convex piece P lies in a

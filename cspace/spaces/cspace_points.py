@@ -147,14 +147,14 @@ class PointQueries:
         ``q - p`` precomputed (the same rounded difference the filter's bound covers);
         only uncertified signs call the exact :func:`orient2d_xy`.
         """
-        from ..kernel.predicates import _UNDERFLOW_GUARD, CCW_ERRBOUND_A, orient2d_xy
+        from ..kernel.predicates import UNDERFLOW_GUARD, CCW_ERRBOUND_A, orient2d_xy
 
         index = self.index  # its scalar lists are made when this first runs (edges_near)
         packed = self.packed
         edge_mask, pieces = self.index.edge_mask, self.pieces
         by_cell: dict = {}  # cell -> per candidate piece, its edges named by the cell's mask
         checks = self.checks
-        tiny = CCW_ERRBOUND_A * _UNDERFLOW_GUARD
+        tiny = CCW_ERRBOUND_A * UNDERFLOW_GUARD
 
         def edges_near(cell: int) -> list:
             # Only the edges whose line passes near this cell: the cell lies well

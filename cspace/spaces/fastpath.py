@@ -82,6 +82,12 @@ def clearance_scan():
     return None if _fast is None else _fast.clearance_scan
 
 
+def se2_pose():
+    """The compiled filter stage of the SE(2) pose test (``_fast.se2_pose(handle, x, y, cos, sin)``:
+    0 blocked, 1 free, 2 undecided), for a handle from :func:`se2_handle`; None on the pure path."""
+    return None if _fast is None else _fast.se2_pose
+
+
 def pack_boxes(pieces: list):
     """``(xy, off, lo, hi, scale)``: convex pieces packed (piece k in rows off[k] to
     off[k + 1] of xy), their boxes as :func:`cspace.kernel.polygon.piece_boxes` gives them,

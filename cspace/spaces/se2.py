@@ -32,14 +32,14 @@ import numpy as np
 from . import fastpath
 from .broadphase import GridIndex
 from .cspace import CSpace
-from .cspace_build import _check_range, decompose_obstacles, decompose_robot, inflated
+from .cspace_build import check_range, decompose_obstacles, decompose_robot, inflated
 from ..kernel.minkowski import minkowski_sum, reflect
 from ..kernel.polygon import point_in_convex
 from ..io.scenario import load_scenario
 from ..io.schema import Scenario
 from .car_motion import CarMotions
 from .se2_motion import SE2Motions, interpolate  # noqa: F401  (interpolate: part of this module's API)
-from ..kernel.slab import (ANGLE_SLACK, TWO_PI, _edges, _typical_gap, default_slabs, robot_radius, rotate_piece,
+from ..kernel.slab import (ANGLE_SLACK, TWO_PI, edge_planes, typical_gap, default_slabs, robot_radius, rotate_piece,
                    slab_hull, slab_inner, slab_of, slab_pad, slab_range, wrap_angle)
 
 # Grid cells of each slab's C-space (unless grid_cells is given): a quarter of the
@@ -66,7 +66,7 @@ class SE2CSpace(SE2Motions, CarMotions):
         t0 = time.perf_counter()
         self.bounds = tuple(float(v) for v in bounds)
         obstacles = obstacles or []
-        _check_range(self.bounds, obstacles + (robot or []))
+        check_range(self.bounds, obstacles + (robot or []))
         self.obstacle_pieces, self.obstacle_of, _ = decompose_obstacles(obstacles, obstacle_holes)
         self.robot_pieces, _ = decompose_robot(robot or [], robot_is_disk)
         # A safety margin (cspace.kernel.margin) is summed with each body-frame robot piece in one
@@ -86,7 +86,7 @@ class SE2CSpace(SE2Motions, CarMotions):
                          + [float(np.abs(p).max()) for p in self.obstacle_pieces if len(p)])
         self.pad = slab_pad(self.radius * math.sqrt(2.0) + self.scale)
         if slabs is None:
-            gap = _typical_gap(self.obstacle_pieces, self.extent)
+            gap = typical_gap(self.obstacle_pieces, self.extent)
             self.slabs, self.slabs_reason = default_slabs(self.radius, self.extent, gap)
         else:
             if isinstance(slabs, bool) or not isinstance(slabs, int) or not slabs >= 4:
@@ -109,12 +109,12 @@ class SE2CSpace(SE2Motions, CarMotions):
         self._olo, self._ohi = olo, ohi
         # Plain lists for the float filter of the exact test (see _pair_filter).
         self.obstacle_lists = [p.tolist() for p in self.obstacle_pieces]
-        self._obstacle_edges = [_edges(p) for p in self.obstacle_pieces]
+        self._obstacle_edges = [edge_planes(p) for p in self.obstacle_pieces]
         self._robot_lists = [p.tolist() for p in self.robot_pieces]
-        self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in _edges(p)] for p in self.robot_pieces]
+        self._robot_normals = [[(nx, ny, ln) for nx, ny, _, ln in edge_planes(p)] for p in self.robot_pieces]
         self._pair_grid()
         self._fast = fastpath.se2_handle(self)  # the compiled filter stage (None: pure path)
-        self._fast_pose = None if self._fast is None else fastpath._fast.se2_pose
+        self._fast_pose = None if self._fast is None else fastpath.se2_pose()
         self.checks = {"states": 0, "exact_states": 0, "motions": 0, "motion_collisions": 0,
                        "motion_floor": 0, "exact_sums": 0, "slab_certified": 0, "refined": 0, "sweeps": 0, "submotions": 0,
                        "curves": 0, "arcs": 0, "arc_sweeps": 0}

@@ -59,7 +59,7 @@ def interpolate(q0, q1, t: float) -> tuple[float, float, float]:
     return x0 + (x1 - x0) * t, y0 + (y1 - y0) * t, th
 
 
-def _arc(a: float, b: float) -> float:
+def turn_arc(a: float, b: float) -> float:
     """The signed angle swept by OMPL's interpolation from a to b (|result| <= π)."""
     diff = b - a
     if abs(diff) <= math.pi:
@@ -84,7 +84,7 @@ class SE2Motions:
         if not (self._pose(x1, y1, a1) and self._pose(x0, y0, a0)):
             self.checks["motion_collisions"] += 1
             return False
-        D = _arc(a0, a1)
+        D = turn_arc(a0, a1)
         budget = [MAX_REFINE]
         for ta, tb in self._split(a0, D):
             self.checks["submotions"] += 1

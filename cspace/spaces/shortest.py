@@ -120,7 +120,7 @@ def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method) -> S
 
     from .pathcheck import Degenerate, path_violations, split_pieces
     from ..kernel.polygon import as_array
-    from .shortest_lazy import _lazy_astar
+    from .shortest_lazy import lazy_astar
 
     t0 = time.perf_counter()
     pieces = [as_array(p, copy=False, nonempty=True) for p in pieces]  # the one input gate: finite (N, 2) reals
@@ -168,7 +168,7 @@ def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method) -> S
     if "method" not in stats:
         if method == "mesh":
             raise ValueError(f"shortest_path: no mesh search here ({stats.get('mesh_error', 'zero-area pieces')})")
-        path, length, counts = _lazy_astar(pts, tangent_dirs, region, deadline, on_progress, deg, PROGRESS_EVERY)
+        path, length, counts = lazy_astar(pts, tangent_dirs, region, deadline, on_progress, deg, PROGRESS_EVERY)
         stats["method"] = "lazy"
     stats["counts"].update(counts, nodes=len(pts))
     stats["time"] = time.perf_counter() - t0

@@ -18,7 +18,7 @@ import numpy as np
 from .astar import astar
 
 
-def _lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None,
+def lazy_astar(pts: np.ndarray, nbrs: list, region, deadline: float | None = None,
                 on_progress: Callable[[int, int, float], None] | None = None, deg=None, every: int = 64) -> tuple:
     """A* from node 0 to node 1 over bitangent candidate edges, each checked when popped."""
     import shapely

@@ -1,0 +1,129 @@
+"""Car-like state spaces: OMPL's Dubins and Reeds–Shepp spaces over the sliced SE(2) C-space.
+
+A car is a rotating robot (poses (x, y, theta), the C-space of :mod:`cspace.spaces.se2`)
+whose motions are not straight lines in SE(2) but the shortest Dubins curves
+(forward only) or Reeds–Shepp curves (forward and reverse) of a minimum turning
+radius. OMPL's ``DubinsStateSpace`` / ``ReedsSheppStateSpace`` give the planners
+their metric and interpolation; every motion the planners ask about is recomputed
+here as its segments (:mod:`cspace.spaces.car_curves`, checked against OMPL's own
+``distance`` and ``interpolate`` by the tests) and certified segment by segment
+(:meth:`cspace.spaces.se2.SE2CSpace.curve_free`: exact straight segments, arcs bounded by
+hulls about the turning centre), never sampled.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cspace.spaces.car_curves import curve_length, dubins_segments, knots, pose_along, reeds_shepp_segments
+
+from .se2 import SE2Space
+from .frame import scaled_bounds
+
+SEGMENT_NAMES = {"L": "left", "S": "straight", "R": "right"}
+
+
+class CarSpace(SE2Space):
+    """Adapter for a car: ``kind`` is ``"dubins"`` or ``"reeds-shepp"``, ``radius`` its
+    minimum turning radius (OMPL's states and radius scaled by 2^k, exactly)."""
+
+    unsolved_hint = "try a longer --time (a car needs room to turn: check the turning radius)"
+    step = "curve"
+    # The SE(2) clearance (its bound, its objective) follows OMPL's SE(2) interpolation between
+    # waypoints, not a car's curves: not inherited. A car's path clearance is not measured (yet).
+    path_clearance = None
+    clearance_functions = None
+
+    def __init__(self, cspace, kind: str, radius: float, k: int | None = None):
+        super().__init__(cspace, k)
+        if kind not in ("dubins", "reeds-shepp"):
+            raise ValueError(f"CarSpace: kind must be 'dubins' or 'reeds-shepp', got {kind!r}")
+        self.name = kind
+        self.radius = float(radius)
+        self._segments = dubins_segments if kind == "dubins" else reeds_shepp_segments
+
+    def state_space(self):
+        from .glue import ompl
+
+        ob = ompl()[0]
+        r = math.ldexp(self.radius, self.k)
+        space = ob.DubinsStateSpace(r, False) if self.name == "dubins" else ob.ReedsSheppStateSpace(r)
+        space.setBounds(scaled_bounds(ob, self.cspace.bounds, self.k))
+        return space
+
+    # ---------------------------------------------------------------- curves
+
+    def segments(self, q0, q1) -> list:
+        """The motion q0 -> q1 as (kind, signed length) segments (the shortest curve)."""
+        return self._segments(q0, q1, self.radius)
+
+    def motion_free(self, q0, q1) -> bool:
+        """Whether the car, driven along the shortest curve from q0 to q1, touches nothing
+        (certified: :meth:`cspace.spaces.se2.SE2CSpace.curve_free`)."""
+        return self.cspace.curve_free(q0, self.segments(q0, q1), self.radius, q1=q1)
+
+    def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
+        """Every curve between consecutive poses certified free, from the start pose to the goal pose.
+
+        A Dubins curve is one-way (the curve from b to a is not the one from a to b
+        reversed); planners that use a motion in both directions (PRM, PRMstar,
+        BKPIECE1, ...) can return paths that fail here, and the message says so."""
+        ok, msg = super().verify(path, start, goal)
+        if not ok and self.name == "dubins":
+            msg += (" (Dubins curves are one-way: planners that use a motion in both directions, such as "
+                    "PRM, PRMstar and BKPIECE1, return such paths; use RRT, RRTConnect, RRTstar or BITstar)")
+        return ok, msg
+
+    def length(self, path: np.ndarray) -> float:
+        """The distance driven: the sum of the curves' lengths (OMPL's metric of the space).
+
+        >>> CarSpace.__new__(CarSpace)._len_of([("L", 1.5), ("S", -2.0)])
+        3.5
+        """
+        path = np.asarray(path, dtype=np.float64)
+        return float(sum(self._len_of(self.segments(tuple(a), tuple(b))) for a, b in zip(path[:-1], path[1:])))
+
+    @staticmethod
+    def _len_of(segments) -> float:
+        return curve_length(segments)
+
+    def curves(self, path: np.ndarray) -> list[dict]:
+        """Per motion of the path: its start pose and its segments (type, length, direction),
+        the JSON form of a car's path."""
+        out = []
+        for a, b in zip(np.asarray(path)[:-1], np.asarray(path)[1:]):
+            segs = self.segments(tuple(a), tuple(b))
+            out.append({"from": [float(v) for v in a], "to": [float(v) for v in b],
+                        "segments": [{"type": SEGMENT_NAMES[kind], "length": abs(float(ln)),
+                                      "direction": "reverse" if ln < 0 else "forward"} for kind, ln in segs]})
+        return out
+
+    def dense(self, path: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+        """See :func:`dense_curve`."""
+        return dense_curve(path, self.name, self.radius, step)
+
+
+def dense_curve(path: np.ndarray, kind: str, radius: float, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Poses along a car's path, driven along its curves, about ``step`` apart (each
+    segment's ends included), and per pose whether the car drives in reverse there:
+    what plots and animations draw (the curves, not the chords between waypoints).
+
+    >>> p, rev = dense_curve(np.array([[0., 0, 0], [2, 0, 0]]), "dubins", 1.0, 0.5)
+    >>> p[:, 0].round(6).tolist(), bool(rev.any())
+    ([0.0, 0.5, 1.0, 1.5, 2.0, 2.0], False)
+    """
+    segments = dubins_segments if kind == "dubins" else reeds_shepp_segments
+    poses, reverse = [], []
+    path = np.asarray(path, dtype=np.float64)
+    for a, b in zip(path[:-1], path[1:]):
+        segs = [sg for sg in segments(tuple(a), tuple(b), radius) if sg[1] != 0.0]
+        for (k, ln), k0 in zip(segs, knots(tuple(a), segs, radius)[:-1]):
+            n = max(2, math.ceil(abs(ln) / step) + 1)
+            for i in range(n):
+                poses.append(pose_along(k0, [(k, ln)], radius, i / (n - 1)))
+                reverse.append(ln < 0)
+    if len(path):
+        poses.append(tuple(path[-1]))
+        reverse.append(reverse[-1] if reverse else False)
+    return np.array(poses, dtype=np.float64).reshape(-1, 3), np.array(reverse, dtype=bool)

@@ -1,0 +1,138 @@
+"""The benchmark sweep: scenarios x planners x time budgets x seeded runs, each run isolated
+in its own process (a planner that segfaults or hangs costs one row, recorded as
+``crashed`` or ``timeout``, never the sweep): locally a forked child of this process,
+which built each scenario's C-space once (:mod:`planners.bench.pool`, at most ``--workers``
+at a time), a fresh process where fork is missing, or on a Dask cluster (``--scheduler``).
+Each run is :func:`planners.bench.rows.run_one`, which calls :func:`planners.core.plan.plan`
+as ``cspace plan`` does.
+
+Rows are sorted by (scenario, planner, budget, seed) in the order given on the command
+line, so the same sweep gives the same rows whatever the number of workers (timings aside;
+anytime planners stopped by a clock are not deterministic anyway, planners that stop at
+their first solution are).
+"""
+from __future__ import annotations
+
+from ..errors import InputError
+from ..pictures.bench_figure import curves
+from ..progress import BenchBar
+from .rows import complete_row, hard_limit, live_children, stop_event
+
+
+def isolated_run(task: dict, limit: float | None = None) -> dict | None:
+    """Run one task in a fresh process (see :func:`planners.bench.pool.isolated_run`)."""
+    from .pool import isolated_run as run
+
+    return run(task, limit)
+
+
+# ---------------------------------------------------------------- the sweep
+
+def sweep(tasks: list[dict], workers: int = 1, scheduler: str | None = None,
+          progress: bool = False, held: dict | None = None) -> tuple[list[dict], bool]:
+    """Run every task; returns ``(rows sorted in task order, interrupted)``.
+
+    With ``held`` (file -> (scenario, cspace), from :func:`reference`) and ``os.fork``,
+    runs are forked children of this process (:mod:`planners.bench.pool`); otherwise
+    (or on a Dask cluster) each run is a fresh process. Ctrl-C stops the sweep:
+    running children are killed, finished rows are kept.
+    """
+    from ..children import CAN_FORK
+    from .pool import run_forked
+
+    stop_event.clear()
+    rows: list[dict] = []
+    bar = BenchBar(len(tasks), progress)
+    interrupted = False
+
+    def on_row(task, row, wall):
+        rows.append(complete_row(task, row, wall))
+        bar.step(rows[-1])
+
+    try:
+        if scheduler:
+            _sweep_dask(tasks, scheduler, rows, bar)
+        elif held is not None and CAN_FORK and all(t["file"] in held for t in tasks):
+            from ..adapters.glue import ompl
+            from ..core import plan  # noqa: F401  (imported once, before forking)
+
+            ompl()
+            run_forked(tasks, held, workers, lambda t: hard_limit(t["time_budget"]), on_row)
+        else:
+            _sweep_local(tasks, workers, rows, bar)
+    except KeyboardInterrupt:
+        interrupted = True
+        stop_event.set()
+        for proc in list(live_children):
+            proc.kill()
+    bar.close()
+    rows.sort(key=lambda r: r["order"])
+    for r in rows:
+        del r["order"]
+    return rows, interrupted
+
+
+def _sweep_local(tasks, workers, rows, bar) -> None:
+    from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+
+    pool = ThreadPoolExecutor(max_workers=workers)
+    try:
+        pending = {pool.submit(isolated_run, t) for t in tasks}
+        while pending:
+            # A short timeout keeps the main thread responsive to Ctrl-C.
+            done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+            for fut in done:
+                row = fut.result()
+                if row is not None:
+                    rows.append(row)
+                    bar.step(row)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _sweep_dask(tasks, scheduler, rows, bar) -> None:
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise InputError("bench", "--scheduler", "needs dask[distributed] (pip install 'cspace[cluster]')") from None
+    try:
+        client = Client(scheduler, timeout="10s")
+    except OSError as exc:
+        raise InputError("bench", "--scheduler", f"cannot connect to {scheduler}: {exc}") from None
+    futures = client.map(isolated_run, tasks, pure=False)
+    try:
+        for fut in as_completed(futures):
+            row = fut.result()
+            if row is not None:
+                rows.append(row)
+                bar.step(row)
+    except KeyboardInterrupt:
+        client.cancel(futures)
+        raise
+    finally:
+        client.close()
+
+
+# ---------------------------------------------------------------- statistics
+
+def summary(rows: list[dict]) -> str:
+    """A table: median error, median min clearance and success rate at the largest budget,
+    per scenario and planner."""
+    from .clearance import clearance_cell
+
+    cs, clear = curves(rows), curves(rows, "min_clearance")
+    bounded = {r["scenario"] for r in rows if r.get("reference") == "lower_bound"}
+    lower = {r["scenario"] for r in rows if r.get("min_clearance_bound") == "lower"}
+    lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'min clearance':>14} "
+             f"{'success':>8}"]
+    for (scen, p), c in cs.items():
+        m = c["median"][-1]
+        text = "-" if m is None else (f"<= {m:.4f}" if scen in bounded else f"{m:.4f}")
+        lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} "
+                     f"{clearance_cell(clear[scen, p]['median'][-1], scen in lower):>14} {c['success'][-1]:>8.0%}")
+    if bounded:
+        lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
+                     "bound on the error")
+    if lower:
+        lines.append(">= : an SE(2) path's min clearance is a certified lower bound")
+    return "\n".join(lines)

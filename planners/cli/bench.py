@@ -1,0 +1,151 @@
+"""``cspace bench``: the command line of the error-against-run-time sweep (:mod:`planners.bench`)."""
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+
+from ..adapters.objectives import OBJECTIVES
+from ..bench.clearance import check_planners, check_scenarios, default_planners
+from ..bench.outputs import clear_outputs, write_deferring_sigint
+from ..bench.reference import make_tasks, reference
+from ..bench.rows import HARD_FACTOR, HARD_MARGIN
+from ..bench.sweep import summary, sweep
+from ..errors import InputError
+
+
+DEFAULT_PLANNERS = ("RRTConnect", "RRTstar", "PRMstar", "BITstar")
+
+
+DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
+
+
+MAX_BUDGET = 1e6  # seconds per run (11 days); OMPL's clock overflows near 8e9 s
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("bench", help="error against run time for OMPL planners vs the exact shortest path",
+                       description="Benchmark OMPL planners: path length error against the exact shortest "
+                                   "path, per time budget. Exit 0 done, 2 bad input, 130 interrupted "
+                                   "(finished rows are written).")
+    p.add_argument("scenario", nargs="+", help="scenario TOML files")
+    p.add_argument("--planners", help=f"comma-separated OMPL planners (default {','.join(DEFAULT_PLANNERS)}; "
+                                      "with --objective clearance or balanced, those of them that take it)")
+    p.add_argument("--times", default=",".join(f"{t:g}" for t in DEFAULT_TIMES),
+                   help="comma-separated time budgets in seconds (default 0.01,0.03,0.1,0.3,1)")
+    p.add_argument("--runs", type=int, default=10, help="seeded runs per planner and budget (seeds 0..N-1)")
+    p.add_argument("--iterations", type=int, help="also stop each run after this many planner iterations")
+    p.add_argument("--workers", type=int, default=1, help="runs in parallel (local processes)")
+    p.add_argument("--out", default="bench_out", help="output folder (created if missing)")
+    p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on")
+    p.add_argument("--objective", choices=OBJECTIVES, default="length",
+                   help="what the optimising planners (RRTstar, SORRTstar, BITstar) optimise: path length "
+                        "(default), the minimum clearance, or length weighted by clearance")
+    p.add_argument("--no-plot", action="store_true", help="skip error_vs_time.png")
+    from ..cli.plan import add_space_options
+
+    add_space_options(p)
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress line")
+    # Test hook: the child of this (planner, seed) calls os.abort(), as a segfaulting planner would.
+    p.add_argument("--abort-on", help=argparse.SUPPRESS)
+    p.set_defaults(run=run)
+
+
+def parse_planners(text: str, source: str = "bench") -> list[str]:
+    """Canonical OMPL planner names from a comma-separated list (``exact`` is the reference, not a contestant).
+
+    >>> parse_planners("rrtconnect,BITstar")
+    ['RRTConnect', 'BITstar']
+    """
+    from ..adapters.glue import PLANNERS
+
+    table = {p.lower(): p for p in PLANNERS}
+    names = [s.strip() for s in str(text).split(",") if s.strip()]
+    if not names:
+        raise InputError(source, "--planners", "empty list")
+    out = []
+    for n in names:
+        canon = table.get(n.lower())
+        if canon is None:
+            raise InputError(source, "--planners", f"unknown planner {n!r} (choose from: {', '.join(PLANNERS)})")
+        if canon in out:
+            raise InputError(source, "--planners", f"planner {canon} given twice")
+        out.append(canon)
+    return out
+
+
+def parse_times(text: str, source: str = "bench") -> list[float]:
+    """Time budgets from a comma-separated list: positive, finite, distinct; returned sorted.
+
+    >>> parse_times("1,0.01,0.1")
+    [0.01, 0.1, 1.0]
+    """
+    parts = [s.strip() for s in str(text).split(",")]
+    if not parts or any(not s for s in parts):
+        raise InputError(source, "--times", f"expected comma-separated seconds, got {text!r}")
+    out = []
+    for s in parts:
+        try:
+            t = float(s)
+        except ValueError:
+            raise InputError(source, "--times", f"not a number: {s!r}") from None
+        if not (math.isfinite(t) and t > 0):
+            raise InputError(source, "--times", f"must be positive seconds, got {s!r}")
+        if t > MAX_BUDGET:
+            raise InputError(source, "--times", f"at most {MAX_BUDGET:g} s per run, got {s!r}")
+        if t in out:
+            raise InputError(source, "--times", f"budget {s} given twice")
+        out.append(t)
+    return sorted(out)
+
+
+def run(args) -> int:
+    from ..adapters.glue import OMPL_HINT, ompl_available
+
+    objective = getattr(args, "objective", "length")
+    planners = parse_planners(args.planners or ",".join(default_planners(objective, DEFAULT_PLANNERS)))
+    check_planners(objective, planners)
+    times = parse_times(args.times)
+    if not ompl_available():
+        raise InputError("bench", "--planners", f"the bench runs OMPL's planners, and OMPL is not installed "
+                                                f"({OMPL_HINT})")
+    if args.runs < 1:
+        raise InputError("bench", "--runs", f"must be at least 1, got {args.runs}")
+    if args.workers < 1:
+        raise InputError("bench", "--workers", f"must be at least 1, got {args.workers}")
+    if args.iterations is not None and args.iterations < 1:
+        raise InputError("bench", "--iterations", f"must be at least 1, got {args.iterations}")
+    abort_on = None
+    if args.abort_on:
+        name, _, seed = args.abort_on.partition(":")
+        abort_on = (parse_planners(name)[0], int(seed or 0))
+    out = args.out
+    from ..output import check_folder
+
+    check_folder(out, "--out")
+    held: dict = {}
+    if args.slabs is not None and not 4 <= args.slabs <= 4096:
+        raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
+    scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
+    check_scenarios(objective, held)
+    os.makedirs(out, exist_ok=True)
+    tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on, objective)
+    t0 = time.perf_counter()
+    rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
+                              held=held)
+    meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
+            "iterations": args.iterations, "objective": objective, "workers": args.workers, "scheduler": args.scheduler,
+            "wall_s": time.perf_counter() - t0, "complete": not interrupted,
+            "hard_limit": f"budget * {HARD_FACTOR:g} + {HARD_MARGIN:g} s"}
+    # Never mix two sweeps in one folder: an earlier sweep's outputs go only now, so a sweep
+    # killed before it writes (kill -9, a power cut) leaves the earlier results whole.
+    clear_outputs(out)
+    interrupted = write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
+    if not args.quiet:
+        sys.stderr.write(summary(rows) + "\n")
+        sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
+                         + (" (interrupted)" if interrupted else "") + "\n")
+    return 130 if interrupted else 0

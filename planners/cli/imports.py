@@ -1,0 +1,128 @@
+"""``cspace import``: a ROS occupancy-grid map (``.yaml``) or an OMPL.app problem (``.cfg``)
+as a scenario TOML, with a report of what was read and what the import changed.
+
+The options that say what such a file does not (the robot, the start and goal)
+are shared with ``cspace plan``, which plans these files directly.
+"""
+from __future__ import annotations
+
+import os
+import sys
+
+from ..errors import InputError
+
+
+def register(sub) -> None:
+    p = sub.add_parser("import", help="convert a ROS map (.yaml) or an OMPL.app problem (.cfg) to a scenario",
+                       description="Import a ROS map_server map (YAML + image) or an OMPL.app .cfg problem "
+                                   "(COLLADA meshes, needs pip install -e \".[io]\") and write it as a scenario "
+                                   "TOML; exit 0 written, 2 bad input.")
+    p.add_argument("file", help="map YAML (.yaml) or OMPL.app problem (.cfg)")
+    p.add_argument("--out", required=True, help="scenario TOML to write (never one of the inputs)")
+    add_import_options(p)
+    p.add_argument("--verbose", "-v", action="store_true")
+    p.set_defaults(run=run)
+
+
+def add_import_options(p) -> None:
+    """The robot, start, goal and tracing options (import and plan share them)."""
+    g = p.add_argument_group("imported files (.yaml maps, .cfg problems)")
+    g.add_argument("--robot", metavar="ROBOT.toml", help="the robot: a TOML file with a [robot] table "
+                                                          "(polygon, parts or radius, as in a scenario)")
+    g.add_argument("--radius", type=float, help="the robot: a disk of this radius")
+    g.add_argument("--polygon", metavar="X,Y;X,Y;...", help="the robot: a polygon about its reference point")
+    g.add_argument("--start", metavar="X,Y[,THETA]", help="start pose (a map has none; a .cfg's is overridden)")
+    g.add_argument("--goal", metavar="X,Y[,THETA]", help="goal pose")
+    g.add_argument("--unknown", choices=("obstacle", "free"), default=None,
+                   help="a map's unknown cells: obstacle (default) or free")
+    g.add_argument("--tolerance", type=float, help="largest simplification error of a map's obstacles, in map "
+                                                   "units (default: two cells; 0: the exact staircase of cells)")
+
+
+IMPORT_FLAGS = ("robot", "radius", "polygon", "start", "goal", "unknown", "tolerance")
+
+
+def import_options(args, src: str):
+    """The :class:`cspace.io.imported.ImportOptions` of the parsed options; for a file that
+    is not imported (a scenario TOML) any of them is an error."""
+    from cspace.io.imported import ImportOptions, is_import
+
+    given = [f for f in IMPORT_FLAGS if getattr(args, f, None) is not None]
+    if not is_import(src):
+        if given:
+            raise InputError(src, f"--{given[0]}", "applies to imported files (.yaml maps, .cfg problems) only; "
+                                                   "a scenario TOML names its own")
+        return None
+    robots = [f for f in ("robot", "radius", "polygon") if getattr(args, f) is not None]
+    if len(robots) > 1:
+        raise InputError(src, f"--{robots[1]}", f"--{robots[0]} and --{robots[1]} exclude each other (one robot)")
+    robot = None
+    if args.robot is not None:
+        robot = read_robot(args.robot)
+    elif args.radius is not None:
+        if not (args.radius > 0 and args.radius < float("inf")):
+            raise InputError(src, "--radius", f"must be a positive number, got {args.radius}")
+        robot = {"radius": args.radius}
+    elif args.polygon is not None:
+        robot = {"polygon": [list(_numbers(v, "--polygon", 2, 2)) for v in args.polygon.split(";") if v.strip()]}
+    return ImportOptions(robot=robot,
+                         start=_numbers(args.start, "--start", 2, 3) if args.start is not None else None,
+                         goal=_numbers(args.goal, "--goal", 2, 3) if args.goal is not None else None,
+                         unknown=args.unknown or "obstacle", tolerance=args.tolerance)
+
+
+def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
+    import math
+
+    parts = [t for t in text.replace(" ", ",").split(",") if t]
+    try:
+        vals = tuple(float(t) for t in parts)
+    except ValueError:
+        vals = ()
+    if not lo <= len(vals) <= hi or not all(math.isfinite(v) for v in vals):
+        want = "x,y" if hi == 2 else "x,y or x,y,theta"
+        raise InputError(text, option, f"expected {want} (finite numbers), got {text!r}")
+    return vals
+
+
+def read_robot(path: str) -> dict:
+    """The ``[robot]`` table of a TOML file (a robot file, or any scenario)."""
+    from cspace.io.files import read_input, toml_reader
+
+    tomllib = toml_reader()
+    raw = read_input(path)
+    try:
+        data = tomllib.loads(raw.decode("utf-8-sig"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError, ValueError, RecursionError) as exc:
+        raise InputError(path, "--robot", f"not a TOML file ({str(exc)[:120]})") from None
+    robot = data.get("robot")
+    if not isinstance(robot, dict):
+        raise InputError(path, "robot", "missing: a robot file needs a [robot] table (polygon, parts or radius)")
+    return robot
+
+
+def run(args) -> int:
+    from cspace.io.files import check_input
+    from cspace.io.imported import import_file, is_import, to_toml
+    from cspace.io.validate import scenario_from_dict
+
+    from ..output import check_output, write_text
+
+    src = args.file
+    if not is_import(src):
+        raise InputError(src, "file", "expected a map YAML (.yaml, .yml) or an OMPL.app problem (.cfg)")
+    check_input(src)
+    check_output(args.out, "--out", {".toml": "toml"}, inputs=[src])
+    options = import_options(args, src)
+    imp = import_file(src, options)
+    check_output(args.out, "--out", {".toml": "toml"}, inputs=imp.inputs)  # nor the image or a mesh
+    text = to_toml(imp)
+    scenario_from_dict(imp.data, src)  # what is written loads: start and goal free, polygons valid
+    write_text(args.out, text, "--out")
+    for line in imp.report:
+        print(line)
+    for w in imp.warnings:
+        sys.stderr.write(f"warning: {w}\n")
+    print(f"wrote {args.out}: {len(imp.data.get('obstacles', []))} obstacles, "
+          f"{os.path.getsize(args.out) if os.path.isfile(args.out) else 0} bytes")
+    return 0

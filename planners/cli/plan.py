@@ -1,0 +1,251 @@
+"""``cspace plan``: plan a path for a scenario file, print a summary, write JSON and a plot."""
+from __future__ import annotations
+
+import sys
+import time
+
+from ..adapters.glue import OMPL_HINT, ompl_available
+from ..output import PLOT_FORMATS, check_distinct, check_output, write_json
+
+
+def register(sub) -> None:
+    p = sub.add_parser("plan", help="plan a collision-free path for a scenario",
+                       description="Plan a path for a translating robot, a rotating one (--space se2) or a car "
+                                   "(--space dubins / reeds-shepp); "
+                                   "exit 0 solved, 1 not solved, 2 bad input.")
+    p.add_argument("scenario", help="scenario TOML file, or a ROS map (.yaml) or OMPL.app problem (.cfg) to "
+                                    "import on the fly (see the options for imported files)")
+    p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, else RRTConnect")
+    p.add_argument("--time", type=number, help="time limit in seconds; default: the scenario's, else 1")
+    p.add_argument("--seed", type=integer, help="random seed; default: the scenario's, else 0")
+    p.add_argument("--iterations", type=integer, help="also stop after this many planner iterations (deterministic budget)")
+    p.add_argument("--all-queries", action="store_true", help="plan every [[queries]] entry on one C-space")
+    p.add_argument("--no-simplify", action="store_true", help="keep the planner's raw path")
+    add_space_options(p)
+    p.add_argument("--turning-radius", type=number, help="a car's minimum turning radius (space dubins or "
+                                                         "reeds-shepp); default: the scenario's")
+    p.add_argument("--plot", help="save a picture of the path (.png, .svg or .pdf)")
+    p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
+    p.add_argument("--json", help="write the result as JSON")
+    p.add_argument("--csv", help="write the path's waypoints as CSV (x,y or x,y,theta, with a header)")
+    p.add_argument("--clearance", type=number, help="safety margin D: keep the robot at least D from every "
+                                                     "obstacle (default: the scenario's clearance, else 0)")
+    p.add_argument("--objective", choices=("length", "clearance", "balanced"), default="length",
+                   help="what optimising planners (RRTstar, PRMstar, BITstar, ...) minimise: path length "
+                        "(default), the inverse of the minimum clearance, or length weighted by clearance")
+    p.add_argument("--verbose", "-v", action="store_true", help="print the C-space report and OMPL's messages")
+    from .imports import add_import_options
+
+    add_import_options(p)
+    p.set_defaults(run=run)
+
+
+def add_space_options(p) -> None:
+    """``--space`` and ``--slabs`` (plan, show and bench share them)."""
+    p.add_argument("--space", choices=("translation", "se2", "dubins", "reeds-shepp"),
+                   help="state space: translation (the robot keeps its angle), se2 (it also rotates), "
+                        "dubins or reeds-shepp (a car: forward only, or forward and reverse, along arcs "
+                        "of a minimum turning radius); default: the scenario's, else translation")
+    p.add_argument("--slabs", type=integer, help="SE(2): angle slabs of the sliced C-space (default: derived "
+                                                 "from the robot and the scene)")
+
+
+def number(s: str) -> float:
+    return float(s)
+
+
+def integer(s: str) -> int:
+    return int(s)
+
+
+def run(args) -> int:
+    from cspace.io.files import check_input
+
+    from ..errors import InputError
+
+    src = args.scenario
+    if args.time is not None and not args.time > 0:
+        raise InputError(src, "--time", f"must be a positive number of seconds, got {args.time}")
+    if args.seed is not None and args.seed < 0:
+        raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
+    if args.iterations is not None and args.iterations < 1:
+        raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
+    if args.clearance is not None:
+        from cspace.io.fields import clearance_fault
+
+        if fault := clearance_fault(args.clearance):
+            raise InputError(src, "--clearance", fault)
+    if args.slabs is not None and not 4 <= args.slabs <= 4096:
+        raise InputError(src, "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
+    from ..adapters.glue import MAX_TIME, SEED_LIMIT, planner_name
+
+    if args.time is not None and args.time > MAX_TIME:
+        raise InputError(src, "--time", f"at most {MAX_TIME:g} s (OMPL's clock overflows near 8e9 s), got {args.time:g}")
+    if args.seed is not None and args.seed >= SEED_LIMIT:
+        raise InputError(src, "--seed", f"must be below 2^32 - 1 (OMPL's seeds are 32-bit), got {args.seed}")
+    if args.planner is not None:
+        args.planner = planner_name(args.planner, src, "--planner")
+        if args.planner != "exact" and not ompl_available():
+            raise InputError(src, "--planner", f"{args.planner} needs OMPL, which is not installed "
+                             f"({OMPL_HINT}); --planner exact works without it")
+    elif not ompl_available():
+        sys.stderr.write("note: OMPL is not installed: planning with the exact planner instead "
+                         f"({OMPL_HINT})\n")
+        args.planner = "exact"
+    if args.objective != "length":
+        from ..adapters.objectives import check_objective
+
+        try:
+            check_objective(args.objective, args.planner or "RRTConnect")
+        except ValueError as exc:
+            if args.planner is not None:
+                raise InputError(src, "--objective", str(exc)) from None
+    check_input(src)
+    from .imports import import_options
+
+    options = import_options(args, src)
+    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[src]) if args.plot is not None else None
+    if args.animate is not None:
+        check_output(args.animate, "--animate", {".gif": "gif"}, inputs=[src])
+    if args.json is not None:
+        check_output(args.json, "--json", inputs=[src])
+    if args.csv is not None:
+        check_output(args.csv, "--csv", inputs=[src])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.csv, "--csv")])
+    from ..core.plan import plan
+
+    if args.verbose and args.planner != "exact":
+        from ..adapters.glue import ompl
+
+        ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
+    from cspace.io.scenario import ScenarioError
+
+    scenario = src
+    if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
+        from cspace.io.imported import import_file
+        from cspace.io.scenario import scenario_from_dict
+
+        t_import = time.perf_counter()
+        imp = import_file(src, options)
+        for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate")):
+            if out is not None:
+                check_output(out, opt, inputs=imp.inputs)
+        for w in imp.warnings:
+            sys.stderr.write(f"warning: {w}\n")
+        scenario = scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
+        import_s = time.perf_counter() - t_import
+    try:
+        res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
+                   simplify=not args.no_simplify, all_queries=args.all_queries,
+                   space=args.space, slabs=args.slabs,
+                   turning_radius=None if options is not None else args.turning_radius,
+                   clearance=args.clearance, objective=args.objective)
+    except ScenarioError as exc:
+        if exc.file == "plan()" and exc.field == "objective":  # the file's planner takes no objective
+            raise InputError(src, "--objective", exc.message) from None
+        raise
+    if options is not None:  # the import (meshes or map, then validation) is this run's load
+        res.timings["load"] = res.timings.get("load", 0.0) + import_s
+        res.timings["total"] = res.timings.get("total", 0.0) + import_s
+    print(summary(res, verbose=args.verbose))
+    if args.json is not None:
+        write_json(args.json, res.as_dict(), "--json")
+    if args.csv is not None:
+        from ..output import write_csv
+
+        if res.solved:
+            write_csv(args.csv, res.path, res.path.shape[1] if res.path.ndim == 2 else 2)
+        else:
+            sys.stderr.write(f"note: --csv {args.csv}: no path to write (not solved)\n")
+    if args.plot is not None:
+        from ..pictures.plot import plot_result
+
+        plot_result(res, args.plot, fmt=fmt)
+    if args.animate and res.solved:
+        from ..pictures.animate import animate_path
+
+        animate_path(res, args.animate)
+    elif args.animate:
+        sys.stderr.write(f"note: --animate {args.animate}: nothing to animate (not solved)\n")
+    results = res.queries or [res]
+    return 0 if all(r.solved for r in results) else 1
+
+
+def summary(res, verbose: bool = False) -> str:
+    """A short human summary of a plan.
+
+    With several queries: one line per query (with its own stage times), then the
+    count, then the whole run's total on a line of its own.
+    """
+    lines = []
+    results = res.queries or [res]
+    for i, r in enumerate(results):
+        tag = f"{r.scenario}" + (f" query {i}" if res.queries else "")
+        by = "exact" if r.planner == "exact" else f"{r.planner} (seed {r.seed})"
+        if r.solved:
+            lines.append(f"{tag}: solved by {by}: length {r.length:.6g}, "
+                         f"{len(r.path)} waypoints, solve {r.timings.get('solve', 0.0) * 1e3:.1f} ms")
+        elif r.planner == "exact" and "proven unsolvable" in r.message:
+            lines.append(f"{tag}: proven unsolvable (start and goal are in different free components)")
+        elif r.planner == "exact":
+            lines.append(f"{tag}: NOT solved by exact: {r.message}")
+        else:
+            lines.append(f"{tag}: NOT solved by {by} within the limit: {r.message}")
+        if r.solved:
+            lines.append(clearance_line(r))
+    if res.queries:
+        for i, r in enumerate(res.queries):
+            lines.append(f"query {i} time: " + _times(r.timings, skip=("load", "cspace", "total")))
+        n = sum(r.solved for r in res.queries)
+        lengths = [r.length for r in res.queries if r.solved]
+        mean = f", mean length {sum(lengths) / len(lengths):.6g}" if lengths else ""
+        lines.append(f"{n}/{len(res.queries)} queries solved{mean}")
+        t = res.timings
+        lines.append("total time: " + _times({k: t[k] for k in ("load", "cspace", "total") if k in t}))
+    else:
+        lines.append("time: " + _times(res.timings))
+    lines.append("stages: " + " -> ".join(res.stages))
+    if verbose and res.cspace_report:
+        rep = res.cspace_report
+        lines.append(f"C-space: {rep['pieces']} pieces ({rep['obstacle_pieces']} obstacle pieces x "
+                     f"{max(rep['robot_pieces'], 1)} robot pieces), build {rep['build_seconds'] * 1e3:.1f} ms")
+        for s in rep["stages"]:
+            counts = {k: v for k, v in s.items() if k not in ("stage", "ran", "seconds", "note")}
+            state = "ran" if s["ran"] else "skipped"
+            note = f" ({s['note']})" if s.get("note") else ""
+            lines.append(f"  {s['stage']:<20} {state:<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
+        lines.append(f"checks: {res.checks}")
+    return "\n".join(lines)
+
+
+def clearance_line(r) -> str:
+    """The clearance of a solved path, in words: how close the robot comes, where, and
+    whether the path touches (exact without a clearance: the limit of free paths).
+
+    >>> class R: min_clearance, min_clearance_at, min_clearance_bound, touches, clearance = 0.5, (1.0, 2.0), "exact", False, 0.0
+    >>> clearance_line(R())
+    'min clearance 0.5 at (1, 2) (exact)'
+    """
+    c = r.min_clearance
+    if c is None:
+        return "min clearance: not measured"
+    if c == float("inf"):
+        return "min clearance: inf (no obstacle)"
+    at = ", ".join(f"{v:.6g}" for v in (r.min_clearance_at or ()))
+    kind = "a certified lower bound" if r.min_clearance_bound == "lower" else "exact"
+    text = f"min clearance {c:.6g} at ({at}) ({kind})"
+    if r.clearance > 0:
+        text += f", margin asked {r.clearance:g}"
+    if r.touches:
+        text += ("; the path TOUCHES obstacles (the limit of free paths, not drivable as it is): "
+                 "set a clearance (--clearance D) to keep away from them")
+    return text
+
+
+def _times(t: dict, skip=()) -> str:
+    """``name 1.2 ms, ...`` for a timings dict.
+
+    >>> _times({"solve": 0.0012, "total": 0.5}, skip=("total",))
+    'solve 1.2 ms'
+    """
+    return ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in t.items() if k not in skip)

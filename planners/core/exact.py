@@ -1,0 +1,80 @@
+"""The ``exact`` planner: the true shortest path over the C-space, as a PlanResult.
+
+The geometry lives in :mod:`cspace.spaces.shortest` (a reduced visibility graph over the
+C-obstacle corners, searched lazily with A*). Here it is only wrapped so that it
+answers like any other planner: ``cspace plan --planner exact`` or
+``planners.shortest_path(scenario)``.
+
+The optimum is an infimum: it may touch C-obstacle boundaries, which the planners'
+closed-obstacle validity forbids. So its path is reported as the reference length,
+``exact`` is true when it was computed exactly, and ``solved`` means a path exists;
+``touches`` (filled by :func:`planners.core.plan.plan`) says the path touches an obstacle.
+With a clearance D > 0 the C-obstacles are those of the robot inflated by the margin,
+so the path is the shortest keeping the robot at least D from every obstacle.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .result import PlanResult
+
+
+def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: bool | None = None) -> PlanResult:
+    """Shortest path for one query on a built C-space (search bounded by ``time_limit``).
+
+    A search that lasts longer than :data:`planners.progress.DELAY` shows a bar on a terminal
+    (nodes settled, and a lower bound on the length that rises towards the answer);
+    ``progress=False`` silences it, ``None`` draws it only when stderr is a terminal.
+    """
+    from cspace.spaces.shortest import shortest_path as geometric_shortest
+
+    from .. import progress as pg
+
+    t = time.perf_counter()
+    with pg.progress(None, "exact search", enabled=progress, unit="node", delay=pg.DELAY, tick=1.0) as bar:
+        sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit,
+                                on_progress=pg.search_reporter(bar) if bar.shown else None)
+    dt = time.perf_counter() - t
+    d = getattr(sc, "clearance", 0.0)
+    if sp.solved and d > 0:
+        message = (f"exact shortest path keeping clearance {d:g} (it touches the C-obstacles inflated by "
+                   f"the margin where it bends)")
+    elif sp.solved:
+        message = ("exact shortest path: the limit of free paths, it touches C-obstacle boundaries where it "
+                   "bends (set a clearance to drive it)")
+    elif sp.proven_unsolvable:
+        message = "proven unsolvable (start and goal are in different free components)"
+    else:
+        message = f"no path found ({sp.stats.get('reason', 'search exhausted')})"
+    return PlanResult(
+        scenario=sc.name, solved=bool(sp.solved), exact=bool(sp.solved),
+        path=np.asarray(sp.path, dtype=np.float64) if sp.solved else np.zeros((0, 2)),
+        length=float(sp.length) if sp.solved else math.inf, planner="exact", seed=0,
+        timings={"solve": dt}, checks=dict(sp.stats.get("counts", {})) if isinstance(sp.stats, dict) else {},
+        stages=["visibility"], start=tuple(query.start), goal=tuple(query.goal), message=message,
+        length_unsimplified=float(sp.length) if sp.solved else None,
+    )
+
+
+def exact_se2(sc, query, source: str, time_limit: float | None = None) -> PlanResult:
+    """``exact`` for a rotating robot: there is no exact SE(2) planner, but the inscribed-disk
+    rule (:mod:`planners.core.bounds`) may prove the query unsolvable; then the result says
+    so (not solved, exit 1). Otherwise a ScenarioError on ``planner`` (exit 2) says what to
+    use instead."""
+    from cspace.io.scenario import ScenarioError
+
+    from .bounds import disk_bound
+
+    db = disk_bound(sc, query, time_limit=time_limit if time_limit is not None else 10.0)
+    if not db.proven_unsolvable:
+        raise ScenarioError(source, "planner", f"there is no exact planner for a rotating robot (space = \"{sc.space}\"); "
+                            "the inscribed-disk rule did not prove the scene unsolvable either: use a sampling "
+                            "planner such as RRTConnect")
+    return PlanResult(
+        scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, planner="exact",
+        seed=0, timings={"solve": db.seconds}, checks={}, stages=["disk_bound"], start=tuple(query.start),
+        goal=tuple(query.goal), message=db.message,
+    )

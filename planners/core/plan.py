@@ -1,0 +1,290 @@
+"""Planning a path: scenario -> C-space -> OMPL -> simplified, exactly verified path.
+
+This module owns :func:`plan` and :class:`PlanResult`: it resolves the options, builds
+the C-space, checks the queries, and hands a state-space adapter
+(:mod:`planners.adapters`) to :func:`planners.core.routine.run_planner`, the one routine
+that drives OMPL. ``cspace plan``, ``planners.plan()`` and every ``cspace bench``
+run go through it. A path is reported solved only if OMPL found an exact solution
+*and* the adapter's exact verification accepts the final (simplified) path, from
+the start exactly to the goal exactly.
+"""
+from __future__ import annotations
+
+import math
+import os
+import time
+
+import numpy as np
+
+from cspace.spaces.cspace import CSpace
+from cspace.io.scenario import Scenario, ScenarioError, load_scenario
+
+from ..adapters.frame import path_length  # noqa: F401  (planners.path_length, the API's name)
+from .result import PlanResult
+
+
+MAX_TIME = 1e8  # seconds (about three years); OMPL's steady clock overflows near 8e9 s
+SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit
+
+
+DEFAULT_TIME_SE2 = 10.0  # seconds, when neither the call nor the file gives a time (translation: 1)
+
+
+def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None, turning_radius=None):
+    """Scenario object plus the effective planner, time and seed (arguments over file defaults)."""
+    from ..adapters.glue import planner_name
+
+    t0 = time.perf_counter()
+    if isinstance(scenario, Scenario):
+        sc = scenario
+        if turning_radius is not None and turning_radius != sc.turning_radius:
+            raise ScenarioError("plan()", "turning_radius", "the scenario was loaded with turning_radius "
+                                f"{sc.turning_radius!r}; pass its path to plan with another")
+        if space is not None and space != sc.space:
+            raise ScenarioError("plan()", "space", f"the scenario was loaded as {sc.space!r}; load it with "
+                                                   f"load_scenario(path, space={space!r}) or pass its path")
+    else:
+        sc = load_scenario(os.fspath(scenario), space=space, turning_radius=turning_radius)
+    load_s = time.perf_counter() - t0
+    src = sc.path or "<scenario>"
+    opts = sc.planner
+    # An argument is blamed as an argument of plan(), a file's value as the file's field.
+    def where(arg, fld):
+        return ("plan()", fld) if arg is not None else (src, f"planner.{fld}")
+
+    if planner is not None:
+        name = planner_name(planner, "plan()", "planner")
+    else:
+        name = planner_name(opts.get("name"), src, "planner.name")
+    # SE(2) builds its angle slabs lazily, inside the planner's time: a longer default.
+    t = time_limit if time_limit is not None else opts.get("time", DEFAULT_TIME_SE2 if sc.rotates else 1.0)
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
+        raise ScenarioError(*where(time_limit, "time"), f"must be a positive number of seconds, got {t!r}")
+    if t > MAX_TIME:
+        raise ScenarioError(*where(time_limit, "time"),
+                            f"at most {MAX_TIME:g} s (OMPL's clock overflows near 8e9 s), got {t!r}")
+    s = seed if seed is not None else opts.get("seed", 0)
+    if iterations is not None and (isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1):
+        raise ScenarioError("plan()", "iterations", f"must be a positive integer, got {iterations!r}")
+    if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s < SEED_LIMIT:
+        raise ScenarioError(*where(seed, "seed"), f"must be an integer in [0, 2^32 - 1), got {s!r}")
+    return sc, name, float(t), int(s), load_s
+
+
+def plan(scenario, planner: str | None = None, time: float | None = None, seed: int | None = None,
+         *, simplify: bool = True, iterations: int | None = None, cspace: CSpace | None = None,
+         all_queries: bool = False, slices: bool = False, on_progress=None, space: str | None = None,
+         slabs: int | None = None, turning_radius: float | None = None, clearance: float | None = None,
+         objective: str = "length") -> PlanResult:
+    """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
+
+    ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
+    (defaults: RRTConnect, 1 s, seed 0). ``iterations`` adds a deterministic budget
+    in planner iterations. With ``all_queries`` every ``[[queries]]`` entry is
+    planned on the same C-space (and, for PRM-family planners, the same roadmap),
+    each query with its own seeded random stream; the result then carries
+    ``queries``, one result per query, and the top-level fields describe the first.
+    ``cspace`` reuses a C-space built from the same scenario. ``slices`` and
+    ``on_progress`` are the bench's hooks (see :func:`run_planner`).
+
+    ``space="se2"`` (or ``space = "se2"`` in the file) lets the robot rotate: poses and
+    the path's rows are (x, y, theta), the C-space is the sliced
+    :class:`cspace.spaces.se2.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
+    derived from the scene) and every motion is certified along OMPL's SE(2)
+    interpolation. There is no exact planner in SE(2); ``planner="exact"`` there
+    answers only when the inscribed-disk rule proves the scene unsolvable.
+
+    ``space="dubins"`` or ``"reeds-shepp"`` (with ``turning_radius``, or the file's
+    ``turning_radius``) plans a car: the same poses and C-space, but every motion is the
+    shortest Dubins (forward only) or Reeds–Shepp (forward and reverse) curve, certified
+    segment by segment; ``PlanResult.curves`` holds each motion's segments.
+
+    ``clearance=D`` (over the file's ``clearance``) inflates the robot by a polygon
+    containing the disk of radius D (:mod:`cspace.kernel.margin`): every path then keeps the
+    robot at least D from every obstacle (``exact``: the shortest such path). Each solved
+    result carries ``min_clearance`` (exact in translation, a certified lower bound in
+    SE(2)), where it occurs, and ``touches``. ``objective`` is ``length`` (default),
+    ``clearance`` or ``balanced`` (:mod:`planners.adapters.objectives`).
+
+    >>> import os
+    >>> res = plan(os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "basic.toml"), seed=3)
+    >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
+    (True, [1.0, 1.0], [9.0, 9.0])
+    """
+    sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space, turning_radius)
+    sc = _with_clearance(sc, clearance)
+    try:
+        from ..adapters.objectives import check_objective
+
+        objective = check_objective(objective, name)
+    except ValueError as exc:
+        raise ScenarioError("plan()", "objective", str(exc)) from None
+    se2 = sc.rotates  # SE(2) or a car: poses (x, y, theta) over the sliced C-space
+    if slabs is not None and not se2:
+        raise ScenarioError("plan()", "slabs", 'applies to a rotating robot only (space = "se2", "dubins" or '
+                                               '"reeds-shepp")')
+    if name != "exact":
+        from ..adapters.glue import ompl
+
+        ompl()  # without OMPL: fails here, before the C-space is built
+    wall0 = _now()
+    if cspace is None:
+        t0 = _now()
+        cspace = build_cspace(sc, slabs)
+        build_s = _now() - t0
+    else:
+        build_s = 0.0
+        _check_margin(sc, cspace)
+    report = cspace.report()
+    adapter = make_adapter(sc, cspace)
+    if objective != "length" and getattr(adapter, "clearance_functions", None) is None:
+        raise ScenarioError("plan()", "objective", f"{objective} is not available for space {sc.space!r} "
+                                                   "(translation and se2 only)")
+    queries = sc.all_queries() if all_queries else sc.all_queries()[:1]
+    src = sc.path or "<scenario>"
+    poses = []
+    for i, q in enumerate(queries):
+        pair = (adapter.pose(q.start), adapter.pose(q.goal))
+        for pt, fld in zip(pair, ("start", "goal")):
+            if not adapter.is_free(pt):
+                label = fld if i == 0 else f"queries[{i - 1}].{fld}"
+                why = (f" with clearance {sc.clearance:g} (the robot there is closer than that to an obstacle)"
+                       if sc.clearance > 0 else " with the margin" if sc.margin is not None else "")
+                raise ScenarioError(src, label, f"{pt} is not a free state of the C-space{why}")
+        poses.append(pair)
+    if name == "exact" and se2:
+        from .exact import exact_se2
+
+        results = [exact_se2(sc, q, src, time_limit=tlim) for q in queries]
+    elif name == "exact":
+        from .exact import exact_plan
+
+        results = [exact_plan(sc, cspace, q, time_limit=tlim) for q in queries]
+    else:
+        from .routine import run_planner
+
+        results = run_planner(adapter, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
+                              slices=slices, on_progress=on_progress, scenario=sc.name, objective=objective)
+        if se2:
+            _explain_se2_failures(sc, queries, results)
+        if hasattr(adapter, "curves"):
+            for r in results:
+                r.curves = adapter.curves(r.path) if r.solved else []
+    for r in results:
+        r.clearance, r.objective = sc.clearance, objective
+        _measure_clearance(r, adapter)
+        r.timings = {"load": load_s, "cspace": build_s, **r.timings}
+        r.stages = _stage_names(report) + r.stages
+        r.cspace_report = report
+    first = results[0]
+    first.timings["total"] = load_s + (_now() - wall0)
+    first.cspace_report = cspace.report()
+    first.checks = {**first.checks, **{f"cspace_{k}": v for k, v in cspace.checks.items()}}
+    if all_queries:
+        first.queries = results
+    first.scenario_data, first.cspace = sc, cspace
+    return first
+
+
+def _now() -> float:
+    return time.perf_counter()
+
+
+def _with_clearance(sc: Scenario, clearance) -> Scenario:
+    """The scenario with the margin D of ``plan(clearance=D)`` (the file's when None)."""
+    if clearance is None:
+        return sc
+    from cspace.io.fields import clearance_fault
+
+    fault = clearance_fault(clearance)
+    if fault:
+        raise ScenarioError("plan()", "clearance", fault)
+    if float(clearance) == sc.clearance:
+        return sc
+    import dataclasses
+
+    return dataclasses.replace(sc, clearance=float(clearance))
+
+
+def _check_margin(sc: Scenario, cspace) -> None:
+    """A C-space passed in must have been built with the margin the plan asks for."""
+    want, have = sc.margins(), getattr(cspace, "margin", [])
+    if len(want) != len(have) or not all(np.array_equal(a, b) for a, b in zip(want, have)):
+        raise ScenarioError("plan()", "cspace", f"was built with another margin than clearance {sc.clearance:g}"
+                                                f"{' and [margin]' if sc.margin is not None else ''}: build it from "
+                                                f"the same scenario and clearance, or pass none")
+
+
+def _measure_clearance(r: PlanResult, adapter) -> None:
+    """Fill a solved result's min_clearance (timed as ``clearance``) and ``touches``."""
+    measure = getattr(adapter, "path_clearance", None)  # a car's curves: not measured (yet)
+    if not r.solved or not len(r.path) or measure is None:
+        return
+    t = _now()
+    c = measure(r.path)
+    r.timings["clearance"] = _now() - t
+    r.min_clearance, r.min_clearance_bound = float(c.distance), c.bound
+    r.min_clearance_at = tuple(c.where) or None
+    r.min_clearance_obstacle = tuple(c.obstacle_point) or None
+    r.touches = c.distance == 0.0 and c.bound == "exact"
+
+
+def _stage_names(report: dict) -> list[str]:
+    """The C-space stages that ran (a sliced SE(2) C-space builds its slabs lazily, later)."""
+    if "stages" in report:
+        return [s["stage"] for s in report["stages"] if s["ran"]]
+    return ["decompose", f"slabs (K = {report['slabs']}, lazy)"]
+
+
+def build_cspace(sc: Scenario, slabs: int | None = None):
+    """The C-space a scenario's state space needs: translation, or sliced SE(2)."""
+    if sc.rotates:
+        from cspace.spaces.se2 import SE2CSpace
+
+        return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)
+    return CSpace.from_scenario(sc)
+
+
+def make_adapter(sc: Scenario, cspace):
+    """The state-space adapter of :mod:`planners.adapters` for the scenario's space."""
+    if sc.turning_radius is not None:
+        from ..adapters.car import CarSpace
+
+        return CarSpace(cspace, sc.space, sc.turning_radius)
+    if sc.space == "se2":
+        from ..adapters.se2 import SE2Space
+
+        return SE2Space(cspace)
+    from ..adapters.translation import TranslationSpace
+
+    return TranslationSpace(cspace)
+
+
+def _explain_se2_failures(sc: Scenario, queries, results) -> None:
+    """A rotating robot's plan that failed: does the inscribed-disk rule prove it unsolvable?"""
+    from .bounds import disk_bound
+
+    for q, r in zip(queries, results):
+        if not r.solved:
+            t = _now()
+            db = disk_bound(sc, q, time_limit=5.0)
+            r.timings["disk_bound"] = _now() - t
+            if db.proven_unsolvable:
+                r.message = db.message
+
+
+def run_planner(*args, **kwargs):
+    """See :func:`planners.core.routine.run_planner` (re-exported here)."""
+    from .routine import run_planner as run
+
+    return run(*args, **kwargs)
+
+
+def shortest_path(scenario, query_index: int = 0) -> PlanResult:
+    """Exact shortest path of a scenario (a path or a Scenario), as a :class:`PlanResult`.
+
+    Unsolvable scenes come back with ``solved`` false and a message saying whether
+    that was proven.
+    """
+    return plan(scenario, planner="exact", all_queries=query_index > 0) if query_index == 0 else \
+        plan(scenario, planner="exact", all_queries=True).queries[query_index]
