@@ -109,7 +109,7 @@ def test_ctrl_c_while_writing_outputs_is_not_complete(tmp_path, monkeypatch):
             for t in bench.make_tasks([{"file": BASIC, "scenario": "basic", "optimum": 1.0}], ["RRT"], [0.1], 2)]
     for r in rows:
         del r["order"]
-    monkeypatch.setattr(bench, "plot_error_vs_time", lambda *a: os.kill(os.getpid(), signal.SIGINT))
+    monkeypatch.setattr(bench_figure, "plot_error_vs_time", lambda *a: os.kill(os.getpid(), signal.SIGINT))
     # The handler the process had (Python's default, or SIG_IGN in a background job of a
     # non-interactive shell, which an earlier version of this test wrongly assumed away).
     before = signal.getsignal(signal.SIGINT)
