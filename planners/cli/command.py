@@ -22,6 +22,7 @@ COMMANDS = {
     "stability": "planners.cli.stability",
     "generate": "planners.cli.generate",
     "import": "planners.cli.imports",
+    "check-proof": "planners.cli.check_proof",
 }
 # Each command's one-line help, for the listing of ``cspace --help`` (and a bare
 # ``cspace``), which then imports no command module, nor numpy: start-up stays short.
@@ -33,6 +34,7 @@ HELP = {
     "stability": "run stiff and extreme cases through every layer",
     "generate": "write a random scenario (random, maze, narrow, disks, office)",
     "import": "convert a ROS map (.yaml) or an OMPL.app problem (.cfg) to a scenario",
+    "check-proof": "re-check a proof that no path exists (from plan --proof)",
 }
 
 

@@ -1,0 +1,32 @@
+"""``cspace check-proof SCENARIO PROOF``: re-check a proof that no path exists (written by
+``cspace plan --planner exact --proof FILE``) with the independent checker
+:mod:`planners.core.proof_check`. Exit 0 valid, 1 invalid (the first failed step named),
+2 bad input."""
+from __future__ import annotations
+
+HELP = "re-check a proof that no path exists (from plan --proof)"
+
+
+def register(sub) -> None:
+    p = sub.add_parser("check-proof", help=HELP,
+                       description="Re-check a proof that a rotating robot has no path, independently of the "
+                                   "planner that wrote it. Exit 0 valid, 1 invalid, 2 bad input.")
+    p.add_argument("scenario", help="the scenario TOML the proof is about")
+    p.add_argument("proof", help="the proof (JSON, from cspace plan --planner exact --proof FILE)")
+    p.add_argument("--query", type=int, default=0, help="the query the proof is about (0: start and goal)")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from cspace.io.scenario import load_scenario
+
+    from ..core.proof_check import check_proof, load_proof
+
+    scenario = load_scenario(args.scenario)  # bad input: one line, exit 2 (planners.cli.command)
+    proof = load_proof(args.proof)
+    result = check_proof(scenario, proof, args.query)
+    if result.valid:
+        print(f"proof valid: {result.detail}")
+        return 0
+    print(f"proof invalid: step {result.step}: {result.detail}")
+    return 1
