@@ -17,6 +17,7 @@ well under two minutes on a laptop core; the acceptance sweep behind
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import time
@@ -89,6 +90,19 @@ def se2_slab_figure(scenario: str, theta: float) -> Callable[[str], str]:
         code = main(["show", os.path.join(SCENARIOS, "se2", f"{scenario}.toml"), "--theta", repr(theta),
                      "--plot", out])
         return f"slab of theta {theta:g} (exit {code})"
+
+    return draw
+
+
+def slab_pair_figure(scenario: str, a: float, b: float, c: float) -> Callable[[str], str]:
+    """The exact SE(2) planner's slab graph for the two slabs [a, b] and [b, c]."""
+
+    def draw(out: str) -> str:
+        from cspace.io.scenario import load_scenario
+        from planners.pictures.slab_pair import plot_slab_pair
+
+        plot_slab_pair(load_scenario(os.path.join(SCENARIOS, "se2", f"{scenario}.toml")), a, b, c, out)
+        return f"slabs [{a:.4g}, {b:.4g}] and [{b:.4g}, {c:.4g}]"
 
     return draw
 
@@ -218,6 +232,12 @@ def figures() -> list[Figure]:
     out.append(Figure("se2_car_maze", "se2", "SE(2): a car-shaped body through a maze", se2_plan_figure("car_maze")))
     out.append(Figure("se2_tee_slot_slab", "se2", "SE(2): the slab C-space of theta = pi/2",
                       se2_slab_figure("tee_slot", 1.5707963267948966)))
+    out.append(Figure("plank_corner", "se2exact", "SE(2) exact: a plank carried round a corner",
+                      se2_plan_figure("plank_corner")))
+    out.append(Figure("door_tight", "se2exact", "SE(2) exact: a box through a door 1 % wider than it",
+                      se2_plan_figure("door_tight")))
+    out.append(Figure("bug_trap_l_slabs", "se2exact", "SE(2) exact: the slab graph of the L in the trap",
+                      slab_pair_figure("bug_trap_l", -0.25 * math.pi, 0.0, 0.25 * math.pi)))
     out.append(Figure("car_parking", "car", "car: parallel parking, Reeds-Shepp (GIF beside it)",
                       se2_plan_figure("parking", animate=True, folder="car")))
     out.append(Figure("car_u_turn", "car", "car: a three-point turn in a narrow street", se2_plan_figure("u_turn", folder="car")))

@@ -4,7 +4,9 @@ the tasks, one per (scenario, planner, budget, seed) in a deterministic order.
 The reference of a translation scenario is its exact shortest path
 (:mod:`cspace.spaces.shortest` through ``plan(planner="exact")``); a rotating robot's is
 the inscribed-disk lower bound (:mod:`planners.core.bounds`), so its error is an upper
-bound. The sweep itself is :mod:`planners.bench`.
+bound; in SE(2) the exact planner's certified path (the slab graph, shortened) is also
+computed once, an upper bound on the optimum, with the exact planner's own time. The sweep
+itself is :mod:`planners.bench`.
 """
 from __future__ import annotations
 
@@ -48,9 +50,15 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
                 cs.slab(k)
             db = disk_bound(sc, sc.all_queries()[0])
             bound = db.lower_bound if math.isfinite(db.lower_bound) else None
-            out.append({"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
-                        "space": sc.space, "slabs": cs.slabs})
+            entry = {"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
+                     "space": sc.space, "slabs": cs.slabs, "upper": None}
             note = f"lower bound {bound:.6g} ({db.message})" if bound else db.message
+            if sc.space == "se2":  # a car cannot follow the exact planner's turns in place
+                ex = plan(sc, planner="exact", cspace=cs)
+                entry.update(upper=float(ex.length) if ex.solved else None, exact_s=ex.timings.get("solve"),
+                             exact_total_s=ex.timings.get("total"), exact_message=ex.message)
+                note += f"; exact: {ex.message}"
+            out.append(entry)
         else:
             res = plan(sc, planner="exact")
             cs = res.cspace
@@ -77,6 +85,7 @@ def make_tasks(scenarios, planners, times, runs, iterations=None, abort_on=None,
                 for seed in range(runs):
                     tasks.append({"order": [si, pi, t, seed], "file": sc["file"], "scenario": sc["scenario"],
                                   "optimum": sc["optimum"], "reference": sc.get("reference", "optimum"),
+                                  "upper": sc.get("upper"),
                                   "space": sc.get("space"), "slabs": sc.get("slabs"),
                                   "planner": p, "time_budget": t, "seed": seed,
                                   "iterations": iterations, "objective": objective,

@@ -24,7 +24,7 @@ FIELDS = (
     "scenario", "file", "planner", "time_budget", "seed", "status", "solved",
     "length", "length_unsimplified", "optimum", "reference", "error", "error_unsimplified",
     "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks",
-    "wall_s", "message", "min_clearance", "min_clearance_bound", "clearance_s",
+    "wall_s", "message", "min_clearance", "min_clearance_bound", "clearance_s", "upper", "error_upper",
 )
 
 
@@ -69,6 +69,8 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
         "length": length, "length_unsimplified": raw_len, "optimum": opt,
         "reference": task.get("reference", "optimum"),
         "error": _error(length, opt), "error_unsimplified": _error(raw_len, opt),
+        # SE(2): the exact planner's certified path is an upper bound on the optimum; a run may beat it
+        "upper": task.get("upper"), "error_upper": _error(length, task.get("upper")),
         "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings["solve"],
         "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
         "motion_checks": int(res.checks["motions"]), "wall_s": None,
@@ -110,7 +112,8 @@ def complete_row(task: dict, row: dict, wall: float) -> dict:
     base = {f: None for f in FIELDS}
     base.update({"scenario": task["scenario"], "file": task["file"], "planner": task["planner"],
                  "time_budget": task["time_budget"], "seed": task["seed"], "optimum": task["optimum"],
-                 "reference": task.get("reference", "optimum"), "solved": False, "progress": []})
+                 "reference": task.get("reference", "optimum"), "upper": task.get("upper"), "solved": False,
+                 "progress": []})
     base.update(row)
     base["wall_s"] = wall
     base["order"] = task["order"]

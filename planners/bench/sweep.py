@@ -115,24 +115,38 @@ def _sweep_dask(tasks, scheduler, rows, bar) -> None:
 
 # ---------------------------------------------------------------- statistics
 
-def summary(rows: list[dict]) -> str:
+def summary(rows: list[dict], scenarios: list[dict] | None = None) -> str:
     """A table: median error, median min clearance and success rate at the largest budget,
-    per scenario and planner."""
+    per scenario and planner; in SE(2) the median length against the exact planner's path
+    ("vs exact": length / its length - 1, negative where a run beat it) and, from
+    ``scenarios`` (:func:`reference`'s), the exact planner's own row."""
     from .clearance import clearance_cell
 
-    cs, clear = curves(rows), curves(rows, "min_clearance")
+    cs, clear, vs = curves(rows), curves(rows, "min_clearance"), curves(rows, "error_upper")
     bounded = {r["scenario"] for r in rows if r.get("reference") == "lower_bound"}
     lower = {r["scenario"] for r in rows if r.get("min_clearance_bound") == "lower"}
+    upper = {r["scenario"] for r in rows if r.get("upper") is not None}
     lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'min clearance':>14} "
-             f"{'success':>8}"]
+             f"{'success':>8}" + (f" {'vs exact':>9}" if upper else "")]
     for (scen, p), c in cs.items():
         m = c["median"][-1]
         text = "-" if m is None else (f"<= {m:.4f}" if scen in bounded else f"{m:.4f}")
+        v = vs[scen, p]["median"][-1] if scen in upper else None
         lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} "
-                     f"{clearance_cell(clear[scen, p]['median'][-1], scen in lower):>14} {c['success'][-1]:>8.0%}")
+                     f"{clearance_cell(clear[scen, p]['median'][-1], scen in lower):>14} {c['success'][-1]:>8.0%}"
+                     + (f" {'-' if v is None else f'{v:+.4f}':>9}" if upper else ""))
+    for s in scenarios or []:
+        if "exact_s" in s:  # the exact planner's own row: its time, once (deterministic)
+            lines.append(f"{s['scenario']:<20} {'exact':<16} {'-':>7} {'-':>13} {'-':>14} "
+                         f"{'100%' if s['upper'] is not None else '0%':>8}"
+                         + (f" {'+0.0000' if s['upper'] is not None else '-':>9}" if upper else "")
+                         + f"  ({s['exact_s']:.3g} s: {s['exact_message']})")
     if bounded:
         lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
                      "bound on the error")
     if lower:
         lines.append(">= : an SE(2) path's min clearance is a certified lower bound")
+    if upper:
+        lines.append("vs exact: length / (the exact planner's certified path length) - 1; that path is an upper bound "
+                     "on the optimum")
     return "\n".join(lines)

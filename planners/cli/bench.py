@@ -145,7 +145,7 @@ def run(args) -> int:
     clear_outputs(out)
     interrupted = write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
     if not args.quiet:
-        sys.stderr.write(summary(rows) + "\n")
+        sys.stderr.write(summary(rows, scenarios) + "\n")
         sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
                          + (" (interrupted)" if interrupted else "") + "\n")
     return 130 if interrupted else 0

@@ -28,6 +28,8 @@ def register(sub) -> None:
     p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
     p.add_argument("--json", help="write the result as JSON")
     p.add_argument("--csv", help="write the path's waypoints as CSV (x,y or x,y,theta, with a header)")
+    p.add_argument("--proof", help="a rotating robot or a car proven to have no path: write the proof (JSON), "
+                                   "which `cspace check-proof SCENARIO PROOF` re-checks independently")
     p.add_argument("--clearance", type=number, help="safety margin D: keep the robot at least D from every "
                                                      "obstacle (default: the scenario's clearance, else 0)")
     p.add_argument("--objective", choices=("length", "clearance", "balanced"), default="length",
@@ -111,7 +113,10 @@ def run(args) -> int:
         check_output(args.json, "--json", inputs=[src])
     if args.csv is not None:
         check_output(args.csv, "--csv", inputs=[src])
-    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.csv, "--csv")])
+    if args.proof is not None:
+        check_output(args.proof, "--proof", inputs=[src])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.csv, "--csv"),
+                    (args.proof, "--proof")])
     from ..core.plan import plan
 
     if args.verbose and args.planner != "exact":
@@ -127,7 +132,8 @@ def run(args) -> int:
 
         t_import = time.perf_counter()
         imp = import_file(src, options)
-        for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate")):
+        for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"),
+                         (args.csv, "--csv"), (args.proof, "--proof")):
             if out is not None:
                 check_output(out, opt, inputs=imp.inputs)
         for w in imp.warnings:
@@ -168,7 +174,22 @@ def run(args) -> int:
     elif args.animate:
         sys.stderr.write(f"note: --animate {args.animate}: nothing to animate (not solved)\n")
     results = res.queries or [res]
+    if args.proof is not None:
+        write_proof(args.proof, results)
     return 0 if all(r.solved for r in results) else 1
+
+
+def write_proof(path: str, results: list) -> None:
+    """The first proven query's proof, written atomically (a note when there is none)."""
+    proven = [(i, r) for i, r in enumerate(results) if r.proof is not None]
+    if not proven:
+        sys.stderr.write(f"note: --proof {path}: no proof to write (no query was proven unsolvable"
+                         f"{'' if results[0].path.shape[-1] == 3 else ': proofs are for rotating robots and cars'})\n")
+        return
+    i, r = proven[0]
+    write_json(path, r.proof, "--proof")
+    if len(results) > 1:
+        sys.stderr.write(f"note: --proof {path}: the proof of query {i} (check it with --query {i})\n")
 
 
 def summary(res, verbose: bool = False) -> str:
@@ -185,12 +206,16 @@ def summary(res, verbose: bool = False) -> str:
         if r.solved:
             lines.append(f"{tag}: solved by {by}: length {r.length:.6g}, "
                          f"{len(r.path)} waypoints, solve {r.timings.get('solve', 0.0) * 1e3:.1f} ms")
+        elif "proven unsolvable" in r.message and r.proof is not None:
+            lines.append(f"{tag}: {r.message}")
         elif r.planner == "exact" and "proven unsolvable" in r.message:
             lines.append(f"{tag}: proven unsolvable (start and goal are in different free components)")
         elif r.planner == "exact":
             lines.append(f"{tag}: NOT solved by exact: {r.message}")
         else:
             lines.append(f"{tag}: NOT solved by {by} within the limit: {r.message}")
+        if r.solved and r.planner == "exact" and r.path.shape[1] == 3:
+            lines.append(r.message)
         if r.solved:
             lines.append(clearance_line(r))
     if res.queries:
@@ -205,7 +230,10 @@ def summary(res, verbose: bool = False) -> str:
     else:
         lines.append("time: " + _times(res.timings))
     lines.append("stages: " + " -> ".join(res.stages))
-    if verbose and res.cspace_report:
+    if verbose and res.cspace_report and "slabs" in res.cspace_report:  # a rotating robot's sliced C-space
+        lines += se2_report_lines(res.cspace_report)
+        lines.append(f"checks: {res.checks}")
+    elif verbose and res.cspace_report:
         rep = res.cspace_report
         lines.append(f"C-space: {rep['pieces']} pieces ({rep['obstacle_pieces']} obstacle pieces x "
                      f"{max(rep['robot_pieces'], 1)} robot pieces), build {rep['build_seconds'] * 1e3:.1f} ms")
@@ -216,6 +244,22 @@ def summary(res, verbose: bool = False) -> str:
             lines.append(f"  {s['stage']:<20} {state:<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
         lines.append(f"checks: {res.checks}")
     return "\n".join(lines)
+
+
+def se2_report_lines(rep: dict) -> list[str]:
+    """The sliced C-space of a rotating robot in words: K and why, the pieces, the slabs built.
+
+    >>> se2_report_lines({"slabs": 8, "slabs_reason": "given", "obstacle_pieces": 2, "robot_pieces": 1,
+    ...                   "setup_seconds": 0.001, "build_seconds": 0.002, "slabs_built": []})[0]
+    'C-space: 8 slabs (given), 2 obstacle pieces x 1 robot pieces, setup 1.0 ms; 0 slabs built in 2.0 ms'
+    """
+    lines = [f"C-space: {rep['slabs']} slabs ({rep['slabs_reason']}), {rep['obstacle_pieces']} obstacle pieces x "
+             f"{rep['robot_pieces']} robot pieces, setup {rep['setup_seconds'] * 1e3:.1f} ms; "
+             f"{len(rep['slabs_built'])} slabs built in {rep['build_seconds'] * 1e3:.1f} ms"]
+    for d in rep["slabs_built"]:
+        lines.append(f"  slab {d['slab']:<5} {d['seconds'] * 1e3:8.2f} ms  {d['pieces']} pieces, "
+                     f"{d.get('inner_pieces', 0)} certified-blocked pieces")
+    return lines
 
 
 def clearance_line(r) -> str:

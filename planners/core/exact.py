@@ -57,24 +57,3 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
         stages=["visibility"], start=tuple(query.start), goal=tuple(query.goal), message=message,
         length_unsimplified=float(sp.length) if sp.solved else None,
     )
-
-
-def exact_se2(sc, query, source: str, time_limit: float | None = None) -> PlanResult:
-    """``exact`` for a rotating robot: there is no exact SE(2) planner, but the inscribed-disk
-    rule (:mod:`planners.core.bounds`) may prove the query unsolvable; then the result says
-    so (not solved, exit 1). Otherwise a ScenarioError on ``planner`` (exit 2) says what to
-    use instead."""
-    from cspace.io.scenario import ScenarioError
-
-    from .bounds import disk_bound
-
-    db = disk_bound(sc, query, time_limit=time_limit if time_limit is not None else 10.0)
-    if not db.proven_unsolvable:
-        raise ScenarioError(source, "planner", f"there is no exact planner for a rotating robot (space = \"{sc.space}\"); "
-                            "the inscribed-disk rule did not prove the scene unsolvable either: use a sampling "
-                            "planner such as RRTConnect")
-    return PlanResult(
-        scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, planner="exact",
-        seed=0, timings={"solve": db.seconds}, checks={}, stages=["disk_bound"], start=tuple(query.start),
-        goal=tuple(query.goal), message=db.message,
-    )

@@ -153,9 +153,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
                 raise ScenarioError(src, label, f"{pt} is not a free state of the C-space{why}")
         poses.append(pair)
     if name == "exact" and se2:
-        from .exact import exact_se2
+        from .exact_se2 import exact_se2
 
-        results = [exact_se2(sc, q, src, time_limit=tlim) for q in queries]
+        results = [exact_se2(sc, cspace, adapter, q, src, time_limit=tlim, simplify=simplify) for q in queries]
     elif name == "exact":
         from .exact import exact_plan
 
@@ -163,8 +163,16 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     else:
         from .routine import run_planner
 
-        results = run_planner(adapter, name, poses, tlim, sd, iterations=iterations, simplify=simplify,
-                              slices=slices, on_progress=on_progress, scenario=sc.name, objective=objective)
+        proven, spent = (_proofs_before_sampling(sc, cspace, queries, tlim, name, sd) if se2
+                         else ([None] * len(queries), [0.0] * len(queries)))
+        todo = [pair for pair, p in zip(poses, proven) if p is None]
+        sampled = iter(run_planner(adapter, name, todo, tlim, sd, iterations=iterations, simplify=simplify,
+                                   slices=slices, on_progress=on_progress, scenario=sc.name, objective=objective)
+                       if todo else [])
+        results = [p if p is not None else next(sampled) for p in proven]
+        if se2:
+            for r, t in zip(results, spent):
+                r.timings = {"proof": t, **r.timings}
         if se2:
             _explain_se2_failures(sc, queries, results)
         if hasattr(adapter, "curves"):
@@ -260,12 +268,32 @@ def make_adapter(sc: Scenario, cspace):
     return TranslationSpace(cspace)
 
 
+def _proofs_before_sampling(sc: Scenario, cspace, queries, tlim: float, name: str, seed: int) -> tuple[list, list]:
+    """A rotating robot's queries that the slab graph's POSSIBLE regions prove unsolvable within a
+    small share of the time limit (:func:`planners.core.exact_se2.quick_proof`): answered
+    without sampling; None for the others; and the seconds each check took. A point robot does
+    not turn: nothing to prove."""
+    if not cspace.body_pieces:
+        return [None] * len(queries), [0.0] * len(queries)
+    from .exact_se2 import quick_proof
+
+    out, spent = [], []
+    for q in queries:
+        t = _now()
+        r = quick_proof(sc, cspace, q, tlim) if tuple(q.start) != tuple(q.goal) else None
+        if r is not None:
+            r.planner, r.seed = name, seed
+        out.append(r)
+        spent.append(_now() - t)
+    return out, spent
+
+
 def _explain_se2_failures(sc: Scenario, queries, results) -> None:
     """A rotating robot's plan that failed: does the inscribed-disk rule prove it unsolvable?"""
     from .bounds import disk_bound
 
     for q, r in zip(queries, results):
-        if not r.solved:
+        if not r.solved and r.proof is None:  # a proof from the slab graph says more already
             t = _now()
             db = disk_bound(sc, q, time_limit=5.0)
             r.timings["disk_bound"] = _now() - t

@@ -53,6 +53,9 @@ class PlanResult:
     # A car's path: per motion its start and end poses and its segments (type, length,
     # direction), see planners.adapters.car.CarSpace.curves; None for other spaces.
     curves: list | None = None
+    # A rotating robot's proof that no path exists (cspace.spaces.se2_exact's JSON form; written
+    # by ``cspace plan --proof FILE``, re-checked by ``cspace check-proof``); None otherwise.
+    proof: dict | None = field(default=None, repr=False, compare=False)
     # The objects behind the result, for plots and further queries (not serialised).
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
@@ -85,6 +88,7 @@ class PlanResult:
             "min_clearance_obstacle": list(self.min_clearance_obstacle) if self.min_clearance_obstacle else None,
             "min_clearance_bound": self.min_clearance_bound,
             "touches": self.touches,
+            "proven_unsolvable": self.proof is not None or "proven unsolvable" in self.message,
         }
         if self.curves is not None:
             d["curves"] = self.curves

@@ -1,0 +1,137 @@
+"""``exact`` for a rotating robot: the slab graph's certified path, its proof that no path
+exists, or the resolution it reached (:mod:`cspace.spaces.se2_exact`), as a PlanResult.
+
+- *solved*: the slab graph's path (translations at fixed angles, each the exact shortest path
+  inside its component, and rotations in place) is re-verified motion by motion by the
+  SE(2) C-space's certified validator (the one OMPL's planners use), then shortened by OMPL's
+  simplifier under that same validator and verified again; the result keeps both lengths
+  (``length_unsimplified`` is the slab graph's). Without OMPL the shortening is skipped.
+- *proven unsolvable*: the POSSIBLE graph separates start and goal: no collision-free path
+  exists at any resolution; the proof (``PlanResult.proof``) can be written out and re-checked
+  by ``cspace check-proof``.
+- *not decided*: refinement reached its floor or the time limit: no path keeps more than D
+  from the obstacles (D = r·Δ, the note's resolution statement).
+
+A car moves along SE(2) paths, so the POSSIBLE graph's proof holds for it too; a car cannot
+turn in place, so its ``exact`` answers only with a proof. :func:`quick_proof` is the cheap end
+(the POSSIBLE graph at the first 8 slabs, no refinement), run before a sampling planner spends its budget.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .result import PlanResult
+
+QUICK_SHARE = 0.1   # of the time limit, at most, for the proof before sampling
+QUICK_MAX = 1.0     # seconds, at most, whatever the limit
+CAR_SLABS = 128     # the finest partition a car's proof-only search tries
+
+
+def search(cspace, query, time_limit: float | None, *, possible_only: bool = False, refine: bool = True,
+           min_width: float | None = None):
+    """The slab-graph search on an SE(2) C-space's pieces (body frame; its margin, if any,
+    inflates the robot for the path, while a proof is made for the body itself)."""
+    from cspace.spaces.se2_exact import exact_se2_search
+
+    return exact_se2_search(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, tuple(query.start),
+                            tuple(query.goal), time_limit=time_limit, margin=cspace.margin or None,
+                            possible_only=possible_only, refine=refine,
+                            **({} if min_width is None else {"min_width": min_width}))
+
+
+def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None = None,
+              simplify: bool = True) -> PlanResult:
+    """``planner = "exact"`` for a rotating robot (``space = "se2"``) or a car (a proof or nothing)."""
+    from cspace.io.scenario import ScenarioError
+
+    car = sc.space != "se2"
+    t0 = time.perf_counter()
+    # a car's proof-only search stops at CAR_SLABS slabs: past that, a proof is unlikely and the
+    # user is waiting for the advice to sample
+    res = search(cspace, query, time_limit, possible_only=car, min_width=2 * math.pi / CAR_SLABS if car else None)
+    search_s = time.perf_counter() - t0
+    st = res.stats
+    checks = {"slabs": st["slabs"], "refinements": st["refinements"],
+              **{f"{g}_{k}": v for g, d in st.get("graphs", {}).items() for k, v in d.items()},
+              **{f"regions_{k}": v for k, v in st.get("regions_built", {}).items()}}
+    timings = {"solve": search_s, "solve_cpu": st["cpu_seconds"],
+               **{f"slab_{k}": v for k, v in st.get("seconds", {}).items()}}
+    base = dict(scenario=sc.name, planner="exact", seed=0, start=tuple(query.start), goal=tuple(query.goal),
+                checks=checks, stages=["slab graph"])
+    graph = f"{st['slabs']} slabs, {st['refinements']} refinements"
+    if res.status == "unsolvable":
+        return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
+                          message=f"proven unsolvable: no collision-free path exists at any resolution (the "
+                                  f"slab graph's POSSIBLE regions separate start and goal; {graph})",
+                          proof=res.proof, **base)
+    if car:
+        raise ScenarioError(source, "planner", f"a car (space = \"{sc.space}\") cannot turn in place, so exact answers "
+                                               f"it only with a proof that no path exists, and the slab graph found "
+                                               f"none ({graph}): use a sampling planner such as RRTConnect")
+    if res.status == "undecided":
+        why = st.get("error") or st.get("reason", "")
+        return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
+                          message=f"not decided ({why}; {graph}): {st['statement']}; try a longer --time, or a "
+                                  "sampling planner (it may find a path closer to the obstacles)", **base)
+    raw = np.asarray(res.path, dtype=np.float64)
+    t1 = time.perf_counter()
+    ok, why = adapter.verify(raw, query.start, query.goal)
+    timings["verify"] = time.perf_counter() - t1
+    if not ok:  # the slab graph certifies its path; this re-check is the second opinion
+        return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
+                          message=f"the slab graph's path failed the certified re-check ({why}): not solved", **base)
+    path, note = raw, "OMPL not installed: not shortened"
+    if simplify:
+        t2 = time.perf_counter()
+        path, note = shorten(adapter, raw, query)
+        timings["simplify"] = time.perf_counter() - t2
+        base["stages"] = ["slab graph", "verify", "simplify"]
+    length, raw_len = adapter.length(path), adapter.length(raw)
+    return PlanResult(solved=True, exact=True, path=path, length=length, timings=timings,
+                      message=f"certified path from the slab graph ({graph}; length {raw_len:.6g}, {note})",
+                      length_unsimplified=raw_len, **base)
+
+
+def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:
+    """``path`` shortened by OMPL's simplifier under the adapter's certified motion validator,
+    and verified again; the original path where OMPL is missing or the result is not better.
+    Deterministic: OMPL's random stream is seeded with 0 (:func:`make_setup`)."""
+    from ..adapters.glue import make_setup, ompl, ompl_available
+
+    if not ompl_available() or len(path) < 3:
+        return path, "OMPL not installed: not shortened" if len(path) >= 3 else "nothing to shorten"
+    og = ompl()[1]
+    ss, _space, _checker, _validator = make_setup(adapter, "RRTConnect", 0)
+    ss.setup()
+    si = ss.getSpaceInformation()
+    p = og.PathGeometric(si)
+    for pose in path:
+        s = si.allocState()
+        adapter.set_state(s, pose)
+        p.append(s)
+    og.PathSimplifier(si).simplifyMax(p)
+    out = adapter.path_array(p)
+    out[0], out[-1] = path[0], path[-1]  # the exact ends (the states' round trip may round x, y)
+    ok, _ = adapter.verify(out, query.start, query.goal)
+    if ok and adapter.length(out) <= adapter.length(path):
+        return out, f"shortened to {adapter.length(out):.6g} by OMPL's simplifier"
+    return path, "OMPL's simplifier did not shorten it"
+
+
+def quick_proof(sc, cspace, query, time_limit: float) -> PlanResult | None:
+    """Before a sampling planner spends its budget: the POSSIBLE graph at the first slabs, within
+    a small share of the time limit. A result (not solved, proven unsolvable) when it separates
+    start and goal, else None (the planner runs)."""
+    budget = min(QUICK_SHARE * time_limit, QUICK_MAX)
+    res = search(cspace, query, budget, possible_only=True, refine=False)
+    if res.status != "unsolvable":
+        return None
+    return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,
+                      planner="", seed=0, start=tuple(query.start), goal=tuple(query.goal),
+                      timings={}, checks={"slabs": res.stats["slabs"]},
+                      stages=["slab graph"], proof=res.proof,
+                      message="proven unsolvable before sampling: no collision-free path exists at any resolution "
+                              f"(the slab graph's POSSIBLE regions at {res.stats['slabs']} slabs separate start and goal)")

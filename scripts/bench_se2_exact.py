@@ -1,0 +1,136 @@
+"""The exact SE(2) planner (the slab graph) against RRTConnect, side by side, CPU time.
+
+Per bundled SE(2) scene (scenarios/se2/*.toml), rounds interleave, in one process:
+
+- ``exact``: ``planners.plan(sc, planner="exact")``, the C-space built inside the call (as
+  ``cspace plan`` does). Reported: its answer, the CPU time to the certified path (the slab
+  graph's search, ``timings["solve"]``), and the CPU time of the whole call (C-space, search,
+  the certified re-check, OMPL's shortening, the clearance measure);
+- ``RRTConnect``: ``planners.plan(sc, planner="RRTConnect", time=T, seed=r)``, the default
+  planner, with the proof before sampling that every rotating plan now runs. Reported: the
+  seeds solved within T, those proven unsolvable before sampling ("proven"), the median CPU
+  time of its calls, and the median time to its first solution (OMPL's solve) over the solved
+  seeds;
+
+and the ratio exact / RRTConnect of the medians. Every path either returns is judged by the
+independent shapely sweep (scripts/sweep_oracle.py): colliding paths are counted.
+
+Targets (issue 34): plank_corner solved by exact in <= 1 s CPU where RRTConnect at 30 s fails
+most seeds; wide_square (a robot too wide for every gap) proven unsolvable in <= 0.1 s with the
+default planner; bug_trap_l (an L-shaped robot in a bug trap) in <= 0.2 s; every scene answered
+by exact in <= 2 s, and exact's time to a certified path <= RRTConnect's median time to a first
+solution on at least half of the scenes RRTConnect solves.
+
+Usage: python scripts/bench_se2_exact.py [--seeds N] [--time T] [--scenes a,b] [--json FILE]
+"""
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import os
+import statistics
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import planners  # noqa: E402
+import sweep_oracle  # noqa: E402
+from cspace.io.scenario import load_scenario  # noqa: E402
+
+TARGETS = {"plank_corner": 1.0, "wide_square": 0.1, "bug_trap_l": 0.2}
+
+
+def cpu(fn):
+    """``(fn(), CPU seconds)``."""
+    t = time.process_time()
+    out = fn()
+    return out, time.process_time() - t
+
+
+def collides(sc, res) -> bool:
+    if not res.solved:
+        return False
+    j = sweep_oracle.sweep_check(sc, res.path)
+    return bool(j["collides"] or j["out_of_bounds"])
+
+
+def run_scene(path: str, seeds: int, limit: float) -> dict:
+    sc = load_scenario(path)
+    name = os.path.splitext(os.path.basename(path))[0]
+    ex_search, ex_total, rrt_total, rrt_first, answers = [], [], [], [], set()
+    rrt_solved, proven, bad = 0, 0, {"exact": 0, "rrt": 0}
+    for seed in range(seeds):  # interleaved: one exact run, one RRTConnect seed
+        ex, t_ex = cpu(lambda: planners.plan(sc, planner="exact", time=30.0))
+        ex_total.append(t_ex)
+        ex_search.append(ex.timings.get("solve_cpu", t_ex))
+        answers.add("solved" if ex.solved else ("proven unsolvable" if ex.proof is not None else "not decided"))
+        bad["exact"] += collides(sc, ex)
+        rr, t_rr = cpu(lambda: planners.plan(sc, planner="RRTConnect", time=limit, seed=seed))
+        rrt_total.append(t_rr)
+        if rr.solved:
+            rrt_solved += 1
+            rrt_first.append(rr.timings.get("solve", t_rr))
+        elif rr.proof is not None:
+            proven += 1
+        bad["rrt"] += collides(sc, rr)
+    med = statistics.median
+    row = {"scene": name, "expect": sc.expect or "solvable", "exact_answer": " / ".join(sorted(answers)),
+           "exact_search_cpu_s": med(ex_search), "exact_total_cpu_s": med(ex_total), "exact_max_total_cpu_s": max(ex_total),
+           "rrt_solved": rrt_solved, "rrt_proven": proven, "seeds": seeds, "rrt_total_cpu_s": med(rrt_total),
+           "rrt_first_solution_s": med(rrt_first) if rrt_first else None, "colliding": bad}
+    row["ratio_total"] = row["exact_total_cpu_s"] / row["rrt_total_cpu_s"]
+    row["exact_first"] = row["rrt_first_solution_s"] is not None and row["exact_search_cpu_s"] <= row["rrt_first_solution_s"]
+    return row
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=10, help="RRTConnect seeds (and exact repetitions) per scene")
+    ap.add_argument("--time", type=float, default=30.0, help="RRTConnect's time limit per seed (s)")
+    ap.add_argument("--scenes", help="comma-separated scene names (default: every scenarios/se2/*.toml)")
+    ap.add_argument("--json", help="write the rows as JSON")
+    args = ap.parse_args(argv)
+    paths = sorted(glob.glob(os.path.join(ROOT, "scenarios", "se2", "*.toml")))
+    if args.scenes:
+        want = set(args.scenes.split(","))
+        paths = [p for p in paths if os.path.splitext(os.path.basename(p))[0] in want]
+    rows = []
+    print(f"{'scene':<16} {'exact answer':<18} {'search s':>9} {'total s':>8} {'RRTConnect':>10} {'proven':>6} "
+          f"{'RRT s':>7} {'RRT 1st s':>9} {'exact/RRT':>9} {'colliding':>10}")
+    for p in paths:
+        r = run_scene(p, args.seeds, args.time)
+        rows.append(r)
+        first = "-" if r["rrt_first_solution_s"] is None else f"{r['rrt_first_solution_s']:.3f}"
+        print(f"{r['scene']:<16} {r['exact_answer'][:18]:<18} {r['exact_search_cpu_s']:9.3f} {r['exact_total_cpu_s']:8.3f} "
+              f"{r['rrt_solved']:>4}/{r['seeds']:<5} {r['rrt_proven']:>6} {r['rrt_total_cpu_s']:7.3f} {first:>9} {r['ratio_total']:9.3f} "
+              f"{r['colliding']['exact']:>4} /{r['colliding']['rrt']:>3}", flush=True)
+    print("\ntargets:")
+    for name, t in TARGETS.items():
+        r = next((r for r in rows if r["scene"] == name), None)
+        if r is None:
+            continue
+        got = r["rrt_total_cpu_s"] if name != "plank_corner" else r["exact_search_cpu_s"]
+        what = "RRTConnect's plan() (the proof before sampling)" if name != "plank_corner" else "exact's certified path"
+        print(f"  {name}: {what} {got:.3f} s CPU (target <= {t:g} s): {'met' if got <= t else 'MISSED'}")
+    worst = max(r["exact_max_total_cpu_s"] for r in rows)
+    print(f"  every scene answered by exact: slowest {worst:.3f} s CPU (target <= 2 s): {'met' if worst <= 2 else 'MISSED'}")
+    solved = [r for r in rows if r["rrt_first_solution_s"] is not None]
+    faster = sum(r["exact_first"] for r in solved)
+    print(f"  exact's certified path no later than RRTConnect's first solution: {faster}/{len(solved)} scenes "
+          f"(target: at least half): {'met' if 2 * faster >= len(solved) else 'MISSED'}")
+    print(f"  colliding paths: exact {sum(r['colliding']['exact'] for r in rows)}, "
+          f"RRTConnect {sum(r['colliding']['rrt'] for r in rows)}")
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(rows, fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    code = main()
+    sys.stdout.flush()
+    os._exit(code)  # skip the bindings' "nanobind: leaked" report
