@@ -43,6 +43,13 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
         from .imported import load_imported
 
         return load_imported(path, space=space, options=options, turning_radius=turning_radius)
+    return scenario_from_dict(read_toml(path), path, space=space, turning_radius=turning_radius)
+
+
+def read_toml(path) -> dict:
+    """A TOML file as a dict: a regular file within the size limit, UTF-8 (BOM allowed),
+    valid TOML; any fault is one :class:`ScenarioError` line naming the file."""
+    path = os.fspath(path)
     raw = read_input(path)
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in raw[:4096]:
         raise ScenarioError(path, "file", "UTF-16 or binary, not UTF-8 text (save the file as UTF-8)")
@@ -56,4 +63,4 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
         raise ScenarioError(path, "toml", f"invalid TOML ({exc})") from None
     except RecursionError:
         raise ScenarioError(path, "toml", "invalid TOML (arrays or tables nested too deeply)") from None
-    return scenario_from_dict(data, path, space=space, turning_radius=turning_radius)
+    return data

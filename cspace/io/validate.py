@@ -114,6 +114,36 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
     return sc
 
 
+def with_queries(sc: Scenario, data: dict, path: str) -> Scenario:
+    """``sc`` with the queries of a queries file (``data``: its parsed TOML, whose one key is
+    ``queries``, an array of ``{start, goal}`` tables as in a scenario) instead of its own,
+    the first becoming its start and goal; every pose is checked as a scenario's (in the
+    bounds, the robot touching nothing). Faults name ``path``, the queries file.
+
+    >>> import numpy as np
+    >>> from .schema import Shape
+    >>> sc = Scenario(name="s", bounds=(0.0, 4.0, 0.0, 4.0), robot=[], obstacles=[], start=(1.0, 1.0), goal=(2.0, 2.0))
+    >>> q = with_queries(sc, {"queries": [{"start": [0.5, 0.5], "goal": [3, 3]}, {"start": [1, 3], "goal": [3, 1]}]}, "q.toml")
+    >>> q.start, q.goal, len(q.all_queries())
+    ((0.5, 0.5), (3.0, 3.0), 2)
+    """
+    import dataclasses
+
+    v = _Validator(path)
+    if not isinstance(data, dict):
+        raise v.err("queries", "must be a TOML document with [[queries]] tables")
+    v.no_extra(data, "", {"queries"})
+    queries = v.queries(data.get("queries", []), sc.rotates)
+    if not queries:
+        raise v.err("queries", "none given: add [[queries]] tables with start and goal")
+    out = dataclasses.replace(sc, start=queries[0].start, goal=queries[0].goal, queries=queries)
+    labelled = [(pt, f"queries[{i}].{k}") for i, q in enumerate(queries) for pt, k in ((q.start, "start"), (q.goal, "goal"))]
+    hits = CollisionProbe(out).first_hits([pt for pt, _ in labelled])
+    for (pt, fld), hit in zip(labelled, hits):
+        v.placement(out, pt, hit, fld)
+    return out
+
+
 class _Validator(ShapeChecks):
     """The field and shape checks, and where starts and goals may be."""
 

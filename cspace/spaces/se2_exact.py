@@ -68,7 +68,8 @@ class _Timeout(Exception):
 
 def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, goal, *,
                      time_limit: float | None = None, min_width: float = TWO_PI / 2048, initial_slabs: int = 8,
-                     margin: list | None = None, possible_only: bool = False, refine: bool = True) -> SE2ExactResult:
+                     margin: list | None = None, possible_only: bool = False, refine: bool = True,
+                     regions: SlabRegions | None = None) -> SE2ExactResult:
     """Plan for a robot of convex ``robot_pieces`` (body frame) among convex ``obstacle_pieces``:
     a certified path, a proof that none exists, or "undecided" at the resolution reached.
 
@@ -77,6 +78,8 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
     is made for the body itself (a stronger statement). ``possible_only``: look for a proof
     only (no FREE regions, no path: a car, or the check before sampling); its refinement
     bisects every slab; ``refine=False`` stops after the first partition ("undecided").
+    ``regions``: a :class:`SlabRegions` of the same pieces, bounds and margin from an earlier
+    search (its regions and links are cached: queries on one scene share them).
 
     >>> wall = [np.array([[4., 0], [5, 0], [5, 4], [4, 4]]), np.array([[4., 6], [5, 6], [5, 10], [4, 10]])]
     >>> bar = [np.array([[-1.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-1.5, 0.2]])]
@@ -93,15 +96,37 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
     robot = [np.asarray(p, dtype=np.float64) for p in robot_pieces]
     if not robot:
         raise ValueError("exact_se2_search: needs a robot of at least one convex piece (a point robot does not turn)")
+    if regions is None:
+        regions = slab_regions(obstacle_pieces, robot, bounds, margin)
+    search = _Search(regions, start, goal, time_limit, float(min_width), initial_slabs)
+    search.possible_only, search.refine = bool(possible_only), bool(refine)
+    return search.run()
+
+
+def initial_partition(n: int = 8) -> list[tuple[float, float]]:
+    """The search's first slabs: ``n`` equal ones from −π, the last ending one ulp above the float
+    π (which is below the true π), so that they cover the circle in exact arithmetic (last b −
+    first a > 2π), as a proof needs.
+
+    >>> p = initial_partition(8)
+    >>> len(p), p[0][0] == -math.pi, p[-1][1] > math.pi, all(p[k][1] == p[k + 1][0] for k in range(7))
+    (8, True, True, True)
+    """
+    part = [slab_range(k, n) for k in range(n)]
+    part[-1] = (part[-1][0], math.nextafter(math.pi, math.inf))
+    return part
+
+
+def slab_regions(obstacle_pieces: list, robot_pieces: list, bounds, margin: list | None = None) -> SlabRegions:
+    """The :class:`SlabRegions` :func:`exact_se2_search` works on (FREE with the robot inflated by
+    ``margin``, POSSIBLE with the body), to keep and pass to several searches."""
+    robot = [np.asarray(p, dtype=np.float64) for p in robot_pieces]
     hull = None
     if margin:
         from .cspace_build import inflated
 
         hull = inflated(robot, [np.asarray(m, dtype=np.float64) for m in margin])
-    regions = SlabRegions(obstacle_pieces, robot, bounds, hull_pieces=hull)
-    search = _Search(regions, start, goal, time_limit, float(min_width), initial_slabs)
-    search.possible_only, search.refine = bool(possible_only), bool(refine)
-    return search.run()
+    return SlabRegions(obstacle_pieces, robot, bounds, hull_pieces=hull)
 
 
 def from_scenario(scenario, query_index: int = 0, **kwargs) -> SE2ExactResult:
@@ -141,10 +166,7 @@ class _Search:
         self.t0, self.c0 = time.perf_counter(), time.process_time()
         self.deadline = None if time_limit is None else self.t0 + float(time_limit)
         self.min_width = min_width
-        self.part = [slab_range(k, initial_slabs) for k in range(initial_slabs)]
-        # The float π is below the true π: the last slab ends one ulp above it, so that the slabs
-        # cover the whole circle in exact arithmetic (last b − first a > 2π), as a proof needs.
-        self.part[-1] = (self.part[-1][0], math.nextafter(math.pi, math.inf))
+        self.part = initial_partition(initial_slabs)
         self.times = {"regions": 0.0, "graphs": 0.0, "path": 0.0}
         self.possible_only, self.refine = False, True
         self.refinements = 0

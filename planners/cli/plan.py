@@ -20,6 +20,8 @@ def register(sub) -> None:
     p.add_argument("--seed", type=integer, help="random seed; default: the scenario's, else 0")
     p.add_argument("--iterations", type=integer, help="also stop after this many planner iterations (deterministic budget)")
     p.add_argument("--all-queries", action="store_true", help="plan every [[queries]] entry on one C-space")
+    p.add_argument("--queries", metavar="FILE", help="plan these [[queries]] (a TOML file of start/goal tables) "
+                                                     "instead of the scenario's, all on one C-space")
     p.add_argument("--no-simplify", action="store_true", help="keep the planner's raw path")
     add_space_options(p)
     p.add_argument("--turning-radius", type=number, help="a car's minimum turning radius (space dubins or "
@@ -106,15 +108,30 @@ def run(args) -> int:
     from .imports import import_options
 
     options = import_options(args, src)
-    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[src]) if args.plot is not None else None
+    queries = None
+    if args.queries is not None:
+        from cspace.io.scenario import read_toml
+
+        check_input(args.queries)
+        queries = read_toml(args.queries)
+        args.all_queries = True
+        first = (queries.get("queries") or [{}])[0] if isinstance(queries.get("queries"), list) else {}
+        from_queries = set()
+        if options is not None and isinstance(first, dict):  # a map has no start: the first query's
+            for key in ("start", "goal"):
+                if getattr(options, key) is None and _pose(first.get(key)) is not None:
+                    setattr(options, key, _pose(first.get(key)))
+                    from_queries.add(key)
+    inputs = [src] + ([args.queries] if args.queries is not None else [])
+    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=inputs) if args.plot is not None else None
     if args.animate is not None:
-        check_output(args.animate, "--animate", {".gif": "gif"}, inputs=[src])
+        check_output(args.animate, "--animate", {".gif": "gif"}, inputs=inputs)
     if args.json is not None:
-        check_output(args.json, "--json", inputs=[src])
+        check_output(args.json, "--json", inputs=inputs)
     if args.csv is not None:
-        check_output(args.csv, "--csv", inputs=[src])
+        check_output(args.csv, "--csv", inputs=inputs)
     if args.proof is not None:
-        check_output(args.proof, "--proof", inputs=[src])
+        check_output(args.proof, "--proof", inputs=inputs)
     check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.csv, "--csv"),
                     (args.proof, "--proof")])
     from ..core.plan import plan
@@ -138,13 +155,26 @@ def run(args) -> int:
                 check_output(out, opt, inputs=imp.inputs)
         for w in imp.warnings:
             sys.stderr.write(f"warning: {w}\n")
-        scenario = scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
+        try:
+            scenario = scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
+        except ScenarioError as exc:
+            if queries is not None and exc.field in from_queries:  # the pose came from the queries file
+                raise InputError(args.queries, f"queries[0].{exc.field}", exc.message) from None
+            raise
         import_s = time.perf_counter() - t_import
+    if queries is not None:
+        from cspace.io.scenario import load_scenario
+        from cspace.io.validate import with_queries
+
+        if options is None:
+            scenario = load_scenario(src, space=args.space, turning_radius=args.turning_radius)
+        scenario = with_queries(scenario, queries, args.queries)
     try:
+        loaded = options is not None or queries is not None  # a Scenario, its space and radius applied
         res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
                    simplify=not args.no_simplify, all_queries=args.all_queries,
-                   space=args.space, slabs=args.slabs,
-                   turning_radius=None if options is not None else args.turning_radius,
+                   space=None if loaded else args.space, slabs=args.slabs,
+                   turning_radius=None if loaded else args.turning_radius,
                    clearance=args.clearance, objective=args.objective)
     except ScenarioError as exc:
         if exc.file == "plan()" and exc.field == "objective":  # the file's planner takes no objective
@@ -177,6 +207,15 @@ def run(args) -> int:
     if args.proof is not None:
         write_proof(args.proof, results)
     return 0 if all(r.solved for r in results) else 1
+
+
+def _pose(value):
+    """A queries file's pose as the import's start or goal (None if it is not 2 or 3 numbers:
+    the queries' own check then names the fault)."""
+    if isinstance(value, list) and 2 <= len(value) <= 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                                 for v in value):
+        return tuple(float(v) for v in value)
+    return None
 
 
 def write_proof(path: str, results: list) -> None:

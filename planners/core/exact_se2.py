@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 
 import numpy as np
 
@@ -28,18 +29,44 @@ from .result import PlanResult
 QUICK_SHARE = 0.1   # of the time limit, at most, for the proof before sampling
 QUICK_MAX = 1.0     # seconds, at most, whatever the limit
 CAR_SLABS = 128     # the finest partition a car's proof-only search tries
+_REGIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> its SlabRegions
 
 
 def search(cspace, query, time_limit: float | None, *, possible_only: bool = False, refine: bool = True,
            min_width: float | None = None):
     """The slab-graph search on an SE(2) C-space's pieces (body frame; its margin, if any,
-    inflates the robot for the path, while a proof is made for the body itself)."""
+    inflates the robot for the path, while a proof is made for the body itself). The slab
+    regions are kept with the C-space, so the queries of one scene share them."""
     from cspace.spaces.se2_exact import exact_se2_search
 
+    regions = _regions_of(cspace)
     return exact_se2_search(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, tuple(query.start),
                             tuple(query.goal), time_limit=time_limit, margin=cspace.margin or None,
-                            possible_only=possible_only, refine=refine,
+                            possible_only=possible_only, refine=refine, regions=regions,
                             **({} if min_width is None else {"min_width": min_width}))
+
+
+def prepare(cspace) -> float:
+    """Build the POSSIBLE regions of the first slabs (what :func:`quick_proof` reads) for a C-space
+    that will serve many queries; returns the seconds it took."""
+    from cspace.spaces.se2_exact import initial_partition
+
+    t = time.perf_counter()
+    regions = _regions_of(cspace)
+    for a, b in initial_partition():
+        regions.possible(a, b)
+    return time.perf_counter() - t
+
+
+def _regions_of(cspace):
+    """The C-space's :class:`cspace.spaces.slab_graph.SlabRegions`, made on first use and kept."""
+    from cspace.spaces.se2_exact import slab_regions
+
+    regions = _REGIONS.get(cspace)
+    if regions is None:
+        regions = _REGIONS[cspace] = slab_regions(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds,
+                                                  cspace.margin or None)
+    return regions
 
 
 def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None = None,
