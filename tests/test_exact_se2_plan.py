@@ -160,20 +160,20 @@ def _scene(length, width, gap, gap_y, box_x, box_y, box, t0, t1):
 # A goal angle 7.8e-10 above a slab boundary: the proof named the goal's component in the slab above
 # only, and the checker (unsure of an angle's last bits within 1e-9) wanted the slab below too.
 @example(length=1.0, width=0.5, gap=1.0, gap_y=3.0, box_x=4.0, box_y=2.0, box=1.5, t0=0.0, t1=7.757372428179119e-10)
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(length=st.floats(0.4, 4.0), width=st.floats(0.1, 0.8), gap=st.floats(0.3, 3.0), gap_y=st.floats(3.0, 9.0),
        box_x=st.floats(1.0, 10.0), box_y=st.floats(1.0, 10.0), box=st.floats(0.2, 1.5),
        t0=st.floats(-math.pi, math.pi), t1=st.floats(-math.pi, math.pi))
 def test_random_scenes_exact_never_contradicts_a_sampled_path(length, width, gap, gap_y, box_x, box_y, box, t0, t1):
     try:
         sc = scenario_from_dict(_scene(length, width, gap, gap_y, box_x, box_y, box, t0, t1), "random.toml")
-        ex = planners.plan(sc, planner="exact", time=10.0)
+        ex = planners.plan(sc, planner="exact", time=2.0, simplify=False)  # its shortening: the scenes test
     except Exception as exc:  # start or goal not free: not a query
         assume(not ("not a free" in str(exc) or "in collision" in str(exc)))
         raise
     if ex.solved:
         assert judged_free(sc, ex.path)
-    sampled = planners.plan(sc, planner="RRTConnect", time=0.2, seed=1, cspace=ex.cspace)
+    sampled = planners.plan(sc, planner="RRTConnect", time=0.1, seed=1, cspace=ex.cspace)
     if sampled.solved:  # a certified path exists: exact must not have called the scene impossible
         assert ex.solved or not ex.message.startswith("proven unsolvable"), ex.message
         assert judged_free(sc, sampled.path)
