@@ -25,7 +25,7 @@
     ``planners.plan`` (the routine of ``cspace plan``); solved count, median solve time,
     median path length, and each path judged by the sweep oracle.
 
-Usage: python scripts/bench_se2.py [--quick] [--parts VMT] [--json FILE]
+Usage: python scripts/bench_se2.py [--quick] [--parts VMTP] [--peers shapely,coal] [--json FILE]
 """
 from __future__ import annotations
 
@@ -253,10 +253,96 @@ def part_t(seeds: int, budget: float) -> list[dict]:
     return rows
 
 
+CAR = [[-0.6, -0.25], [0.5, -0.25], [0.7, -0.1], [0.7, 0.1], [0.5, 0.25], [-0.6, 0.25]]  # a car-shaped body
+
+
+def generated(kind: str, size: int, robot: list, scale: float, seed: int = 0):
+    """A generated scene (``cspace generate``) for a rotating robot of ``robot`` x ``scale``; the
+    first seed from ``seed`` whose start and goal are free for it."""
+    import tomllib
+
+    from cspace.io.scenario import ScenarioError, scenario_from_dict
+    from planners.cli.generate import generate
+
+    for s in range(seed, seed + 50):
+        data = tomllib.loads(generate(kind, seed=s, size=size))
+        data["robot"] = {"polygon": [[scale * x, scale * y] for x, y in robot]}
+        data["space"] = "se2"
+        data["name"] = f"{kind}-{size}-car"
+        try:
+            return scenario_from_dict(data, f"<{kind} {size}, seed {s}>")
+        except ScenarioError:
+            continue
+    raise SystemExit(f"no {kind} {size} scene with a free start and goal for the car")
+
+
+def car_judge(sc):
+    """``path -> bool``: a car's path swept along its own curves by the oracle."""
+    from sweep_oracle import car_sweep_check
+
+    from cspace.spaces.car_curves import dubins_segments, reeds_shepp_segments
+
+    f = dubins_segments if sc.space == "dubins" else reeds_shepp_segments
+
+    def collides(path) -> bool:
+        j = car_sweep_check(sc, path, lambda a, b: f(a, b, sc.turning_radius), sc.turning_radius)
+        return bool(j["collides"] or j["out_of_bounds"])
+
+    return collides
+
+
+def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RRTConnect") -> list[dict]:
+    """Side by side: ours (certified) against OMPL with shapely and coal checkers (sampled motions),
+    RRTConnect, time to the first solution, CPU, interleaved per seed; every path judged by the
+    sweep oracle."""
+    import se2_peers
+    from planners.core.plan import build_cspace, make_adapter
+
+    scenes = [load_scenario(os.path.join(SE2_DIR, f)) for f in
+              ("bar_door.toml", "bug_trap.toml", "car_maze.toml", "piano_corridor.toml", "tee_slot.toml")]
+    scenes += [generated("random", 40, CAR, 1.5), generated("maze", 8, CAR, 2.0), generated("maze", 14, CAR, 2.0)]
+    scenes += [load_scenario(os.path.join(ROOT, "scenarios", "car", f)) for f in
+               ("maze.toml", "parking.toml", "loading_dock.toml", "u_turn.toml")]
+    rows = []
+    for sc in scenes:
+        cs = build_cspace(sc)
+        adapter = make_adapter(sc, cs)
+        q = sc.all_queries()[0]
+        collides = car_judge(sc) if sc.space in ("dubins", "reeds-shepp") else \
+            (lambda path, sc=sc: (lambda j: bool(j["collides"] or j["out_of_bounds"]))(sweep_check(sc, path)))
+        checkers = {"shapely": se2_peers.shapely_checker(sc)} if "shapely" in peers else {}
+        if "coal" in peers:
+            checkers["coal"] = se2_peers.coal_checker(cs.obstacle_pieces, cs.robot_pieces, sc.bounds)
+        cpu = {m: [] for m in ("ours", *checkers)}
+        solved = {m: 0 for m in cpu}
+        bad = {m: 0 for m in cpu}
+        for seed in range(seeds):  # interleaved: every method once per seed
+            runs = {"ours": se2_peers.ours_first(sc, cs, adapter, q, seed, budget, planner)}
+            for name, chk in checkers.items():
+                runs[name] = se2_peers.peer_first(adapter, chk, adapter.pose(q.start), adapter.pose(q.goal), seed,
+                                                  budget, planner)
+            for m, (path, c) in runs.items():
+                cpu[m].append(c if path is not None else None)
+                if path is not None:
+                    solved[m] += 1
+                    bad[m] += collides(path)
+        row = {"scene": sc.name if sc.space == "se2" else f"{sc.name} ({sc.space})", "planner": planner, "vertices": sum(len(o.polygon) for o in sc.obstacles), "seeds": seeds,
+               "solved": solved, "colliding": bad,
+               "median_cpu_s": {m: (statistics.median([c for c in v if c is not None]) if any(c is not None for c in v)
+                                    else None) for m, v in cpu.items()}}
+        for m in checkers:  # the paired median: seeds both solved (a colliding peer path still counts as solved)
+            pairs = [a / b for a, b in zip(cpu["ours"], cpu[m]) if a is not None and b is not None and b > 0]
+            row[f"ours/{m}"] = statistics.median(pairs) if pairs else None
+        rows.append(row)
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="fewer states, motions and seeds")
-    ap.add_argument("--parts", default="VMT")
+    ap.add_argument("--parts", default="VMT", help="V validity, M motions, T plans, P side by side with peers")
+    ap.add_argument("--peers", default="shapely,coal", help="part P's peers (coal needs the bench extra)")
+    ap.add_argument("--planners", default="RRTConnect,RRTstar", help="part P's planners")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args(argv)
     out = {}
@@ -286,6 +372,38 @@ def main(argv=None) -> int:
             ml = f"{r['median_length']:.3f}" if r["median_length"] is not None else "-"
             print(f"  {r['scene']:16} solved {r['solved']}/{r['seeds']}  median first solution {ms}"
                   f"  median length {ml}  colliding paths {r['colliding_paths']}")
+    if "P" in a.parts:
+        peers = tuple(p for p in a.peers.split(",") if p)
+        if "coal" in peers:
+            try:
+                import coal  # noqa: F401
+            except ImportError:
+                print("(P) coal is not installed (pip install coal, or the bench extra): without it")
+                peers = tuple(p for p in peers if p != "coal")
+        rows = []
+        for name in a.planners.split(","):
+            rows += part_p(seeds=3 if a.quick else 10, budget=10.0, peers=peers, planner=name)
+        out["peers"] = rows
+        print("(P) side by side, time to the first solution, CPU s (median over solved seeds), paired median ratio;")
+        print("    colliding = returned paths the sweep oracle finds colliding (a car's along its curves)")
+        print(f"  {'scene':24} {'planner':10} {'verts':>5}" + "".join(f" {m + ' solved':>14} {m + ' s':>10} {m + ' coll.':>11}"
+                                                       for m in ("ours", *peers))
+              + "".join(f" {'ours/' + m:>13}" for m in peers))
+        for r in rows:
+            med = r["median_cpu_s"]
+            cells = "".join(f" {r['solved'][m]:>10}/{r['seeds']:<3} {'-' if med[m] is None else f'{med[m]:.4f}':>10}"
+                            f" {r['colliding'][m]:>11}" for m in ("ours", *peers))
+            ratio = {m: r["ours/" + m] for m in peers}
+            ratios = "".join(f" {'-' if ratio[m] is None else f'{ratio[m]:.2f}':>13}" for m in peers)
+            print(f"  {r['scene']:24} {r['planner']:10} {r['vertices']:>5}{cells}{ratios}")
+        for name in a.planners.split(","):
+            mine = [r for r in rows if r["planner"] == name]
+            for m in peers:
+                vals = [r["ours/" + m] for r in mine if r["ours/" + m] is not None]
+                if vals:
+                    print(f"  {name} ours/{m}: median over scenes {statistics.median(vals):.2f}x, worst "
+                          f"{max(vals):.2f}x; colliding paths: ours {sum(r['colliding']['ours'] for r in mine)}, "
+                          f"{m} {sum(r['colliding'][m] for r in mine)}")
     if a.json:
         with open(a.json, "w") as fh:
             json.dump(out, fh, indent=1)

@@ -7,14 +7,12 @@ free with a margin), written to a temporary folder.
 - ours: the map imported (``cspace.io.imported``, the default tolerance), the SE(2) C-space built
   (``planners.core.plan.build_cspace``) with all its slabs and the POSSIBLE regions that the proof
   before sampling reads (``planners.core.exact_se2.prepare``), then every pair planned on that one
-  prepared C-space through ``planners.plan`` (RRTConnect, seed = the pair's index; the proof
-  before sampling included). Preparation time (import, C-space, slabs) and, per pair, the time to
-  its certified path (the call's wall time up to the end of the verified solve: OMPL's solve,
-  whose every motion is certified) and the whole call (with simplification and verification).
-- peer: OMPL's RRTConnect on an SE2StateSpace of the same bounds (weights as ours), coal's
-  DynamicAABBTree over the same convex obstacle pieces as prisms, the footprint as a prism
-  turned and moved to each state, and OMPL's default discrete motion check (1 % of the
-  space's extent), seeded the same; its path simplified as ours is.
+  prepared C-space (RRTConnect, seed = the pair's index): the CPU time to its first certified
+  path, the proof before sampling included (``se2_peers.ours_first``).
+- peer: OMPL's RRTConnect on the same state space (bounds and weights as ours), coal's
+  DynamicAABBTree over the same convex obstacle pieces as prisms, the footprint's prism turned
+  and moved to each state, and OMPL's default discrete motion check (1 % of the space's
+  extent), seeded the same (``se2_peers.peer_first``), CPU time to its first path.
 
 Pairs alternate ours / peer. Every returned path is judged by an independent check on the
 grid: the occupied cells, merged into row runs as shapely boxes, against the footprint swept
@@ -43,6 +41,7 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
 
 import make_warehouse_map as wh  # noqa: E402
+import se2_peers  # noqa: E402
 
 L, W = wh.FOOTPRINT
 POLYGON = [[-L / 2, -W / 2], [L / 2, -W / 2], [L / 2, W / 2], [-L / 2, W / 2]]
@@ -86,73 +85,6 @@ def grid_judge(img: np.ndarray):
         return False
 
     return collides
-
-
-def coal_se2_checker(pieces, bounds):
-    """``state -> bool``: obstacle pieces as coal prisms in an AABB tree, the footprint turned and moved."""
-    import coal
-    from bench_planning import _prism  # noqa: PLC2701 (the prisms of the translation bench)
-
-    manager = coal.DynamicAABBTreeCollisionManager()
-    keep = []
-    for p in pieces:
-        obj = coal.CollisionObject(_prism(p), coal.Transform3s())
-        keep.append(obj)
-        manager.registerObject(obj)
-    manager.setup()
-    robot = coal.CollisionObject(_prism(np.array(POLYGON)), coal.Transform3s())
-    callback = coal.CollisionCallBackDefault()
-    data = callback.data
-    xmin, xmax, ymin, ymax = bounds
-
-    def is_valid(s) -> bool:
-        x, y, t = s.getX(), s.getY(), s.getYaw()
-        if not (xmin <= x <= xmax and ymin <= y <= ymax):
-            return False
-        c, sn = math.cos(t), math.sin(t)
-        tf = coal.Transform3s(np.array([[c, -sn, 0.0], [sn, c, 0.0], [0.0, 0.0, 1.0]]), np.array([x, y, 0.0]))
-        robot.setTransform(tf)
-        robot.computeAABB()
-        data.result.clear()
-        data.done = False
-        manager.collide(robot, callback)
-        return not data.result.isCollision()
-
-    is_valid.keep = (manager, keep, robot, callback)
-    return is_valid
-
-
-def peer_plan(checker, bounds, start, goal, seed: int, limit: float):
-    """OMPL RRTConnect with the coal checker and OMPL's discrete motion check: (path or None, seconds)."""
-    from planners.adapters.glue import ompl, ompl_seed
-
-    ob, og, ou = ompl()
-    ou.RNG.setSeed(ompl_seed(seed))
-    space = ob.SE2StateSpace()
-    b = ob.RealVectorBounds(2)
-    b.setLow(0, bounds[0])
-    b.setHigh(0, bounds[1])
-    b.setLow(1, bounds[2])
-    b.setHigh(1, bounds[3])
-    space.setBounds(b)
-    ss = og.SimpleSetup(space)
-    ss.setStateValidityChecker(checker)
-    s, g = space.allocState(), space.allocState()
-    for st, p in ((s, start), (g, goal)):
-        st.setX(p[0])
-        st.setY(p[1])
-        st.setYaw(p[2])
-    ss.setStartAndGoalStates(s, g, 1e-9)
-    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
-    ss.setup()
-    t = time.perf_counter()
-    ok = ss.solve(ob.timedPlannerTerminationCondition(limit))
-    solve = time.perf_counter() - t
-    if not (ok and ss.haveExactSolutionPath()):
-        return None, solve
-    ss.simplifySolution()
-    path = np.array([(q.getX(), q.getY(), q.getYaw()) for q in ss.getSolutionPath().getStates()])
-    return path, solve
 
 
 def pct(xs, q):
@@ -209,29 +141,31 @@ def main(argv=None) -> int:
           f"{prep['slabs_s']:.2f} s, proof regions {prep['regions_s']:.2f} s: {prep['total_s']:.2f} s (target <= 2 s: "
           f"{'met' if prep['total_s'] <= 2 else 'MISSED'})")
     judge = grid_judge(img)
-    checker = coal_se2_checker(cs.obstacle_pieces, sc.bounds) if peer else None
-    ours_first, ours_total, ours_solved, ours_bad = [], [], 0, 0
+    checker = se2_peers.coal_checker(cs.obstacle_pieces, cs.robot_pieces, sc.bounds) if peer else None
+    from planners.core.plan import make_adapter
+
+    adapter = make_adapter(sc, cs)
+    ours_first, ours_solved, ours_bad = [], 0, 0
     peer_first, peer_solved, peer_bad = [], 0, 0
     queries = sc.all_queries()
-    for i, q in enumerate(queries):
-        single = planners.plan(_one(sc, q), planner="RRTConnect", time=args.time, seed=i, cspace=cs)
-        t = single.timings
-        if single.solved:
+    for i, q in enumerate(queries):  # alternating: ours, then the peer, on the same pair and seed
+        path, cpu = se2_peers.ours_first(sc, cs, adapter, q, i, args.time)
+        if path is not None:
             ours_solved += 1
-            ours_first.append(t.get("proof", 0.0) + t.get("setup", 0.0) + t.get("solve", 0.0))
-            ours_total.append(sum(v for k, v in t.items() if k not in ("load", "cspace", "total", "clearance")))
-            ours_bad += judge(single.path)
+            ours_first.append(cpu)
+            ours_bad += judge(path)
         if peer:
-            path, solve = peer_plan(checker, sc.bounds, q.start, q.goal, i, args.time)
+            path, cpu = se2_peers.peer_first(adapter, checker, adapter.pose(q.start), adapter.pose(q.goal), i,
+                                             args.time)
             if path is not None:
                 peer_solved += 1
-                peer_first.append(solve)
+                peer_first.append(cpu)
                 peer_bad += judge(path)
     n = len(queries)
     mean_first = statistics.mean(ours_first) if ours_first else float("nan")
     print(f"ours: {ours_solved}/{n} solved; time to a certified path mean {mean_first * 1e3:.1f} ms, "
-          f"p95 {pct(ours_first, 95) * 1e3:.1f} ms, median {pct(ours_first, 50) * 1e3:.1f} ms; whole query mean "
-          f"{statistics.mean(ours_total) * 1e3 if ours_total else float('nan'):.1f} ms; colliding paths {ours_bad}")
+          f"p95 {pct(ours_first, 95) * 1e3:.1f} ms, median {pct(ours_first, 50) * 1e3:.1f} ms (CPU); "
+          f"colliding paths {ours_bad}")
     print(f"  targets: mean <= 100 ms: {'met' if mean_first <= 0.1 else 'MISSED'}; p95 <= 200 ms: "
           f"{'met' if pct(ours_first, 95) <= 0.2 else 'MISSED'}; 0 colliding: {'met' if ours_bad == 0 else 'MISSED'}")
     if peer:
@@ -241,7 +175,7 @@ def main(argv=None) -> int:
         print(f"ours / coal, mean time to a (certified / first) path: {mean_first / pm:.2f}x")
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"prep": prep, "ours": {"first": ours_first, "total": ours_total, "solved": ours_solved,
+            json.dump({"prep": prep, "ours": {"first": ours_first, "solved": ours_solved,
                                               "colliding": ours_bad},
                        "peer": {"first": peer_first, "solved": peer_solved, "colliding": peer_bad} if peer else None},
                       fh, indent=1)
