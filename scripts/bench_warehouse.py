@@ -100,7 +100,6 @@ def main(argv=None) -> int:
     ap.add_argument("--json", help="write the figures as JSON")
     args = ap.parse_args(argv)
 
-    import planners
     from cspace.io.imported import ImportOptions, import_file
     from cspace.io.scenario import read_toml, scenario_from_dict
     from cspace.io.validate import with_queries

@@ -232,8 +232,8 @@ def figures() -> list[Figure]:
     out.append(Figure("se2_car_maze", "se2", "SE(2): a car-shaped body through a maze", se2_plan_figure("car_maze")))
     out.append(Figure("se2_tee_slot_slab", "se2", "SE(2): the slab C-space of theta = pi/2",
                       se2_slab_figure("tee_slot", 1.5707963267948966)))
-    out.append(Figure("plank_corner", "se2exact", "SE(2) exact: a plank carried round a corner",
-                      se2_plan_figure("plank_corner")))
+    out.append(Figure("plank_corner_tight", "se2exact", "SE(2) exact: a plank round a corner, 1 % of room",
+                      se2_plan_figure("plank_corner_tight")))
     out.append(Figure("door_tight", "se2exact", "SE(2) exact: a box through a door 1 % wider than it",
                       se2_plan_figure("door_tight")))
     out.append(Figure("bug_trap_l_slabs", "se2exact", "SE(2) exact: the slab graph of the L in the trap",

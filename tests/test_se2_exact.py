@@ -22,7 +22,7 @@ from cspace.io.scenario import load_scenario
 from cspace.spaces.se2_exact import exact_se2_search, from_scenario
 
 SE2 = os.path.join(SCENARIOS, "se2")
-EXPECT = {"plank_corner.toml": "solved", "door_tight.toml": "solved", "bug_trap_l.toml": "unsolvable",
+EXPECT = {"plank_corner.toml": "solved", "plank_corner_tight.toml": "solved", "door_tight.toml": "solved", "bug_trap_l.toml": "unsolvable",
           "hole_turn.toml": "solved", "bar_door.toml": "solved", "bug_trap.toml": "solved",
           "car_maze.toml": "solved", "piano_corridor.toml": "solved", "tee_slot.toml": "solved",
           "wide_square.toml": "unsolvable"}
