@@ -79,6 +79,61 @@ class GridIndex(CellClassifier):
 
     def __init__(self, pieces: list[np.ndarray], bounds, cells: int | None = None,
                  shape: tuple[int, int] | None = None, packed: PieceSet | None = None):
+        self._frame(pieces, bounds, cells, shape, packed)
+        n, nx, ny = len(pieces), self.nx, self.ny
+        if not n:  # nothing to classify: every cell FREE
+            cp = cm = np.zeros(0, np.int64)
+            state, blocker = np.zeros(nx * ny, np.int8), np.full(nx * ny, -1, np.int64)
+            starts = np.zeros(nx * ny + 1, np.int64)
+            self._counts = (nx * ny, 0, 0)
+        elif fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
+            cc, cp, cm, inside = self._classify_all(pieces, packed)
+            state, blocker = np.empty(nx * ny, np.int8), np.empty(nx * ny, np.int64)
+            starts, cand, masks = np.empty(nx * ny + 1, np.int64), np.empty(len(cc), np.int64), np.empty(len(cc), np.int64)
+            self._counts = fastpath.assemble(cc, cp, cm, inside, n, state, blocker, starts, cand, masks)
+            cp, cm = cand[: int(starts[-1])], masks[: int(starts[-1])]
+        else:
+            state, blocker, cp, cm, starts = self._assembled(*self._classify_all(pieces), n)
+            self._counts = None
+        self.state = state
+        self.blocker = blocker
+        self._cand = cp
+        self._starts = starts
+        self._masks = cm
+        # Compact copies for the scalar hot path: indexing bytes or an array.array yields
+        # a Python int as cheaply as a list does, and they are built by one copy of the
+        # buffer instead of one Python object per cell (a million cells: ~1 ms, not ~50).
+        # The state bytes serve every point test; the other copies only the Python narrow
+        # phase, so they are made when it first runs (with the compiled path, rarely).
+        self.state_list = state.astype(np.uint8).tobytes()
+        self._rows = None
+        self._sat_rows = None
+
+    @classmethod
+    def blocked_cells(cls, pieces: list[np.ndarray], bounds, shape: tuple[int, int],
+                      packed: PieceSet | None = None) -> np.ndarray:
+        """The cells ``GridIndex(pieces, bounds, shape=shape, packed=packed)`` calls BLOCKED, as
+        a bool per cell (flat, row-major), without the rest of the grid (blockers,
+        candidates, masks): the same frame and classification, fewer arrays. (The SE(2)
+        slabs' inner grids: only their BLOCKED cells are read.)
+
+        >>> sq = [np.array([[-1., -1], [2, -1], [2, 2], [-1, 2]])]
+        >>> g = GridIndex(sq, (0, 4, 0, 4), shape=(4, 4))
+        >>> bool((GridIndex.blocked_cells(sq, (0, 4, 0, 4), (4, 4)) == (g.state == BLOCKED)).all())
+        True
+        """
+        g = cls.__new__(cls)
+        g._frame(pieces, bounds, None, shape, packed)
+        out = np.zeros(g.nx * g.ny, dtype=bool)
+        if len(pieces):
+            cc, _, _, inside = g._classify_all(pieces, packed)
+            out[cc[inside]] = True
+        return out
+
+    def _frame(self, pieces: list[np.ndarray], bounds, cells: int | None, shape: tuple[int, int] | None,
+               packed: PieceSet | None) -> None:
+        """The grid's frame (columns and rows, cells, local origin, margin) and the pieces'
+        boxes, as the classification reads them."""
         xmin, xmax, ymin, ymax = map(float, bounds)
         self.bounds = (xmin, xmax, ymin, ymax)
         n = len(pieces)
@@ -122,33 +177,6 @@ class GridIndex(CellClassifier):
         top = [float(max(self._hi.max(), -self._lo.min()))] if n else []
         big = max([abs(xmin), abs(xmax), abs(ymin), abs(ymax)] + top)
         self.margin = _MARGIN * max(w, h) + 64.0 * 2.0**-53 * big
-        if not n:  # nothing to classify: every cell FREE
-            cp = cm = np.zeros(0, np.int64)
-            state, blocker = np.zeros(nx * ny, np.int8), np.full(nx * ny, -1, np.int64)
-            starts = np.zeros(nx * ny + 1, np.int64)
-            self._counts = (nx * ny, 0, 0)
-        elif fastpath.compiled() and self.compiled:  # the same arrays, assembled in C
-            cc, cp, cm, inside = self._classify_all(pieces, packed)
-            state, blocker = np.empty(nx * ny, np.int8), np.empty(nx * ny, np.int64)
-            starts, cand, masks = np.empty(nx * ny + 1, np.int64), np.empty(len(cc), np.int64), np.empty(len(cc), np.int64)
-            self._counts = fastpath.assemble(cc, cp, cm, inside, n, state, blocker, starts, cand, masks)
-            cp, cm = cand[: int(starts[-1])], masks[: int(starts[-1])]
-        else:
-            state, blocker, cp, cm, starts = self._assembled(*self._classify_all(pieces), n)
-            self._counts = None
-        self.state = state
-        self.blocker = blocker
-        self._cand = cp
-        self._starts = starts
-        self._masks = cm
-        # Compact copies for the scalar hot path: indexing bytes or an array.array yields
-        # a Python int as cheaply as a list does, and they are built by one copy of the
-        # buffer instead of one Python object per cell (a million cells: ~1 ms, not ~50).
-        # The state bytes serve every point test; the other copies only the Python narrow
-        # phase, so they are made when it first runs (with the compiled path, rarely).
-        self.state_list = state.astype(np.uint8).tobytes()
-        self._rows = None
-        self._sat_rows = None
 
     def _assembled(self, cc, cp, cm, inside, n: int):
         """The grid's arrays from its classified (cell, piece, mask, inside) entries:

@@ -85,7 +85,10 @@ class CSpace(PointQueries, SegmentQueries):
         convex = obstacle_convex if normalized else None
         self.obstacle_pieces, self.obstacle_of = self._decompose_obstacles(obstacles, holes, owner, convex)
         self.robot_pieces = self._decompose_robot(robot, robot_is_disk)
-        raw, raw_owner = self._sum()
+        self._finish(*self._sum(), grid_cells)
+
+    def _finish(self, raw: list, raw_owner: np.ndarray, grid_cells: int | None) -> None:
+        """The build after the sums: prune, index, the compiled handle, the query closures."""
         self.pieces, self.piece_obstacle = self._prune(raw, raw_owner)
         t = time.perf_counter()
         self.packed = PieceSet(self.pieces, self._boxes, self._packing)  # the prune's boxes and packing
@@ -183,6 +186,41 @@ class CSpace(PointQueries, SegmentQueries):
         self.stages.append(Stage("minkowski", True, time.perf_counter() - t, counts))
         return out, owner
 
+    @classmethod
+    def from_sums(cls, bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray], sums: list[np.ndarray],
+                  *, grid_cells: int | None = None, seconds: float = 0.0) -> "CSpace":
+        """The C-space ``CSpace(bounds, obstacle_pieces, robot_pieces, normalized=True)`` builds when
+        every obstacle and robot piece is convex (kept as it is) and ``sums`` are their pair
+        sums obstacle piece ⊕ −(robot piece), obstacle-major, as :func:`pair_sums` gives them
+        (the caller computed them, for several C-spaces at once: the SE(2) slabs): the same
+        pieces, pairs, grid and answers, the same stages in the report (``seconds``: the
+        sums' share of the caller's time).
+
+        >>> sq, tri = np.array([[4., 4], [6, 4], [6, 6], [4, 6]]), np.array([[-1., -1], [0, -1], [-1, 0]])
+        >>> a = CSpace((0, 10, 0, 10), [sq], [-tri], normalized=True)
+        >>> b = CSpace.from_sums((0, 10, 0, 10), [sq], [-tri], pair_sums([sq], [tri]))
+        >>> [p.tolist() for p in a.pieces] == [p.tolist() for p in b.pieces], b.is_free((3.5, 3.5))
+        (True, False)
+        """
+        self = cls.__new__(cls)
+        self.bounds = tuple(float(v) for v in bounds)
+        check_range(self.bounds, list(obstacle_pieces) + list(robot_pieces))
+        no, nr = len(obstacle_pieces), len(robot_pieces)
+        self.stages = [Stage("decompose_obstacles", False, 0.0, {"obstacles": no, "decomposed": 0, "pieces": no},
+                             "all obstacles convex: nothing to decompose")]
+        self.margin = []
+        self.obstacle_pieces, self.obstacle_of = list(obstacle_pieces), np.arange(no, dtype=np.int64)
+        self.robot_pieces = list(robot_pieces)
+        if not nr:
+            raise ValueError("CSpace.from_sums: needs robot pieces")
+        self.stages.append(Stage("decompose_robot", False, 0.0, {"parts": nr, "pieces": nr}, "robot parts convex"))
+        if len(sums) != no * nr:
+            raise ValueError(f"CSpace.from_sums: {len(sums)} sums for {no} x {nr} pairs")
+        self._raw_pairs = [(i, j) for i in range(no) for j in range(nr)]
+        self.stages.append(Stage("minkowski", True, seconds, {"pairs": len(sums), "robot_pieces": nr}))
+        self._finish(list(sums), np.repeat(self.obstacle_of, nr), grid_cells)
+        return self
+
     def _prune(self, pieces, owner):
         """Drop pieces that cannot meet the bounds, and pieces inside another piece.
 
@@ -193,8 +231,13 @@ class CSpace(PointQueries, SegmentQueries):
         t = time.perf_counter()
         xmin, xmax, ymin, ymax = self.bounds
         before = len(pieces)
-        pts, sizes = pack(pieces)  # kept for the index's PieceSet
-        lo, hi = piece_boxes(pieces, (pts, sizes))  # an empty piece: lo = inf, hi = -inf, dropped
+        got = fastpath.pack_boxes(pieces)  # compiled: the same packing and boxes in one pass
+        if got is not None:
+            pts, off, lo, hi, _ = got
+            sizes = np.diff(off)
+        else:
+            pts, sizes = pack(pieces)  # kept for the index's PieceSet
+            lo, hi = piece_boxes(pieces, (pts, sizes))  # an empty piece: lo = inf, hi = -inf, dropped
         keep = np.flatnonzero((lo[:, 0] <= xmax) & (hi[:, 0] >= xmin) & (lo[:, 1] <= ymax) & (hi[:, 1] >= ymin)).tolist()
         outside = before - len(keep)
         pieces = [pieces[k] for k in keep]

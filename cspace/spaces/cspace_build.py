@@ -120,7 +120,6 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
     if n < 2:
         return {}
     lo, hi = boxes if boxes is not None else piece_boxes(pieces)
-    order = np.argsort(lo[:, 0], kind="stable")
     removed: dict[int, int] = {}
     # Pairs (q, p), p != q, whose box lies inside q's box (closed), each q's in the order of
     # ``order``. A piece inside q has every vertex in q, so one vertex stands for it: an
@@ -133,14 +132,13 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
     # vertices: boxes covering boxes.)
     import shapely
 
-    sizes = np.fromiter((len(p) for p in pieces), np.int64, n)
     if n <= BOX_PROPOSALS:
         # Few pieces: every pair whose boxes nest, by one comparison of all the boxes (at
         # most n^2 pairs for the exact test; building the trees and polygons for the
         # point-in-polygon filter below costs more than the exact test of what it drops).
         qs, ps = np.nonzero((lo[None, :, 0] >= lo[:, None, 0]) & (hi[None, :, 0] <= hi[:, None, 0]) &
                             (lo[None, :, 1] >= lo[:, None, 1]) & (hi[None, :, 1] <= hi[:, None, 1]))
-    elif (sizes >= 3).all():
+    elif (sizes := np.fromiter((len(p) for p in pieces), np.int64, n)).min() >= 3:
         flat = np.concatenate(pieces)
         owner = np.repeat(np.arange(n), sizes)
         rings = shapely.linearrings(flat, indices=owner)
@@ -161,6 +159,9 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
     inside = (ps != qs) & (lo[ps, 0] >= lo[qs, 0]) & (hi[ps, 0] <= hi[qs, 0]) & (lo[ps, 1] >= lo[qs, 1]) & \
         (hi[ps, 1] <= hi[qs, 1])
     qs, ps = qs[inside], ps[inside]
+    if not len(qs):  # no box inside another (the common case): nothing to test
+        return removed
+    order = np.argsort(lo[:, 0], kind="stable")
     rank = np.empty(n, dtype=np.int64)
     rank[order] = np.arange(n)
     by = np.lexsort((rank[ps], qs))

@@ -32,9 +32,10 @@ import numpy as np
 from . import fastpath
 from .broadphase import GridIndex
 from .cspace import CSpace
-from .cspace_build import check_range, decompose_obstacles, decompose_robot, inflated
+from .cspace_build import check_range, decompose_obstacles, decompose_robot, inflated, pair_sums
+from .slab_build import build_slabs, slab_run
 from ..kernel.minkowski import minkowski_sum, reflect
-from ..kernel.polygon import point_in_convex
+from ..kernel.polygon import is_convex, point_in_convex
 from ..io.scenario import load_scenario
 from ..io.schema import Scenario
 from .car_motion import CarMotions
@@ -100,10 +101,11 @@ class SE2CSpace(SE2Motions, CarMotions):
         self._lo = [slab_range(k, K)[0] - ANGLE_SLACK for k in range(K)] if K > 1 else [-math.inf]
         self._hi = [slab_range(k, K)[1] + ANGLE_SLACK for k in range(K)] if K > 1 else [math.inf]
         self._outer: list = [None] * K  # slab k's CSpace (robot = slab hulls)
-        self._inner: list = [None] * K  # slab k's certified-blocked grid (GridIndex), or False if empty
+        self._inner: list = [None] * K  # slab k's certified-blocked cells (a bool per cell of its grid), or False
         self._tests: list = [None] * K  # (outer point test, None)
         self._grids: list = [None] * K  # the one-lookup grid of each slab (see _combined_grid)
         self._built: list[dict] = []
+        self._convex = None
         olo = np.array([p.min(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         ohi = np.array([p.max(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         self._olo, self._ohi = olo, ohi
@@ -159,10 +161,15 @@ class SE2CSpace(SE2Motions, CarMotions):
             self._built.append({"slab": k, "seconds": time.perf_counter() - t, "pieces": len(outer.pieces),
                                 "inner_pieces": 0})
             return
+        if fastpath.compiled():  # the slabs of k's run at once (cspace.spaces.slab_build): the same slabs
+            self._build_run(k)
+            return
         a, b = self._lo[k], self._hi[k]
         hulls = [slab_hull(p, a, b, scale=self.scale) for p in self.robot_pieces]
+        if self._convex is None:  # the pieces' exact convexity, once for all slabs (all True)
+            self._convex = [is_convex(p) for p in self.obstacle_pieces]
         outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells or SLAB_GRID_CELLS,
-                       normalized=True)  # decomposed, CCW pieces: no input conversion per slab
+                       normalized=True, obstacle_convex=self._convex)  # decomposed, CCW pieces: no input conversion per slab
         t_outer = time.perf_counter() - t
         if len(outer.obstacle_pieces) != len(self.obstacle_pieces) or len(outer.robot_pieces) != len(hulls):
             # piece_pairs index our pieces: the slab must keep them as given (they are convex)
@@ -174,28 +181,44 @@ class SE2CSpace(SE2Motions, CarMotions):
             # Only the inner grid's BLOCKED cells are used (everything else goes to the
             # exact test), so the inner set is a grid over its sums, not a whole CSpace.
             neg = [reflect(p) for p in inner_pieces]
-            sums = [minkowski_sum(o, r) for o in self.obstacle_pieces for r in neg]
-            inner = GridIndex(sums, self.bounds, shape=(g.nx, g.ny))
+            sums = pair_sums(self.obstacle_pieces, neg)  # minkowski_sum's arrays, pair for pair
+            inner = GridIndex.blocked_cells(sums, self.bounds, (g.nx, g.ny))
         self._outer[k], self._inner[k] = outer, inner
         self._tests[k] = (outer.point_test(), None)
         self._grids[k] = self._combined_grid(k, outer, inner)
         self._built.append({"slab": k, "seconds": time.perf_counter() - t, "outer_seconds": t_outer,
                             "pieces": len(outer.pieces), "inner_pieces": len(inner_pieces)})
 
+    def _build_run(self, k: int) -> None:
+        """Slab k and the other unbuilt slabs of its run (:func:`slab_run`), built together
+        by :func:`build_slabs`: the same C-spaces and grids as :meth:`_build` makes one by one."""
+        pairs = len(self.obstacle_pieces) * 2 * len(self.robot_pieces)
+        ks = [j for j in slab_run(k, self.slabs, pairs) if self._outer[j] is None]
+        built = build_slabs(self.bounds, self.obstacle_pieces, self.robot_pieces, [self._lo[j] for j in ks],
+                            [self._hi[j] for j in ks], scale=self.scale, pad=self.pad,
+                            grid_cells=self.grid_cells or SLAB_GRID_CELLS)
+        for j, (outer, inner, n_inner, seconds, outer_seconds) in zip(ks, built):
+            t = time.perf_counter()
+            self._outer[j], self._inner[j] = outer, inner
+            self._tests[j] = (outer._point_uncounted, None)  # outer.point_test(): the one it made
+            self._grids[j] = self._combined_grid(j, outer, inner)
+            self._built.append({"slab": j, "seconds": seconds + time.perf_counter() - t, "outer_seconds": outer_seconds,
+                                "pieces": len(outer.pieces), "inner_pieces": n_inner})
+
     def _combined_grid(self, k: int, outer: CSpace, inner) -> tuple:
         """Slab k's one-lookup grid: per cell 0 (FREE in the slab C-space: free at every
         angle), 2 (BLOCKED in the inner C-space: blocked at every angle) or 1 (the slow
         path: the slab's own point test, then the exact test), one bytes object per row
         with a border cell (3) at its end and a border row after the last, as in
-        :meth:`CSpace.point_test`. The inner grid shares the outer grid's cells."""
-        from .broadphase import BLOCKED, FREE
+        :meth:`CSpace.point_test`. The inner grid (its BLOCKED cells,
+        :meth:`GridIndex.blocked_cells`) shares the outer grid's cells."""
+        from .broadphase import FREE
 
         g = outer.index
-        state = np.where(g.state == FREE, 0, 1).astype(np.uint8)
-        if inner:
-            h = inner
-            assert (h.nx, h.ny, h.x0, h.y0, h.inv_w, h.inv_h) == (g.nx, g.ny, g.x0, g.y0, g.inv_w, g.inv_h)
-            state[(h.state == BLOCKED) & (state == 1)] = 2
+        state = (g.state != FREE).view(np.uint8)
+        if inner is not False and inner is not None:
+            assert inner.shape == (g.nx * g.ny,)
+            state = state + (inner & (state == 1)).view(np.uint8)
         flat = state.tobytes()
         nx, ny = g.nx, g.ny
         rows = [flat[r * nx:(r + 1) * nx] + b"\x03" for r in range(ny)] + [b"\x03" * (nx + 1)]
