@@ -285,22 +285,18 @@ static int test_cell(Grid *g, int64_t c, double ax, double ay, double bx, double
    build's classification, so every cell holding a point of the segment is walked.
    Where y at a column edge is not finite (the slope overflowed), the column gets the
    segment's whole y-range. */
-static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+static int grid_segment(Grid *g, double ax, double ay, double bx, double by)
 {
-    double q[4];
-    if (check_nargs(nargs, 5, "segment(grid, ax, ay, bx, by)") < 0) return NULL;
-    Grid *g = get_grid(args[0]);
-    if (!g || get_doubles(args + 1, 4, q) < 0) return NULL;
-    double ax = q[0], ay = q[1], bx = q[2], by = q[3], m = g->m;
-    if (!(isfinite(ax) && isfinite(ay) && isfinite(bx) && isfinite(by))) return PyLong_FromLong(-1);
+    double m = g->m;
+    if (!(isfinite(ax) && isfinite(ay) && isfinite(bx) && isfinite(by))) return -1;
     if (!(g->xmin <= ax && ax <= g->xmax && g->ymin <= ay && ay <= g->ymax && g->xmin <= bx && bx <= g->xmax
           && g->ymin <= by && by <= g->ymax))
-        return PyLong_FromLong(-1); /* the caller's case */
+        return -1; /* the caller's case */
     next_stamp(g);
     double xlo = ax < bx ? ax : bx, xhi = ax < bx ? bx : ax;
     double ylo = ay < by ? ay : by, yhi = ay < by ? by : ay;
     double fi0 = floor((xlo - m - g->x0) * g->iw), fi1 = floor((xhi + m - g->x0) * g->iw);
-    if (!(fi0 <= (double)(g->nx - 1) && fi1 >= 0.0)) return PyLong_FromLong(-1); /* off the grid: never in bounds */
+    if (!(fi0 <= (double)(g->nx - 1) && fi1 >= 0.0)) return -1; /* off the grid: never in bounds */
     int64_t i0 = fi0 < 0.0 ? 0 : (int64_t)fi0;
     int64_t i1 = fi1 > (double)(g->nx - 1) ? g->nx - 1 : (int64_t)fi1;
     double slope = bx != ax ? (by - ay) / (bx - ax) : 0.0;
@@ -322,16 +318,33 @@ static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t na
             }
         }
         double fr0 = floor((y_lo - m - g->y0) * g->ih), fr1 = floor((y_hi + m - g->y0) * g->ih);
-        if (!(fr0 == fr0 && fr1 == fr1)) return PyLong_FromLong(-1); /* NaN: never on finite input */
+        if (!(fr0 == fr0 && fr1 == fr1)) return -1; /* NaN: never on finite input */
         int64_t r0 = clamp_cell(fr0, g->ny);
         int64_t r1 = clamp_cell(fr1, g->ny);
         for (int64_t r = r0; r <= r1; r++) {
             int res = test_cell(g, r * g->nx + i, ax, ay, bx, by, &tested);
-            if (res == 0) return PyLong_FromLong(0);
+            if (res == 0) return 0;
             if (res == UNDECIDED) unknown = 1;
         }
     }
-    return PyLong_FromLong(unknown ? -1 : (tested ? 3 : 1));
+    return unknown ? -1 : (tested ? 3 : 1);
+}
+
+static PyObject *py_segment(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    double q[4];
+    if (check_nargs(nargs, 5, "segment(grid, ax, ay, bx, by)") < 0) return NULL;
+    Grid *g = get_grid(args[0]);
+    if (!g || get_doubles(args + 1, 4, q) < 0) return NULL;
+    return PyLong_FromLong(grid_segment(g, q[0], q[1], q[2], q[3]));
+}
+
+/* For _se2motion.c (declared in _fast.h): the segment and point tests on a grid capsule,
+   -2 with an exception set when it is not one. */
+int fast_grid_segment(PyObject *cap, double ax, double ay, double bx, double by)
+{
+    Grid *g = get_grid(cap);
+    return g ? grid_segment(g, ax, ay, bx, by) : -2;
 }
 
 /* Is (x, y) a free state? 1 free, 0 not free, -1 undecided. */
@@ -365,6 +378,12 @@ static PyObject *py_point(PyObject *self, PyObject *const *args, Py_ssize_t narg
     Grid *g = get_grid(args[0]);
     if (!g || get_doubles(args + 1, 2, q) < 0) return NULL;
     return PyLong_FromLong(point_test(g, q[0], q[1]));
+}
+
+int fast_grid_point(PyObject *cap, double x, double y)
+{
+    Grid *g = get_grid(cap);
+    return g ? point_test(g, x, y) : -2;
 }
 
 /* orient(ax, ay, bx, by, cx, cy) -> the filter's sign, or 2 when it cannot certify one. */
@@ -586,6 +605,14 @@ static int se2_filter(SE2 *h, double x, double y, double c, double sn)
     return unknown ? -1 : 1;
 }
 
+/* For _se2motion.c: the filter stage of the exact pose test on an SE(2) capsule (1 free,
+   0 not free, -1 undecided; -2 with an exception set when it is not one). */
+int fast_se2_filter(PyObject *cap, double x, double y, double c, double sn)
+{
+    SE2 *h = (SE2 *)PyCapsule_GetPointer(cap, "cspace.spaces._fast.SE2");
+    return h ? se2_filter(h, x, y, c, sn) : -2;
+}
+
 static PyMethodDef methods[] = {
     {"grid", py_grid, METH_VARARGS, "Hold a grid index and its packed pieces (read-only); returns a handle."},
     {"segment", (PyCFunction)(void (*)(void))py_segment, METH_FASTCALL,
@@ -608,6 +635,18 @@ static PyMethodDef methods[] = {
      "se2_pose(handle, x, y, c, s): 1 free, 0 not free, -1 undecided (the exact test's float filter)."},
     {"se2_slow", (PyCFunction)(void (*)(void))py_se2_slow, METH_FASTCALL,
      "se2_slow(grid, handle, x, y, c, s): 1 free in the slab, 2 free, 0 not free, -1 undecided."},
+    {"se2_motion_handle", fast_se2_motion_handle, METH_VARARGS,
+     "se2_motion_handle(...): the data of the compiled SE(2) motion check (_se2motion.c)."},
+    {"se2_motion", (PyCFunction)(void (*)(void))fast_se2_motion, METH_FASTCALL,
+     "se2_motion(handle, grids, x0, y0, a0, x1, y1, a1): 1 free, 0 not free, -1 undecided, -2-k slab k (_se2motion.c)."},
+    {"car_handle", fast_car_handle, METH_VARARGS,
+     "car_handle(...): the data of the compiled car curve check (_carmotion.c)."},
+    {"car_curve", (PyCFunction)(void (*)(void))fast_car_curve, METH_FASTCALL,
+     "car_curve(handle, grids, x, y, th, segments, radius): (r, x, y, th), r 1 free, 0 not, -1 undecided, -2-k slab k (_carmotion.c)."},
+    {"reeds_shepp_word", (PyCFunction)(void (*)(void))fast_reeds_shepp_word, METH_FASTCALL,
+     "reeds_shepp_word(x, y, phi): reeds_shepp.py's word and lengths, the same doubles, or None (_carwords.c)."},
+    {"dubins_word", (PyCFunction)(void (*)(void))fast_dubins_word, METH_FASTCALL,
+     "dubins_word(d, alpha, beta): dubins.py's word and lengths, the same doubles, or None (_carwords.c)."},
     {"gjk", (PyCFunction)(void (*)(void))fast_gjk, METH_FASTCALL,
      "gjk(a, b, max_iterations): the loop of cspace.kernel.gjk._gjk on float64 (n, 2) arrays."},
     {"clearance_scan", (PyCFunction)(void (*)(void))fast_clearance_scan, METH_FASTCALL,

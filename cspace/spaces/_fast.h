@@ -120,4 +120,14 @@ PyObject *fast_clearance_scan(PyObject *self, PyObject *const *args, Py_ssize_t 
 PyObject *fast_pack_boxes(PyObject *self, PyObject *args);                    /* _nearest.c */
 PyObject *fast_box_gaps(PyObject *self, PyObject *args);                      /* _nearest.c */
 
+int fast_grid_segment(PyObject *grid, double ax, double ay, double bx, double by); /* _fast.c */
+int fast_grid_point(PyObject *grid, double x, double y);                         /* _fast.c */
+int fast_se2_filter(PyObject *se2, double x, double y, double c, double s);      /* _fast.c */
+PyObject *fast_se2_motion_handle(PyObject *self, PyObject *args);              /* _se2motion.c */
+PyObject *fast_se2_motion(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _se2motion.c */
+PyObject *fast_car_handle(PyObject *self, PyObject *args);                     /* _carmotion.c */
+PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carmotion.c */
+PyObject *fast_reeds_shepp_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */
+PyObject *fast_dubins_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */
+
 #endif

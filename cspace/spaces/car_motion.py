@@ -24,6 +24,12 @@ The certified set is the union of the exact primitive motions started from the
 float knots (:func:`cspace.spaces.car_curves.advance`); consecutive knots meet within
 rounding, which the hull's pad (hundreds of units of roundoff of the coordinates)
 covers, and the curve's end is joined to the goal pose by a certified SE(2) motion.
+
+On the compiled path (:func:`cspace.spaces.fastpath.car_curve`, cspace/spaces/_carmotion.c)
+the probe, the straight segments and the arcs' halving run in one C call per curve with the
+same doubles; it answers "free" only where this path would (a separating axis needs this
+path's gap plus ~2048 roundoffs), "not free" only on a pose in collision, and hands
+anything else ("undecided") to this path, the oracle.
 """
 from __future__ import annotations
 
@@ -31,6 +37,7 @@ import math
 
 import numpy as np
 
+from . import fastpath
 from .car_curves import advance, turning_centre
 from ..kernel.slab import rotate_piece, slab_pad, wrap_angle
 
@@ -72,6 +79,8 @@ class CarMotions:
     """The car-like motion queries of :class:`cspace.spaces.se2.SE2CSpace` (a mixin)."""
 
     _car_planes = None
+    # The compiled curve check (fastpath.car_curve), made on the first curve; None: pure.
+    _car_fast = False
 
     def curve_free(self, q0, segments, radius: float, q1=None) -> bool:
         """Is every pose of the segment chain from q0 free? Certified (see module doc).
@@ -94,6 +103,40 @@ class CarMotions:
         self.checks["curves"] += 1
         radius = float(radius)
         pose = (float(q0[0]), float(q0[1]), wrap_angle(float(q0[2])))
+        fast = self._car_fast
+        if fast is False:  # first curve: the compiled check, or None on the pure path
+            fast = self._car_fast = fastpath.car_curve(self, MAX_HULLS, FLOOR_REL, ARC_CHUNK)
+            self._car_grids = [None] * self.slabs
+        if fast is not None:
+            got = self._curve_fast(fast, pose, segments, radius, q1)
+            if got is not None:
+                return got
+        return self._curve_pure(pose, segments, radius, q1)
+
+    def _curve_fast(self, fast, pose, segments, radius: float, q1):
+        """:meth:`curve_free` by the compiled check (cspace/spaces/_carmotion.c: its "free" and
+        "not free" are the pure path's), or None when it cannot decide."""
+        grids = self._car_grids
+        while True:  # one call; a slab not built yet is built and the call repeated
+            r, x, y, th = fast(grids, pose[0], pose[1], pose[2], segments, radius)
+            if r == 0:
+                return False
+            if r == 1:
+                break
+            if r == -1:
+                return None
+            handle = self.slab(-2 - r)._fast
+            if handle is None:
+                return None
+            grids[-2 - r] = handle
+        if q1 is not None:
+            q1 = (float(q1[0]), float(q1[1]), wrap_angle(float(q1[2])))
+            if (x, y, th) != q1 and not self.motion_free((x, y, th), q1):
+                return False
+        return True
+
+    def _curve_pure(self, pose, segments, radius: float, q1) -> bool:
+        """:meth:`curve_free` after its counter, on the pure path (the oracle)."""
         if not self._pose(*pose):
             self.checks["motion_collisions"] += 1
             return False

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import math
 
+from . import fastpath
+
 TWO_PI = 2.0 * math.pi
 # OMPL's tolerances: a turn in (−1e-7, 0) or within 0.5e-6 of 2π is a rounding of "no turn";
 # poses closer than 1e-6 radii with headings within 1e-6 are joined by one straight step.
@@ -148,6 +150,16 @@ def dubins_word(d: float, alpha: float, beta: float) -> tuple[str, tuple[float, 
     """The shortest Dubins word for (d, α, β) in the normalized frame, as OMPL picks it.
 
     >>> dubins_word(4.0, 0.0, 0.0)
+    ('LSL', (0.0, 4.0, 0.0))
+    """
+    got = fastpath.dubins_word(d, alpha, beta)  # compiled: the same word, the same doubles
+    return got if got is not None else dubins_word_pure(d, alpha, beta)
+
+
+def dubins_word_pure(d: float, alpha: float, beta: float) -> tuple[str, tuple[float, float, float]]:
+    """:func:`dubins_word` in Python (the oracle of the compiled one).
+
+    >>> dubins_word_pure(4.0, 0.0, 0.0)
     ('LSL', (0.0, 4.0, 0.0))
     """
     if d < NEAR and abs(alpha - beta) < NEAR:

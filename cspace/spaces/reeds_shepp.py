@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import math
 
+from . import fastpath
+
 PI = math.pi
 TWO_PI = 2.0 * PI
 HALF_PI = 0.5 * PI
@@ -229,6 +231,16 @@ def reeds_shepp_word(x: float, y: float, phi: float) -> tuple[str, tuple[float, 
     ('LSL', (0.0, 2.0, 0.0))
     >>> reeds_shepp_word(-2.0, 0.0, 0.0)[1][1]
     -2.0
+    """
+    got = fastpath.reeds_shepp_word(x, y, phi)  # compiled: the same word, the same doubles
+    return got if got is not None else reeds_shepp_word_pure(x, y, phi)
+
+
+def reeds_shepp_word_pure(x: float, y: float, phi: float) -> tuple[str, tuple[float, ...]]:
+    """:func:`reeds_shepp_word` in Python (the oracle of the compiled one).
+
+    >>> reeds_shepp_word_pure(2.0, 0.0, 0.0)
+    ('LSL', (0.0, 2.0, 0.0))
     """
     # Ties between words of equal length are common where the goal is symmetric (φ = π, goals
     # on a line): to pick OMPL's word there, compare as OMPL does, the candidate's cost against

@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from . import fastpath
 from ..kernel.gjk import exact_relation
 from ..kernel.minkowski import minkowski_sum, reflect
 from ..kernel.pieces import PieceSet
@@ -71,6 +72,9 @@ class SE2Motions:
     """The motion queries of :class:`cspace.spaces.se2.SE2CSpace` (a mixin: it reads the C-space's
     pieces, slabs, pose test and counters)."""
 
+    # The compiled motion check (fastpath.se2_motion), made on the first motion; None: pure.
+    _motion_fast = False
+
     def motion_free(self, q0, q1) -> bool:
         """Is every pose of OMPL's SE(2) interpolation from q0 to q1 free? Certified.
 
@@ -84,6 +88,27 @@ class SE2Motions:
         if not (self._pose(x1, y1, a1) and self._pose(x0, y0, a0)):
             self.checks["motion_collisions"] += 1
             return False
+        fast = self._motion_fast
+        if fast is False:  # first motion: the compiled check, or None on the pure path
+            fast = self._motion_fast = fastpath.se2_motion(self, MAX_REFINE, FLOOR_REL)
+            self._motion_grids = [None] * self.slabs
+        if fast is not None:
+            grids = self._motion_grids
+            while True:  # one call; a slab not built yet is built and the call repeated
+                r = fast(grids, x0, y0, a0, x1, y1, a1)
+                if r >= 0:
+                    return r == 1  # certified (see cspace/spaces/_se2motion.c), counted there
+                if r == -1:
+                    break  # undecided: the pure path below decides, from the start
+                k = -2 - r
+                handle = self.slab(k)._fast
+                if handle is None:
+                    break
+                grids[k] = handle
+        return self._motion_pure(x0, y0, a0, x1, y1, a1)
+
+    def _motion_pure(self, x0: float, y0: float, a0: float, x1: float, y1: float, a1: float) -> bool:
+        """:meth:`motion_free` after its end poses, on the pure path (the oracle)."""
         D = turn_arc(a0, a1)
         budget = [MAX_REFINE]
         for ta, tb in self._split(a0, D):
