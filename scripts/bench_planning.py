@@ -64,11 +64,13 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
+sys.path.insert(0, HERE)  # se2_peers
 
 from cspace.spaces.cspace import CSpace, decompose_obstacles, decompose_robot  # noqa: E402
 from cspace.io.scenario import load_scenario  # noqa: E402
 from planners.core.routine import run_planner  # noqa: E402
 from planners.adapters.translation import TranslationSpace  # noqa: E402
+from se2_peers import prism  # noqa: E402  (coal's prisms, shared with the SE(2) benches)
 
 PLANNERS = ("RRTConnect", "RRTstar")
 CHECKERS = ("ours", "shapely", "coal", "coal-fine")  # the coals only when installed (pip install -e ".[bench]")
@@ -135,26 +137,6 @@ def coal_available() -> bool:
     return True
 
 
-def _prism(poly: np.ndarray):
-    """A convex polygon as a coal.Convex prism (z in [-1, 1]): coal is 3-D."""
-    import coal
-
-    n = len(poly)
-    pts = coal.StdVec_Vec3s()
-    for z in (-1.0, 1.0):
-        for x, y in poly.tolist():
-            pts.append(np.array([x, y, z]))
-    tris = coal.StdVec_Triangle()
-    for i in range(1, n - 1):
-        tris.append(coal.Triangle(0, i + 1, i))
-        tris.append(coal.Triangle(n, n + i, n + i + 1))
-    for i in range(n):
-        j = (i + 1) % n
-        tris.append(coal.Triangle(i, j, n + j))
-        tris.append(coal.Triangle(i, n + j, n + i))
-    return coal.Convex(pts, tris)
-
-
 def convex_pieces(sc) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """Our convex pieces of the scene: (obstacle pieces, robot pieces; none for a point)."""
     opieces, _owner, _n = decompose_obstacles([o.polygon for o in sc.obstacles], [o.holes for o in sc.obstacles])
@@ -170,12 +152,12 @@ def coal_checker(sc):
     manager = coal.DynamicAABBTreeCollisionManager()
     keep = []  # coal's objects hold the geometries by reference
     for p in opieces:
-        obj = coal.CollisionObject(_prism(p), coal.Transform3s())
+        obj = coal.CollisionObject(prism(p), coal.Transform3s())
         keep.append(obj)
         manager.registerObject(obj)
     manager.setup()
     if rpieces:
-        robot = [coal.CollisionObject(_prism(p), coal.Transform3s()) for p in rpieces]
+        robot = [coal.CollisionObject(prism(p), coal.Transform3s()) for p in rpieces]
     else:
         robot = [coal.CollisionObject(coal.Sphere(0.0), coal.Transform3s())]
     callback = coal.CollisionCallBackDefault()

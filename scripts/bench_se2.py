@@ -56,26 +56,11 @@ VALIDITY_SCENES = ("car_maze.toml", "bug_trap.toml", "piano_corridor.toml")
 
 
 def shapely_se2_checker(sc):
-    """The peer: ``state -> bool``: the robot rotated and translated by shapely, STRtree + prepared intersects."""
-    import shapely
-    from shapely import affinity
+    """The peer: ``state -> bool``: the robot rotated and translated by shapely, STRtree + prepared
+    intersects (``se2_peers.shapely_checker``, which part P uses too)."""
+    import se2_peers
 
-    obstacles = np.array([o.to_shapely() for o in sc.obstacles], dtype=object)
-    shapely.prepare(obstacles)
-    tree = shapely.STRtree(obstacles)
-    body = shapely.union_all([shapely.Polygon(r.polygon) for r in sc.robot])
-    xmin, xmax, ymin, ymax = sc.bounds
-    rot, tr, intersects, query = affinity.rotate, affinity.translate, shapely.intersects, tree.query
-
-    def is_valid(s) -> bool:
-        x, y = s.getX(), s.getY()
-        if not (xmin <= x <= xmax and ymin <= y <= ymax):
-            return False
-        moved = tr(rot(body, s.getYaw(), origin=(0, 0), use_radians=True), x, y)
-        cand = query(moved)
-        return not (len(cand) and intersects(obstacles[cand], moved).any())
-
-    return is_valid
+    return se2_peers.shapely_checker(sc)
 
 
 def _si(space_adapter, checker=None, validator: str = "ours"):
