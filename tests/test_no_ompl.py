@@ -89,3 +89,14 @@ def test_help_imports_no_command_module():
     m = subprocess.run([sys.executable, "-m", "planners", "--help"], cwd=ROOT, capture_output=True, text=True,
                        timeout=60)
     assert m.returncode == 0 and m.stdout.startswith("usage: cspace") and "plan a collision-free path" in m.stdout
+
+
+def test_a_rotating_robot_plans_without_ompl_by_the_slab_graph():
+    door = str(ROOT / "scenarios" / "se2" / "bar_door.toml")
+    r = cli("plan", door)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.startswith("note: OMPL is not installed: planning with the exact planner instead")
+    assert "solved by exact" in r.stdout and "not shortened" in r.stdout
+    trap = str(ROOT / "scenarios" / "se2" / "bug_trap_l.toml")
+    r = cli("plan", trap)
+    assert r.returncode == 1 and "proven unsolvable" in r.stdout
