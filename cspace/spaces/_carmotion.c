@@ -32,8 +32,6 @@
    Hence "free" here implies "free" on the Python path, and "not free" implies "not free". */
 #include "_fast.h"
 
-#define PI 3.141592653589793
-#define TWO_PI (2.0 * PI)
 #define MAX_SEGMENTS 16
 #define STRAIGHT_BUDGET 512
 
@@ -80,23 +78,6 @@ static void car_free_cap(PyObject *cap)
     if (h) car_release(h);
 }
 
-static void *car_copy(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const char *name)
-{
-    Py_buffer view;
-    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS) < 0) return NULL;
-    void *out = NULL;
-    if (view.len != size * count) {
-        PyErr_Format(PyExc_ValueError, "_fast.car_handle: %s has %zd bytes, expected %zd", name, view.len,
-                     size * count);
-    } else {
-        out = PyMem_Malloc(view.len ? view.len : 1);
-        if (!out) PyErr_NoMemory();
-        else memcpy(out, view.buf, view.len);
-    }
-    PyBuffer_Release(&view);
-    return out;
-}
-
 /* car_handle(se2, checks, slab_lo, slab_hi, o_off, o_xy, o_edge, r_off, r_xy, K, n_obs, n_rob,
    max_hulls, scale, radius, floor_len, arc_chunk, xmin, xmax, ymin, ymax) -> capsule. */
 PyObject *fast_car_handle(PyObject *self, PyObject *args)
@@ -127,22 +108,15 @@ PyObject *fast_car_handle(PyObject *self, PyObject *args)
     h->scale = scale, h->radius = radius, h->floor_len = floor_len, h->arc_chunk = chunk;
     h->xmin = xmin, h->xmax = xmax, h->ymin = ymin, h->ymax = ymax;
     h->margin = 0x1p-42 * (scale + radius) + 0x1p-900;
-    if (!(h->slab_lo = car_copy(a[0], 8, K, "slab_lo"))) goto fail;
-    if (!(h->slab_hi = car_copy(a[1], 8, K, "slab_hi"))) goto fail;
-    if (!(h->o_off = car_copy(a[2], 8, n_obs + 1, "o_off"))) goto fail;
-    if (!(h->r_off = car_copy(a[5], 8, n_rob + 1, "r_off"))) goto fail;
-    if (h->o_off[0] != 0 || h->r_off[0] != 0) goto bad;
-    for (int64_t i = 0; i < n_obs; i++)
-        if (h->o_off[i + 1] < h->o_off[i] + 3) goto bad;
-    h->max_n = 0;
-    for (int64_t j = 0; j < n_rob; j++) {
-        if (h->r_off[j + 1] <= h->r_off[j]) goto bad;
-        if (h->r_off[j + 1] - h->r_off[j] > h->max_n) h->max_n = h->r_off[j + 1] - h->r_off[j];
-    }
+    if (!(h->slab_lo = fast_copy_buffer(a[0], 8, K, "slab_lo"))) goto fail;
+    if (!(h->slab_hi = fast_copy_buffer(a[1], 8, K, "slab_hi"))) goto fail;
+    if (!(h->o_off = fast_copy_buffer(a[2], 8, n_obs + 1, "o_off"))) goto fail;
+    if (!(h->r_off = fast_copy_buffer(a[5], 8, n_rob + 1, "r_off"))) goto fail;
+    if ((h->max_n = piece_offsets_max(h->o_off, n_obs, h->r_off, n_rob)) < 0) goto bad;
     int64_t no = h->o_off[n_obs], nr = h->r_off[n_rob];
-    if (!(h->o_xy = car_copy(a[3], 16, no, "o_xy"))) goto fail;
-    if (!(h->o_edge = car_copy(a[4], 32, no, "o_edge"))) goto fail;
-    if (!(h->r_xy = car_copy(a[6], 16, nr, "r_xy"))) goto fail;
+    if (!(h->o_xy = fast_copy_buffer(a[3], 16, no, "o_xy"))) goto fail;
+    if (!(h->o_edge = fast_copy_buffer(a[4], 32, no, "o_edge"))) goto fail;
+    if (!(h->r_xy = fast_copy_buffer(a[6], 16, nr, "r_xy"))) goto fail;
     h->o_box = PyMem_Malloc(32 * (size_t)(n_obs ? n_obs : 1));
     h->P = PyMem_Malloc(16 * (size_t)nr);
     h->N = PyMem_Malloc(16 * (size_t)nr);
@@ -155,18 +129,7 @@ PyObject *fast_car_handle(PyObject *self, PyObject *args)
         PyErr_NoMemory();
         goto fail;
     }
-    for (int64_t i = 0; i < n_obs; i++) {
-        double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
-        for (int64_t v = h->o_off[i]; v < h->o_off[i + 1]; v++) {
-            double x = h->o_xy[2 * v], y = h->o_xy[2 * v + 1];
-            if (!(isfinite(x) && isfinite(y))) goto bad;
-            if (x < x0) x0 = x;
-            if (x > x1) x1 = x;
-            if (y < y0) y0 = y;
-            if (y > y1) y1 = y;
-        }
-        h->o_box[4 * i] = x0, h->o_box[4 * i + 1] = y0, h->o_box[4 * i + 2] = x1, h->o_box[4 * i + 3] = y1;
-    }
+    if (piece_boxes(h->o_xy, h->o_off, n_obs, h->o_box) < 0) goto bad;
     PyObject *cap = PyCapsule_New(h, "cspace.spaces._fast.Car", car_free_cap);
     if (cap) return cap;
     goto fail;
@@ -177,31 +140,6 @@ fail:
     return NULL;
 }
 
-/* OMPL's angle wrap (cspace.kernel.slab.wrap_angle). */
-static inline double car_wrap(double t)
-{
-    if (-PI <= t && t < PI) return t;
-    double v = fmod(t, TWO_PI);
-    if (v < -PI) v += TWO_PI;
-    else if (v >= PI) v -= TWO_PI;
-    return v;
-}
-
-static int64_t car_slab(const Car *h, double t)
-{
-    int64_t K = h->K;
-    if (K == 1) return 0;
-    if (t != t) return -1;
-    double f = floor((t + PI) * ((double)K / TWO_PI));
-    int64_t k = f < 0.0 ? 0 : (f > (double)(K - 1) ? K - 1 : (int64_t)f);
-    int64_t cands[3] = {k, k - 1, k + 1};
-    for (int c = 0; c < 3; c++) {
-        int64_t q = cands[c];
-        if (q >= 0 && q < K && h->slab_lo[q] <= t && t <= h->slab_hi[q]) return q;
-    }
-    return -1;
-}
-
 /* Undecided / slab k unbuilt / error codes of the helpers below. */
 #define R_UNDECIDED (-1)
 #define R_ERROR (-2)
@@ -210,7 +148,7 @@ static int64_t car_slab(const Car *h, double t)
 /* The pose (th wrapped): 1 free, 0 not free, R_UNDECIDED, R_SLAB(k), R_ERROR. */
 static int64_t car_pose(Car *h, PyObject *grids, double x, double y, double th)
 {
-    int64_t k = car_slab(h, th);
+    int64_t k = slab_index(h->slab_lo, h->slab_hi, h->K, th);
     if (k < 0) return R_UNDECIDED;
     PyObject *g = PyList_GET_ITEM(grids, k);
     if (g == Py_None) return R_SLAB(k);
@@ -404,18 +342,6 @@ static int turn_hits(Car *h, double cx, double cy, double a, double b, double sc
     return 0;
 }
 
-static inline void dot_range(const double *p, int64_t n, double nx, double ny, double *lo, double *hi)
-{
-    double a = HUGE_VAL, b = -HUGE_VAL;
-    for (int64_t k = 0; k < n; k++) {
-        double v = nx * p[2 * k] + ny * p[2 * k + 1];
-        if (v < a) a = v;
-        if (v > b) b = v;
-    }
-    *lo = a;
-    *hi = b;
-}
-
 /* Might a robot piece at the angle whose rotated pieces (about the origin) are in h->P,
    normals in h->N, swept along a-b, meet an obstacle piece? 0 certainly not (every pair
    has a separating axis with a gap above M |n|_1), 1 maybe. */
@@ -427,8 +353,8 @@ static int fixed_hits(Car *h, double ax, double ay, double bx, double by)
         int64_t o = h->r_off[j], n = h->r_off[j + 1] - o;
         const double *R = h->P + 2 * o, *Nr = h->N + 2 * o;
         double tx0, tx1, ty0, ty1;
-        dot_range(R, n, 1.0, 0.0, &tx0, &tx1);
-        dot_range(R, n, 0.0, 1.0, &ty0, &ty1);
+        dot_interval(R, n, 1.0, 0.0, &tx0, &tx1);
+        dot_interval(R, n, 0.0, 1.0, &ty0, &ty1);
         double bx0 = tx0 + (ax < bx ? ax : bx) - M, bx1 = tx1 + (ax < bx ? bx : ax) + M;
         double by0 = ty0 + (ay < by ? ay : by) - M, by1 = ty1 + (ay < by ? by : ay) + M;
         for (int64_t i = 0; i < h->n_obs; i++) {
@@ -444,8 +370,8 @@ static int fixed_hits(Car *h, double ax, double ay, double bx, double by)
                 else nx = snx, ny = sny;
                 if (nx == 0.0 && ny == 0.0) continue;
                 double tlo, thi, olo, ohi;
-                dot_range(R, n, nx, ny, &tlo, &thi);
-                dot_range(O, no, nx, ny, &olo, &ohi);
+                dot_interval(R, n, nx, ny, &tlo, &thi);
+                dot_interval(O, no, nx, ny, &olo, &ohi);
                 double pa = nx * ax + ny * ay, pb = nx * bx + ny * by, g = M * (fabs(nx) + fabs(ny));
                 double slo = tlo + (pa < pb ? pa : pb), shi = thi + (pa < pb ? pb : pa);
                 if (shi + g < olo || ohi + g < slo) sep = 1;
@@ -454,19 +380,6 @@ static int fixed_hits(Car *h, double ax, double ay, double bx, double by)
         }
     }
     return 0;
-}
-
-static int car_count(PyObject *d, const char *key, long delta)
-{
-    if (!delta) return 0;
-    PyObject *old = PyDict_GetItemString(d, key);
-    long v = old ? PyLong_AsLong(old) : 0;
-    if (v == -1 && PyErr_Occurred()) return -1;
-    PyObject *n = PyLong_FromLong(v + delta);
-    if (!n) return -1;
-    int r = PyDict_SetItemString(d, key, n);
-    Py_DECREF(n);
-    return r;
 }
 
 typedef struct {
@@ -479,7 +392,7 @@ typedef struct {
 /* A straight segment at the angle th from (x0, y0) to (x1, y1): 1, 0 or an R_ code. */
 static int64_t straight(Car *h, PyObject *grids, double x0, double y0, double x1, double y1, double th)
 {
-    int64_t k = car_slab(h, th);
+    int64_t k = slab_index(h->slab_lo, h->slab_hi, h->K, th);
     if (k < 0) return R_UNDECIDED;
     PyObject *g = PyList_GET_ITEM(grids, k);
     if (g == Py_None) return R_SLAB(k);
@@ -551,7 +464,7 @@ static int64_t arc(Car *h, PyObject *grids, const Link *L, double radius, int64_
         ++*n_sweeps;
         if (!turn_hits(h, cx, cy, a, b, scale, M, n_near)) continue;
         double m = 0.5 * (a + b), c = cos(m), s = sin(m);
-        int64_t pr = car_pose(h, grids, cx + rx * c - ry * s, cy + rx * s + ry * c, car_wrap(th + m));
+        int64_t pr = car_pose(h, grids, cx + rx * c - ry * s, cy + rx * s + ry * c, wrap_angle(th + m));
         if (pr != 1) return pr;
         if (reach * (b - a) <= h->floor_len || *budget <= 0 || !(a < m && m < b) || top + 2 > h->stack_cap)
             return R_UNDECIDED; /* the floor: the Python path counts and answers it */
@@ -624,7 +537,7 @@ PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs
             break;
         }
         L->sx = px, L->sy = py, L->st = pt, L->kind = ks[0], L->length = length;
-        L->ex = e[0], L->ey = e[1], L->et = car_wrap(e[2]);
+        L->ex = e[0], L->ey = e[1], L->et = wrap_angle(e[2]);
         px = L->ex, py = L->ey, pt = L->et;
     }
     Py_DECREF(seq);
@@ -639,7 +552,7 @@ PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs
         res = car_pose(h, grids, L->ex, L->ey, L->et);
         if (res == 1) {
             advance(L->sx, L->sy, L->st, L->kind, 0.5 * L->length, radius, mid);
-            res = car_pose(h, grids, mid[0], mid[1], car_wrap(mid[2]));
+            res = car_pose(h, grids, mid[0], mid[1], wrap_angle(mid[2]));
         }
         if (res == 0) n_coll++;
     }
@@ -658,8 +571,8 @@ PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs
     if (res == R_ERROR) return NULL;
     if (res >= 0) { /* decided: count as the Python path counts */
         PyObject *d = h->checks;
-        if (car_count(d, "arcs", n_arcs) < 0 || car_count(d, "arc_sweeps", n_sweeps) < 0
-            || car_count(d, "motion_collisions", n_coll) < 0)
+        if (fast_add_count(d, "arcs", n_arcs) < 0 || fast_add_count(d, "arc_sweeps", n_sweeps) < 0
+            || fast_add_count(d, "motion_collisions", n_coll) < 0)
             return NULL;
     }
     long code = res >= 0 ? (long)res : (res == R_UNDECIDED ? -1 : (long)(-2 - (-3 - res)));

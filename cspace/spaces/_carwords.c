@@ -6,8 +6,6 @@
    here: the words only say which curve a motion is; its poses are certified elsewhere. */
 #include "_fast.h"
 
-#define PI 3.141592653589793
-#define TWO_PI (2.0 * PI)
 #define HALF_PI (0.5 * PI)
 
 /* ------------------------------------------------------------------ Reeds-Shepp */

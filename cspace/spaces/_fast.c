@@ -107,8 +107,9 @@ static void grid_free(PyObject *cap)
     if (g) grid_release(g);
 }
 
-/* A private copy of a buffer of `count` items of `size` bytes (the caller owns the arrays). */
-static void *copy_buffer(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const char *name)
+/* A private copy of a buffer of `count` items of `size` bytes (the caller owns the arrays;
+   also the copy of _se2motion.c's and _carmotion.c's handles). */
+void *fast_copy_buffer(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const char *name)
 {
     Py_buffer view;
     if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS) < 0) return NULL;
@@ -122,6 +123,20 @@ static void *copy_buffer(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const
     }
     PyBuffer_Release(&view);
     return out;
+}
+
+/* d[key] += delta (a counter of the C-space's checks dict, 0 when absent); 0, or -1 on error. */
+int fast_add_count(PyObject *d, const char *key, long delta)
+{
+    if (!delta) return 0;
+    PyObject *old = PyDict_GetItemString(d, key); /* borrowed */
+    long v = old ? PyLong_AsLong(old) : 0;
+    if (v == -1 && PyErr_Occurred()) return -1;
+    PyObject *n = PyLong_FromLong(v + delta);
+    if (!n) return -1;
+    int r = PyDict_SetItemString(d, key, n);
+    Py_DECREF(n);
+    return r;
 }
 
 /* A view of `count` items of `size` bytes held by g until its release (the caller hands
@@ -464,20 +479,20 @@ static PyObject *py_se2(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "_fast.se2: bad sizes");
         goto fail;
     }
-    if (!(h->o_off = copy_buffer(a[0], 8, n_obs + 1, "o_off"))) goto fail;
-    if (!(h->r_off = copy_buffer(a[3], 8, n_rob + 1, "r_off"))) goto fail;
+    if (!(h->o_off = fast_copy_buffer(a[0], 8, n_obs + 1, "o_off"))) goto fail;
+    if (!(h->r_off = fast_copy_buffer(a[3], 8, n_rob + 1, "r_off"))) goto fail;
     int64_t no = h->o_off[n_obs], nr = h->r_off[n_rob];
     for (int64_t i = 0; i < n_obs; i++)
         if (h->o_off[i + 1] <= h->o_off[i]) goto bad;
     for (int64_t j = 0; j < n_rob; j++)
         if (h->r_off[j + 1] <= h->r_off[j]) goto bad;
-    if (!(h->o_edge = copy_buffer(a[1], 32, no, "o_edge"))) goto fail;
-    if (!(h->o_pt = copy_buffer(a[2], 16, no, "o_pt"))) goto fail;
-    if (!(h->r_pt = copy_buffer(a[4], 16, nr, "r_pt"))) goto fail;
-    if (!(h->r_nrm = copy_buffer(a[5], 24, nr, "r_nrm"))) goto fail;
-    if (!(h->starts = copy_buffer(a[6], 8, n * n + 1, "starts"))) goto fail;
-    if (!(h->e_ij = copy_buffer(a[7], 16, n_ent, "e_ij"))) goto fail;
-    if (!(h->e_box = copy_buffer(a[8], 32, n_ent, "e_box"))) goto fail;
+    if (!(h->o_edge = fast_copy_buffer(a[1], 32, no, "o_edge"))) goto fail;
+    if (!(h->o_pt = fast_copy_buffer(a[2], 16, no, "o_pt"))) goto fail;
+    if (!(h->r_pt = fast_copy_buffer(a[4], 16, nr, "r_pt"))) goto fail;
+    if (!(h->r_nrm = fast_copy_buffer(a[5], 24, nr, "r_nrm"))) goto fail;
+    if (!(h->starts = fast_copy_buffer(a[6], 8, n * n + 1, "starts"))) goto fail;
+    if (!(h->e_ij = fast_copy_buffer(a[7], 16, n_ent, "e_ij"))) goto fail;
+    if (!(h->e_box = fast_copy_buffer(a[8], 32, n_ent, "e_box"))) goto fail;
     for (int64_t c = 0; c < n * n; c++)
         if (h->starts[c] < 0 || h->starts[c] > h->starts[c + 1] || h->starts[c + 1] > n_ent) goto bad;
     for (int64_t t = 0; t < n_ent; t++)

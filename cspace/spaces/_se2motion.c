@@ -30,9 +30,6 @@
    Hence "free" here implies "free" on the Python path, and "not free" implies "not free". */
 #include "_fast.h"
 
-#define PI 3.141592653589793
-#define TWO_PI (2.0 * PI)
-
 typedef struct {
     int64_t K, n_obs, n_rob, max_refine, max_n;
     double *slab_lo, *slab_hi;    /* per slab: its hull interval (slab range +- ANGLE_SLACK) */
@@ -75,23 +72,6 @@ static void motion_free_cap(PyObject *cap)
     if (h) motion_release(h);
 }
 
-static void *copy_array(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const char *name)
-{
-    Py_buffer view;
-    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS) < 0) return NULL;
-    void *out = NULL;
-    if (view.len != size * count) {
-        PyErr_Format(PyExc_ValueError, "_fast.se2_motion_handle: %s has %zd bytes, expected %zd", name, view.len,
-                     size * count);
-    } else {
-        out = PyMem_Malloc(view.len ? view.len : 1);
-        if (!out) PyErr_NoMemory();
-        else memcpy(out, view.buf, view.len);
-    }
-    PyBuffer_Release(&view);
-    return out;
-}
-
 /* se2_motion_handle(se2, checks, slab_lo, slab_hi, o_off, o_xy, r_off, r_xy, K, n_obs, n_rob,
    max_refine, scale, radius, floor_len, slack) -> capsule (copies the arrays). */
 PyObject *fast_se2_motion_handle(PyObject *self, PyObject *args)
@@ -120,21 +100,14 @@ PyObject *fast_se2_motion_handle(PyObject *self, PyObject *args)
     h->scale = scale, h->radius = radius, h->floor_len = floor_len, h->slack = slack;
     /* The gap a separating axis needs, per unit of |n|_1 (see the file's comment). */
     h->margin = 0x1p-42 * (scale + radius) + 0x1p-900;
-    if (!(h->slab_lo = copy_array(a[0], 8, K, "slab_lo"))) goto fail;
-    if (!(h->slab_hi = copy_array(a[1], 8, K, "slab_hi"))) goto fail;
-    if (!(h->o_off = copy_array(a[2], 8, n_obs + 1, "o_off"))) goto fail;
-    if (!(h->r_off = copy_array(a[4], 8, n_rob + 1, "r_off"))) goto fail;
-    if (h->o_off[0] != 0 || h->r_off[0] != 0) goto bad;
-    for (int64_t i = 0; i < n_obs; i++)
-        if (h->o_off[i + 1] < h->o_off[i] + 3) goto bad; /* convex pieces: at least a triangle */
-    h->max_n = 0;
-    for (int64_t j = 0; j < n_rob; j++) {
-        if (h->r_off[j + 1] <= h->r_off[j]) goto bad;
-        if (h->r_off[j + 1] - h->r_off[j] > h->max_n) h->max_n = h->r_off[j + 1] - h->r_off[j];
-    }
+    if (!(h->slab_lo = fast_copy_buffer(a[0], 8, K, "slab_lo"))) goto fail;
+    if (!(h->slab_hi = fast_copy_buffer(a[1], 8, K, "slab_hi"))) goto fail;
+    if (!(h->o_off = fast_copy_buffer(a[2], 8, n_obs + 1, "o_off"))) goto fail;
+    if (!(h->r_off = fast_copy_buffer(a[4], 8, n_rob + 1, "r_off"))) goto fail;
+    if ((h->max_n = piece_offsets_max(h->o_off, n_obs, h->r_off, n_rob)) < 0) goto bad;
     int64_t no = h->o_off[n_obs], nr = h->r_off[n_rob];
-    if (!(h->o_xy = copy_array(a[3], 16, no, "o_xy"))) goto fail;
-    if (!(h->r_xy = copy_array(a[5], 16, nr, "r_xy"))) goto fail;
+    if (!(h->o_xy = fast_copy_buffer(a[3], 16, no, "o_xy"))) goto fail;
+    if (!(h->r_xy = fast_copy_buffer(a[5], 16, nr, "r_xy"))) goto fail;
     h->o_nrm = PyMem_Malloc(16 * (size_t)(no ? no : 1));
     h->o_box = PyMem_Malloc(32 * (size_t)(n_obs ? n_obs : 1));
     size_t t = 3 * (size_t)h->max_n + 2;
@@ -149,21 +122,14 @@ PyObject *fast_se2_motion_handle(PyObject *self, PyObject *args)
         PyErr_NoMemory();
         goto fail;
     }
+    if (piece_boxes(h->o_xy, h->o_off, n_obs, h->o_box) < 0) goto bad;
     for (int64_t i = 0; i < n_obs; i++) {
-        double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
         int64_t s = h->o_off[i], e = h->o_off[i + 1];
         for (int64_t v = s; v < e; v++) {
-            double x = h->o_xy[2 * v], y = h->o_xy[2 * v + 1];
-            if (!(isfinite(x) && isfinite(y))) goto bad;
-            if (x < x0) x0 = x;
-            if (x > x1) x1 = x;
-            if (y < y0) y0 = y;
-            if (y > y1) y1 = y;
             int64_t p = v == s ? e - 1 : v - 1; /* the edge ending at v: any direction is an axis */
-            h->o_nrm[2 * v] = y - h->o_xy[2 * p + 1];
-            h->o_nrm[2 * v + 1] = h->o_xy[2 * p] - x;
+            h->o_nrm[2 * v] = h->o_xy[2 * v + 1] - h->o_xy[2 * p + 1];
+            h->o_nrm[2 * v + 1] = h->o_xy[2 * p] - h->o_xy[2 * v];
         }
-        h->o_box[4 * i] = x0, h->o_box[4 * i + 1] = y0, h->o_box[4 * i + 2] = x1, h->o_box[4 * i + 3] = y1;
     }
     PyObject *cap = PyCapsule_New(h, "cspace.spaces._fast.SE2Motion", motion_free_cap);
     if (cap) return cap;
@@ -173,45 +139,6 @@ bad:
 fail:
     motion_release(h);
     return NULL;
-}
-
-/* OMPL's angle wrap (cspace.kernel.slab.wrap_angle). */
-static inline double wrap(double t)
-{
-    if (-PI <= t && t < PI) return t;
-    double v = fmod(t, TWO_PI);
-    if (v < -PI) v += TWO_PI;
-    else if (v >= PI) v -= TWO_PI;
-    return v;
-}
-
-/* slab_of(t, K) for t already wrapped, or -1 (never: a slab always covers it). */
-static int64_t slab_index(const Motion *h, double t)
-{
-    int64_t K = h->K;
-    if (K == 1) return 0;
-    if (t != t) return -1;
-    double f = floor((t + PI) * ((double)K / TWO_PI));
-    int64_t k = f < 0.0 ? 0 : (f > (double)(K - 1) ? K - 1 : (int64_t)f);
-    int64_t cands[3] = {k, k - 1, k + 1};
-    for (int c = 0; c < 3; c++) {
-        int64_t q = cands[c];
-        if (q >= 0 && q < K && h->slab_lo[q] <= t && t <= h->slab_hi[q]) return q;
-    }
-    return -1;
-}
-
-/* The interval of n . x over the points (n points, x y interleaved). */
-static inline void interval(const double *p, int64_t n, double nx, double ny, double *lo, double *hi)
-{
-    double a = HUGE_VAL, b = -HUGE_VAL;
-    for (int64_t k = 0; k < n; k++) {
-        double v = nx * p[2 * k] + ny * p[2 * k + 1];
-        if (v < a) a = v;
-        if (v > b) b = v;
-    }
-    *lo = a;
-    *hi = b;
 }
 
 /* Float convex hull (Andrew's chain) of n points: the indices of its vertices in idx, CCW;
@@ -278,8 +205,8 @@ static int sweep_hits(Motion *h, double pax, double pay, double pbx, double pby,
         if (!(isfinite(d) && isfinite(ch) && ch > 0.0)) return 1;
         /* The sweep's box (the axes of the square), and its hull's normals with T's intervals. */
         double tx0, tx1, ty0, ty1;
-        interval(T, nt, 1.0, 0.0, &tx0, &tx1);
-        interval(T, nt, 0.0, 1.0, &ty0, &ty1);
+        dot_interval(T, nt, 1.0, 0.0, &tx0, &tx1);
+        dot_interval(T, nt, 0.0, 1.0, &ty0, &ty1);
         double bx0 = tx0 - d + sxlo, bx1 = tx1 + d + sxhi, by0 = ty0 - d + sylo, by1 = ty1 + d + syhi;
         int64_t *chain = h->idx + (3 * h->max_n + 2);
         int64_t nh = float_hull(T, nt, h->idx, chain);
@@ -290,7 +217,7 @@ static int sweep_hits(Motion *h, double pax, double pay, double pbx, double pby,
             if (nx == 0.0 && ny == 0.0) continue;
             h->hull_nrm[2 * na] = nx, h->hull_nrm[2 * na + 1] = ny;
             double tlo, thi;
-            interval(T, nt, nx, ny, &tlo, &thi);
+            dot_interval(T, nt, nx, ny, &tlo, &thi);
             double pa = nx * pax + ny * pay, pb = nx * pbx + ny * pby, w = d * (fabs(nx) + fabs(ny));
             h->hull_lo[na] = tlo - w + (pa < pb ? pa : pb);
             h->hull_hi[na] = thi + w + (pa < pb ? pb : pa);
@@ -298,7 +225,7 @@ static int sweep_hits(Motion *h, double pax, double pay, double pbx, double pby,
         }
         if (segnx != 0.0 || segny != 0.0) { /* the segment's own normal */
             double tlo, thi;
-            interval(T, nt, segnx, segny, &tlo, &thi);
+            dot_interval(T, nt, segnx, segny, &tlo, &thi);
             double w = d * (fabs(segnx) + fabs(segny));
             h->hull_nrm[2 * na] = segnx, h->hull_nrm[2 * na + 1] = segny;
             h->hull_lo[na] = tlo - w + (segA < segB ? segA : segB);
@@ -314,15 +241,15 @@ static int sweep_hits(Motion *h, double pax, double pay, double pbx, double pby,
             for (int64_t a = 0; a < na && !sep; a++) { /* the sweep's normals */
                 double nx = h->hull_nrm[2 * a], ny = h->hull_nrm[2 * a + 1], olo, ohi;
                 double g = M * (fabs(nx) + fabs(ny));
-                interval(O, no, nx, ny, &olo, &ohi);
+                dot_interval(O, no, nx, ny, &olo, &ohi);
                 if (h->hull_hi[a] + g < olo || ohi + g < h->hull_lo[a]) sep = 1;
             }
             for (int64_t e = 0; e < no && !sep; e++) { /* the obstacle's normals */
                 double nx = h->o_nrm[2 * (o0 + e)], ny = h->o_nrm[2 * (o0 + e) + 1], olo, ohi, tlo, thi;
                 if (nx == 0.0 && ny == 0.0) continue;
                 double w = fabs(nx) + fabs(ny), g = M * w;
-                interval(O, no, nx, ny, &olo, &ohi);
-                interval(T, nt, nx, ny, &tlo, &thi);
+                dot_interval(O, no, nx, ny, &olo, &ohi);
+                dot_interval(T, nt, nx, ny, &tlo, &thi);
                 double pa = nx * pax + ny * pay, pb = nx * pbx + ny * pby;
                 double slo = tlo - d * w + (pa < pb ? pa : pb), shi = thi + d * w + (pa < pb ? pb : pa);
                 if (shi + g < olo || ohi + g < slo) sep = 1;
@@ -336,7 +263,7 @@ static int sweep_hits(Motion *h, double pax, double pay, double pbx, double pby,
 /* The pose (x, y, th) (th wrapped): 1 free, 0 in collision, -1 undecided, -2 error. */
 static int pose_test(Motion *h, PyObject *grids, double x, double y, double th)
 {
-    int64_t k = slab_index(h, th);
+    int64_t k = slab_index(h->slab_lo, h->slab_hi, h->K, th);
     if (k >= 0 && k < PyList_GET_SIZE(grids)) {
         PyObject *g = PyList_GET_ITEM(grids, k);
         if (g != Py_None) {
@@ -346,19 +273,6 @@ static int pose_test(Motion *h, PyObject *grids, double x, double y, double th)
         }
     }
     return fast_se2_filter(h->se2, x, y, cos(th), sin(th));
-}
-
-static int add_count(PyObject *d, const char *key, long delta)
-{
-    if (!delta) return 0;
-    PyObject *old = PyDict_GetItemString(d, key); /* borrowed */
-    long v = old ? PyLong_AsLong(old) : 0;
-    if (v == -1 && PyErr_Occurred()) return -1;
-    PyObject *n = PyLong_FromLong(v + delta);
-    if (!n) return -1;
-    int r = PyDict_SetItemString(d, key, n);
-    Py_DECREF(n);
-    return r;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -423,8 +337,8 @@ PyObject *fast_se2_motion(PyObject *self, PyObject *const *args, Py_ssize_t narg
         n_sub++;
         double pax = ta == 0.0 ? x0 : x0 + (x1 - x0) * ta, pay = ta == 0.0 ? y0 : y0 + (y1 - y0) * ta;
         double pbx = tb == 1.0 ? x1 : x0 + (x1 - x0) * tb, pby = tb == 1.0 ? y1 : y0 + (y1 - y0) * tb;
-        double mid = wrap(a0 + D * (0.5 * (ta + tb)));
-        int64_t k = slab_index(h, mid);
+        double mid = wrap_angle(a0 + D * (0.5 * (ta + tb)));
+        int64_t k = slab_index(h->slab_lo, h->slab_hi, h->K, mid);
         if (k < 0) return PyLong_FromLong(-1);
         PyObject *g = PyList_GET_ITEM(grids, k);
         if (g == Py_None) return PyLong_FromLong(-2 - (long)k);
@@ -451,7 +365,7 @@ PyObject *fast_se2_motion(PyObject *self, PyObject *const *args, Py_ssize_t narg
             n_sweeps++;
             if (!sweep_hits(h, qax, qay, qbx, qby, lo, hi)) continue;
             double sm = 0.5 * (sa + sb);
-            double xm = x0 + (x1 - x0) * sm, ym = y0 + (y1 - y0) * sm, am = wrap(a0 + D * sm);
+            double xm = x0 + (x1 - x0) * sm, ym = y0 + (y1 - y0) * sm, am = wrap_angle(a0 + D * sm);
             int pr = pose_test(h, grids, xm, ym, am);
             if (pr == -2) return NULL;
             if (pr == 0) {
@@ -470,9 +384,9 @@ PyObject *fast_se2_motion(PyObject *self, PyObject *const *args, Py_ssize_t narg
         }
     }
     PyObject *d = h->checks;
-    if (add_count(d, "submotions", n_sub) < 0 || add_count(d, "slab_certified", n_cert) < 0
-        || add_count(d, "refined", n_ref) < 0 || add_count(d, "sweeps", n_sweeps) < 0
-        || add_count(d, "motion_collisions", n_coll) < 0)
+    if (fast_add_count(d, "submotions", n_sub) < 0 || fast_add_count(d, "slab_certified", n_cert) < 0
+        || fast_add_count(d, "refined", n_ref) < 0 || fast_add_count(d, "sweeps", n_sweeps) < 0
+        || fast_add_count(d, "motion_collisions", n_coll) < 0)
         return NULL;
     return PyLong_FromLong(result);
 }
