@@ -350,8 +350,11 @@ def test_main_and_load_proof(narrow, tmp_path, capsys):
         assert main([scen, path]) == 2, name
         err = capsys.readouterr().err
         assert err.startswith(f"error: {path}: ") and err.count("\n") == 1, err
-    assert main([scen, str(good), "--query", "3"]) == 1
-    assert capsys.readouterr().out.startswith("proof invalid: step query: no query 3")
+    assert main([scen, str(good), "--query", "3"]) == 2  # the command refuses a query the scenario lacks
+    assert "--query: must be from 0 to" in capsys.readouterr().err
+    from cspace.io.scenario import load_scenario
+
+    assert check_proof(load_scenario(scen), json.loads(good.read_text()), 3).step == "query"  # the API: invalid
     assert main([str(tmp_path / "nope.toml"), str(good)]) == 2
     assert "nope.toml" in capsys.readouterr().err
 
@@ -369,3 +372,15 @@ def test_checker_is_independent_of_the_geometry_code():
     assert {m for m in modules if m.startswith(("cspace", "planners"))} <= {
         "cspace.io.files", "cspace.io.scenario", "planners.errors"}
     assert os.path.getsize(proof_check.__file__) < 40000
+
+
+def test_a_query_the_scenario_lacks_is_bad_input(tmp_path, capsys):
+    import os
+
+    from conftest import SCENARIOS
+
+    trap = os.path.join(SCENARIOS, "se2", "bug_trap_l.toml")
+    for q in ("-1", "1"):
+        assert main([trap, str(tmp_path / "p.json"), "--query", q]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "--query: must be from 0 to 0" in err, err

@@ -88,3 +88,10 @@ def test_a_maps_first_query_in_collision_names_the_queries_file(tmp_path, capsys
     assert main(["plan", OFFICE, "--radius", "0.2", "--queries", q]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"error: {q}: queries[0].goal: (8.0, 2.0) puts the robot in collision"), err
+
+
+def test_the_queries_file_counts_in_the_load_time(tmp_path):
+    q = write(tmp_path, "[[queries]]\nstart = [1, 9]\ngoal = [9, 1]\n")
+    js = tmp_path / "r.json"
+    assert main(["plan", BASIC, "--queries", q, "--json", str(js)]) == 0
+    assert json.loads(js.read_text())["timings"]["load"] > 0  # read, validated and checked here, not in plan()

@@ -22,7 +22,12 @@ def run(args) -> int:
 
     from ..core.proof_check import check_proof, load_proof
 
+    from ..errors import InputError
+
     scenario = load_scenario(args.scenario)  # bad input: one line, exit 2 (planners.cli.command)
+    count = len(scenario.all_queries())
+    if not 0 <= args.query < count:  # a query the scenario does not have is a bad option, not a bad proof
+        raise InputError(args.scenario, "--query", f"must be from 0 to {count - 1}, got {args.query}")
     proof = load_proof(args.proof)
     result = check_proof(scenario, proof, args.query)
     if result.valid:

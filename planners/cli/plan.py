@@ -143,11 +143,11 @@ def run(args) -> int:
     from cspace.io.scenario import ScenarioError
 
     scenario = src
+    t_import = time.perf_counter()  # a load done here (an import, a queries file) is this run's load
     if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
         from cspace.io.imported import import_file
         from cspace.io.scenario import scenario_from_dict
 
-        t_import = time.perf_counter()
         imp = import_file(src, options)
         for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"),
                          (args.csv, "--csv"), (args.proof, "--proof")):
@@ -161,7 +161,6 @@ def run(args) -> int:
             if queries is not None and exc.field in from_queries:  # the pose came from the queries file
                 raise InputError(args.queries, f"queries[0].{exc.field}", exc.message) from None
             raise
-        import_s = time.perf_counter() - t_import
     if queries is not None:
         from cspace.io.scenario import load_scenario
         from cspace.io.validate import with_queries
@@ -169,6 +168,7 @@ def run(args) -> int:
         if options is None:
             scenario = load_scenario(src, space=args.space, turning_radius=args.turning_radius)
         scenario = with_queries(scenario, queries, args.queries)
+    import_s = time.perf_counter() - t_import
     try:
         loaded = options is not None or queries is not None  # a Scenario, its space and radius applied
         res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
@@ -180,7 +180,7 @@ def run(args) -> int:
         if exc.file == "plan()" and exc.field == "objective":  # the file's planner takes no objective
             raise InputError(src, "--objective", exc.message) from None
         raise
-    if options is not None:  # the import (meshes or map, then validation) is this run's load
+    if options is not None or queries is not None:  # loaded here, not by plan()
         res.timings["load"] = res.timings.get("load", 0.0) + import_s
         res.timings["total"] = res.timings.get("total", 0.0) + import_s
     print(summary(res, verbose=args.verbose))
