@@ -372,12 +372,11 @@ def se2_motion(cs, max_refine: int, floor_rel: float):
 
     from ..kernel.slab import ANGLE_SLACK
 
-    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
-    offsets = lambda ps: np.concatenate([[0], np.cumsum([len(p) for p in ps])]).astype(np.int64)  # noqa: E731
-    obs, rob = list(cs.obstacle_pieces), list(cs.robot_pieces)
-    o_xy = f64(np.concatenate(obs) if obs else np.zeros((0, 2)))
+    f64 = _contiguous
+    (o_off, o_xy), (r_off, r_xy) = _packed(cs.obstacle_pieces), _packed(cs.robot_pieces)
+    obs, rob = cs.obstacle_pieces, cs.robot_pieces
     handle = _fast.se2_motion_handle(
-        cs._fast, cs.checks, f64(cs._lo), f64(cs._hi), offsets(obs), o_xy, offsets(rob), f64(np.concatenate(rob)),
+        cs._fast, cs.checks, f64(cs._lo), f64(cs._hi), o_off, o_xy, r_off, r_xy,
         cs.slabs, len(obs), len(rob), int(max_refine), float(cs.scale), float(cs.radius), floor_rel * cs.extent,
         ANGLE_SLACK)
     return functools.partial(_fast.se2_motion, handle)
@@ -408,15 +407,14 @@ def car_curve(cs, max_hulls: int, floor_rel: float, arc_chunk: float):
         return None
     import functools
 
-    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
-    offsets = lambda ps: np.concatenate([[0], np.cumsum([len(p) for p in ps])]).astype(np.int64)  # noqa: E731
-    obs, rob = list(cs.obstacle_pieces), list(cs.robot_pieces)
-    o_xy = f64(np.concatenate(obs) if obs else np.zeros((0, 2)))
+    f64 = _contiguous
+    (o_off, o_xy), (r_off, r_xy) = _packed(cs.obstacle_pieces), _packed(cs.robot_pieces)
+    obs, rob = cs.obstacle_pieces, cs.robot_pieces
     o_edge = f64(np.array([e for edges in cs._obstacle_edges for e in edges], dtype=np.float64).reshape(-1, 4))
     xmin, xmax, ymin, ymax = cs.bounds
     handle = _fast.car_handle(
-        cs._fast, cs.checks, f64(cs._lo), f64(cs._hi), offsets(obs), o_xy, o_edge, offsets(rob),
-        f64(np.concatenate(rob)), cs.slabs, len(obs), len(rob), int(max_hulls), float(cs.scale), float(cs.radius),
+        cs._fast, cs.checks, f64(cs._lo), f64(cs._hi), o_off, o_xy, o_edge, r_off,
+        r_xy, cs.slabs, len(obs), len(rob), int(max_hulls), float(cs.scale), float(cs.radius),
         floor_rel * cs.extent, float(arc_chunk), xmin, xmax, ymin, ymax)
     return functools.partial(_fast.car_curve, handle)
 
@@ -440,3 +438,17 @@ def dubins_word(d: float, alpha: float, beta: float):
     True
     """
     return None if _fast is None else _fast.dubins_word(d, alpha, beta)
+
+
+def _contiguous(a) -> np.ndarray:
+    """A C-contiguous float64 array (the compiled handles' buffers)."""
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _packed(pieces: list) -> tuple[np.ndarray, np.ndarray]:
+    """The motion handles' piece arrays: each piece's first row (int64, K + 1 entries) and all
+    the vertices one piece after another (:func:`cspace.kernel.polygon.pack`)."""
+    from ..kernel.polygon import pack
+
+    xy, sizes = pack(list(pieces))
+    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64), _contiguous(xy)
