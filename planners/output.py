@@ -6,8 +6,10 @@ This module owns output paths:
   an empty path, a folder, a path under a file, a missing or unwritable folder
   (probed by creating and removing a temporary file there, which also catches
   ``/proc`` and read-only mounts), a block device or socket, and an output that is
-  one of the inputs (same file, also through a symbolic or hard link: compared by
-  device and inode) are all refused.
+  one of the inputs (every file the command reads: the scenario, a map's image, a
+  cfg's meshes, a robot or queries file; the same file also through a symbolic or
+  hard link or another spelling: compared by device and inode when the output
+  exists, by resolved path otherwise) are all refused.
 - **What a path is decides how it is written** (:func:`atomic_path`):
   a regular file (or a new name) is written atomically: to an unnamed temporary
   file in the target's folder (Linux ``O_TMPFILE``), which is given a name only
@@ -17,19 +19,21 @@ This module owns output paths:
   (``/dev/null``, a terminal) or a FIFO (``>(jq .)``) is written directly, never
   replaced by a file; a FIFO without a reader is refused rather than waited on.
 - **Temporaries** are named ``.cspace-tmp-PID-RANDOM``: where ``O_TMPFILE`` is
-  not available, or in the instant between naming and renaming, a killed process
-  can leave one; the next run that writes into that folder removes those whose
-  process is gone.
+  not available, or in the instant between naming and renaming. A process removes
+  the ones it made (each is tracked from before its creation: on success, on failure,
+  at exit); it never removes a file by its name alone, so another process's
+  temporaries (alive or not, on this host or another) are left alone. Only a
+  process killed outright (``kill -9``) can leave one behind.
 - **Write failures** (a full disk, ``/dev/full``) are one-line :class:`InputError`
   s naming the path, never a traceback and never a silent success.
 """
 from __future__ import annotations
 
+import atexit
 import contextlib
 import errno
 import json
 import os
-import re
 import secrets
 import stat
 
@@ -38,7 +42,7 @@ from .errors import InputError
 PLOT_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 TMP_PREFIX = ".cspace-tmp-"
 NAMED_EXTENSIONS = {".gif"}  # formats whose writer reads the file name's extension
-_TMP_NAME = re.compile(re.escape(TMP_PREFIX) + r"(\d+)-[0-9a-f]+(\.[A-Za-z0-9]*)?$")
+_OURS: set[str] = set()  # named temporaries this process made and has not removed yet
 
 
 def check_output(path: str, option: str, suffixes: dict | None = None, inputs=()) -> str:
@@ -58,12 +62,10 @@ def check_output(path: str, option: str, suffixes: dict | None = None, inputs=()
             raise InputError(path, option, f"unsupported extension {ext or '(none)'!r} (use {', '.join(suffixes)})")
         fmt = suffixes[ext]
     st = _stat(path, option)
+    check_not_input(path, option, inputs, st)
     if st is not None:
         if stat.S_ISDIR(st.st_mode):
             raise InputError(path, option, "is a directory, expected a file name")
-        for src in inputs:
-            if _same(st, src):
-                raise InputError(path, option, f"is the input {src}; writing it would destroy it")
         if stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode):
             return fmt  # written directly (see atomic_path)
         if not stat.S_ISREG(st.st_mode):
@@ -71,7 +73,6 @@ def check_output(path: str, option: str, suffixes: dict | None = None, inputs=()
     folder = os.path.dirname(os.path.realpath(path))
     if not os.path.isdir(folder):  # (realpath and isdir take a NUL byte; _stat refused it above)
         raise InputError(path, option, f"folder {folder} does not exist")
-    clean_stale(folder)
     try:  # the one reliable test (root passes access(); /proc and read-only mounts refuse files)
         with _temporary(folder, os.path.splitext(path)[1]) as (fd, _tmp):
             pass
@@ -95,7 +96,6 @@ def check_folder(path: str, option: str) -> None:
         raise InputError(path, option, "a parent of this path is a file, not a folder") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL byte
         raise InputError(path, option, f"cannot create this folder ({getattr(exc, 'strerror', None) or exc})") from None
-    clean_stale(path)
     try:
         with _temporary(path, ""):
             pass
@@ -130,48 +130,60 @@ def _stat(path: str, option: str):
         raise InputError(path, option, f"cannot use this path ({getattr(exc, 'strerror', None) or exc})") from None
 
 
-def _same(st: os.stat_result, src) -> bool:
+def check_not_input(path: str, option: str, inputs, st: os.stat_result | None = None) -> None:
+    """Refuse an output that is one of ``inputs`` (the files the command reads).
+
+    An existing output is compared by device and inode (``st``, its ``os.stat``: links
+    followed, so a symbolic or hard link to an input is the input); a new name by its
+    resolved path (``./x``, ``d/../x`` and a link's target are one file).
+
+    >>> check_not_input("./new.json", "--json", ["new.json"])
+    Traceback (most recent call last):
+    ...
+    planners.errors.InputError: ./new.json: --json: is the input new.json; writing it would destroy it
+    """
+    for src in inputs:
+        if src is not None and _same(path, st, src):
+            raise InputError(path, option, f"is the input {src}; writing it would destroy it")
+
+
+def _same(path: str, st: os.stat_result | None, src) -> bool:
     try:
         s = os.stat(src)
     except (OSError, ValueError, TypeError):
+        s = None
+    if st is not None and s is not None:
+        return (s.st_dev, s.st_ino) == (st.st_dev, st.st_ino)
+    try:
+        return os.path.realpath(path) == os.path.realpath(src)
+    except (OSError, ValueError, TypeError):
         return False
-    return (s.st_dev, s.st_ino) == (st.st_dev, st.st_ino)
 
 
-def clean_stale(folder: str) -> int:
-    """Remove this tool's temporaries in ``folder`` whose process is gone; returns how many.
+def clean_stale(folder: str | None = None) -> int:
+    """Remove the named temporaries this process made and still has (in ``folder``, or
+    anywhere); returns how many. Only this process's own: never a file by its name alone
+    (another process's, even one whose pid is gone, is not ours to judge).
 
     >>> import tempfile
     >>> clean_stale(tempfile.mkdtemp())
     0
     """
     removed = 0
-    try:
-        names = os.listdir(folder)
-    except OSError:
-        return 0
-    for name in names:
-        m = _TMP_NAME.match(name)
-        if m is None or _alive(int(m.group(1))):
+    where = None if folder is None else os.path.realpath(folder)
+    for name in sorted(_OURS):
+        if where is not None and os.path.dirname(os.path.realpath(name)) != where:
             continue
+        _OURS.discard(name)
         try:
-            os.unlink(os.path.join(folder, name))
+            os.unlink(name)
             removed += 1
         except OSError:
             pass
     return removed
 
 
-def _alive(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return pid < 2**31  # exists, another user's (an absurd pid is nobody's)
-    return True
+atexit.register(clean_stale)  # what a failure left (the context managers remove theirs already)
 
 
 def _umask() -> int:
@@ -194,15 +206,38 @@ def _temporary(folder: str, ext: str, unnamed: bool = True):
             if exc.errno not in (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT):
                 raise
     name = None
-    if fd is None:  # no O_TMPFILE here: a named temporary, removed below or by clean_stale
-        name = os.path.join(folder, f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(6)}{ext}")
-        fd = os.open(name, os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666 & ~_UMASK)
+    if fd is None:  # no O_TMPFILE here: a named temporary, removed below (or at exit)
+        name = _new_name(folder, ext)  # tracked before it exists: an interrupt cannot orphan it
+        try:
+            fd = os.open(name, os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666 & ~_UMASK)
+        except BaseException:
+            if fd is None:  # not created (O_EXCL: an existing file of that name is not ours)
+                _OURS.discard(name)
+            else:  # interrupted just after
+                os.close(fd)
+                _remove_ours(name)
+            raise
     try:
         yield fd, name
     finally:
         os.close(fd)
-        if name is not None and os.path.lexists(name):
+        if name is not None:
+            _remove_ours(name)
+
+
+def _new_name(folder: str, ext: str) -> str:
+    """A fresh temporary name in ``folder``, tracked as this process's."""
+    name = os.path.join(folder, f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(6)}{ext}")
+    _OURS.add(name)
+    return name
+
+
+def _remove_ours(name: str) -> None:
+    """Remove a temporary this process made (if still there) and stop tracking it."""
+    if name in _OURS:
+        with contextlib.suppress(FileNotFoundError):
             os.unlink(name)
+        _OURS.discard(name)
 
 
 @contextlib.contextmanager
@@ -223,7 +258,6 @@ def atomic_path(path: str, option: str = "output"):
             return
         real = os.path.realpath(path)  # a link is followed: its target is what gets replaced
         folder = os.path.dirname(real)
-        clean_stale(folder)
         # Unnamed (O_TMPFILE) unless a writer needs the extension in the name (Pillow's GIF).
         ext = os.path.splitext(real)[1]
         with _temporary(folder, ext, unnamed=ext.lower() not in NAMED_EXTENSIONS) as (fd, name):
@@ -231,18 +265,24 @@ def atomic_path(path: str, option: str = "output"):
                 os.fchmod(fd, stat.S_IMODE(st.st_mode))  # a replaced file keeps its permissions
             yield name or f"/proc/self/fd/{fd}"
             if name is None:  # give the complete file a name, then move it over the target at once
-                name = os.path.join(folder, f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(6)}")
+                name = _new_name(folder, "")
                 dfd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
                 try:  # a dir fd makes this linkat(..., AT_SYMLINK_FOLLOW), which names an O_TMPFILE file
                     os.link(f"/proc/self/fd/{fd}", os.path.basename(name), dst_dir_fd=dfd)
+                except BaseException:  # removed only if it is this very file (never another's)
+                    with contextlib.suppress(OSError):
+                        if os.path.samestat(os.stat(name), os.fstat(fd)):
+                            os.unlink(name)
+                    _OURS.discard(name)
+                    raise
                 finally:
                     os.close(dfd)
             try:
                 os.replace(name, real)
             except BaseException:
-                if os.path.lexists(name):
-                    os.unlink(name)
+                _remove_ours(name)
                 raise
+            _OURS.discard(name)  # renamed: it is the target now, no longer a temporary
     except (OSError, ValueError) as exc:
         raise InputError(path, option, f"cannot write ({getattr(exc, 'strerror', None) or exc})") from None
 
@@ -294,3 +334,20 @@ def path_csv(path, dim: int = 2) -> str:
 def write_csv(path: str, waypoints, dim: int = 2, option: str = "--csv") -> None:
     """Write a path as CSV (:func:`path_csv`), atomically (see :func:`atomic_path`)."""
     write_text(path, path_csv(waypoints, dim), option)
+
+
+def queries_csv(paths, dim: int = 2) -> str:
+    """Several queries' paths as one CSV: a ``query`` column (the query's index) before
+    ``x,y`` (or ``x,y,theta``); ``paths`` is ``[(index, waypoints)]`` (the solved ones).
+
+    >>> print(queries_csv([(0, [[0.0, 1.0]]), (2, [[2.0, 3.0], [4.0, 5.0]])]), end="")
+    query,x,y
+    0,0.0,1.0
+    2,2.0,3.0
+    2,4.0,5.0
+    """
+    lines = []
+    for i, waypoints in paths:
+        body = path_csv(waypoints, dim).split("\n", 1)[1]
+        lines += [f"{int(i)},{row}" for row in body.splitlines()]
+    return f"query,{'x,y,theta' if dim == 3 else 'x,y'}\n" + "".join(line + "\n" for line in lines)

@@ -192,7 +192,7 @@ def test_atomic_write_leaves_the_old_file_on_failure(tmp_path):
 
 def test_kill_9_during_a_write_leaves_no_temporary(tmp_path):
     """A writer killed mid-save: the target is untouched, and no temporary remains
-    (an O_TMPFILE has no name; a named one is removed by the next run)."""
+    (an O_TMPFILE has no name)."""
     target = tmp_path / "pic.png"
     target.write_bytes(b"old")
     code = ("import sys, time\nfrom planners.output import atomic_path\n"
@@ -208,16 +208,19 @@ def test_kill_9_during_a_write_leaves_no_temporary(tmp_path):
     assert target.read_bytes() == b"old" and os.listdir(tmp_path) == ["pic.png"]
 
 
-def test_stale_named_temporaries_are_cleaned_and_live_ones_kept(tmp_path):
+def test_other_processes_temporaries_are_never_removed(tmp_path):
+    # issue 36 item 7a: a dead pid's temporary is not ours to judge (pids are reused, and a
+    # shared folder has other hosts' pids): only a process's own temporaries are removed.
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
     stale = tmp_path / f"{TMP_PREFIX}{dead.pid}-0123abcd.png"
-    live = tmp_path / f"{TMP_PREFIX}{os.getpid()}-0123abcd.png"
+    live = tmp_path / f"{TMP_PREFIX}{os.getpid()}-0123abcd.png"  # this pid's name, not made by this code
     other = tmp_path / ".tmp-abcdefgh.png"  # not ours: never touched
     for f in (stale, live, other):
         f.write_bytes(b"x")
     write_text(str(tmp_path / "r.txt"), "new\n")
-    assert sorted(os.listdir(tmp_path)) == sorted([live.name, other.name, "r.txt"])
+    assert clean_stale(str(tmp_path)) == 0
+    assert sorted(os.listdir(tmp_path)) == sorted([stale.name, live.name, other.name, "r.txt"])
 
 
 # ------------------------------------------------------------------ item 2: inputs that hang

@@ -40,10 +40,16 @@ def outside_references(source: str) -> list[tuple[int, str]]:
     [(1, 'join(ROOT, "..")')]
     >>> outside_references('p = os.path.dirname(ROOT)\\nq = "a..b"\\nr = os.path.join(HERE, "..", "scenarios")')
     [(1, 'dirname(ROOT)')]
+    >>> outside_references('def f():\\n    "writes d/../x"\\n    return "../x"')
+    [(3, "'../x'")]
     """
     found = []
     tree = ast.parse(source)
     in_fstring = {id(v) for n in ast.walk(tree) if isinstance(n, ast.JoinedStr) for v in n.values}
+    # a docstring describes paths ("d/../x is the same file"), it reads none
+    in_fstring |= {id(n.body[0].value) for n in ast.walk(tree)
+                   if isinstance(n, (ast.Module, ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and n.body
+                   and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
     for node in ast.walk(tree):
         if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in in_fstring:
             if UP.search(node.value) or any(n in node.value for n in OUTSIDE_NAMES):

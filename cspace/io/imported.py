@@ -16,6 +16,7 @@ import time
 import numpy as np
 
 from .messages import ScenarioError
+from .schema import MAX_MAGNITUDE
 from .import_record import Imported, ImportOptions, robot_and_queries  # noqa: F401  (the imports' API)
 from .validate import scenario_from_dict
 
@@ -85,7 +86,7 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     """
     import shapely
 
-    from .occupancy import (classify, fill_corner_touches, polygons_of, read_image, read_map_yaml,
+    from .occupancy import (check_vertices, classify, fill_corner_touches, polygons_of, read_image, read_map_yaml,
                             simplify_conservative, staircase)
 
     t0 = time.perf_counter()
@@ -94,12 +95,16 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     cells = classify(values, alpha, info)
     h, w = cells.shape
     res, (ox, oy, _) = info.resolution, info.origin
+    if not max(abs(ox), abs(oy)) + (max(w, h) + 1) * res <= MAX_MAGNITUDE:  # before any geometry (issue 36)
+        raise ScenarioError(path, "resolution", f"{res!r} per cell over {w} x {h} cells from the origin ({ox!r}, "
+                                                f"{oy!r}) reaches beyond the supported magnitude 2^400")
     unknown_blocks = options.unknown == "obstacle"
     blocked = (cells == 1) | ((cells == -1) if unknown_blocks else False)
     # Rows bottom-up, and a ring of unknown cells around the map: with unknown cells as
     # obstacles the robot cannot leave the map (the reference point stays in its bounds).
     grid = np.pad(blocked[::-1], 1, constant_values=unknown_blocks)
     filled = fill_corner_touches(grid)
+    check_vertices(grid, info.image)  # before any polygon is made (issue 36)
     t_read = time.perf_counter() - t0
     exact = staircase(grid)
     exact = shapely.transform(exact, lambda c: c - 1.0)  # padded units to cell units (exact on integers)
@@ -109,7 +114,7 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     rounding = 64 * np.finfo(float).eps * (max(abs(ox), abs(oy)) + max(w, h) * res + res) / res
     result = simplify_conservative(exact, tol / res, margin=rounding)
     t_trace = time.perf_counter() - t0 - t_read
-    error = _largest_error(result, exact) * res
+    error = _largest_error(result, exact, tol / res + 1.0) * res
 
     def world(c):
         return np.column_stack((ox + c[:, 0] * res, oy + c[:, 1] * res))
@@ -151,17 +156,11 @@ def import_map(path: str, options: ImportOptions) -> Imported:
     return imp
 
 
-def _largest_error(result, exact) -> float:
+def _largest_error(result, exact, bound: float | None = None) -> float:
     """The largest distance from a vertex of ``result`` to ``exact`` (0 when equal)."""
-    import shapely
+    from .trace import largest_error
 
-    if result is exact or result.is_empty:
-        return 0.0
-    pts = shapely.points(shapely.get_coordinates(result))
-    parts = polygons_of_any(exact)
-    tree = shapely.STRtree(parts)
-    _, dist = tree.query_nearest(pts, return_distance=True, all_matches=False)
-    return float(dist.max()) if len(dist) else 0.0
+    return largest_error(result, exact, bound)  # O(n log n): a tree of exact's segments (issue 36)
 
 
 def polygons_of_any(geom) -> list:

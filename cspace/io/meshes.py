@@ -4,7 +4,7 @@ OMPL.app's 2-D problems are 3-D meshes: a planar robot or environment extruded
 along the up axis. Seen from above, every triangle covers part of the footprint:
 the caps cover all of it, the walls project to segments. The footprint is the
 union of the projected triangles (GEOS), walls and other zero-area triangles left
-out; then:
+out (each triangle judged by its own size and position); then:
 
 - holes thinner than ``sliver`` x (the scene's size) or of area below ``sliver``
   x size^2 are filled: slits between triangles that do not share their vertices
@@ -76,7 +76,10 @@ def footprint(tri: np.ndarray, sliver: float = SLIVER):
     lo, hi = tri.reshape(-1, 2).min(axis=0), tri.reshape(-1, 2).max(axis=0)
     size = float(max(max(hi - lo), np.abs(tri).max())) or 1.0
     areas = triangle_areas(tri)
-    keep = areas > (1e-12 * size) ** 2  # walls (and any zero-area triangle) cover no area
+    # walls (and any zero-area triangle) cover no area; each judged by its own size, so that no
+    # triangle elsewhere (however large or far) can make the others count as flat
+    own = np.maximum(np.ptp(tri, axis=1).max(axis=1), np.abs(tri).max(axis=(1, 2)))
+    keep = areas > (1e-12 * own) ** 2
     info["flat"] = int((~keep).sum())
     tri = tri[keep]
     if len(tri) == 0:

@@ -12,8 +12,9 @@ the image at the top as ``map_server`` reads it):
 1. Cells that touch only at a corner (a 2 x 2 checkerboard) would give a polygon
    whose boundary touches itself; one free cell of each such block is filled
    (conservative), until none is left.
-2. Each row's runs of blocked cells, runs repeated in the next row merged into one
-   rectangle, are united (GEOS): the exact staircase union, integer vertices.
+2. The blocked cells' boundary is traced edge by edge (:mod:`cspace.io.trace`, time linear
+   in the map): the exact staircase union, integer vertices. A map of many vertices is
+   cut into regions traced (and simplified) one at a time, so no step is quadratic.
 3. With a tolerance t > 0 the union is simplified (Douglas-Peucker, topology kept)
    within a = t / 2.5, then grown by a with mitred corners (limit 1.5 a: right angles
    stay sharp, sharper corners are bevelled 1.5 a out, so the growth contains the
@@ -39,9 +40,15 @@ import numpy as np
 
 from .files import read_input, utf8_text
 from .messages import ScenarioError
+from .trace import REGION_VERTICES, corner_points, flat_parts, regions, staircase_polygons
 
 MODES = ("trinary", "scale", "raw")
-MAX_PIXELS = 2**26  # 64 Mi cells (8192 x 8192): a bigger map is refused, not read
+# Limits (issue 36): a map's cells, checked on the image's header before its pixels are
+# decoded, and its traced vertices (boundary corners), counted before any polygon is made.
+# A map within both imports in time linear in its cells and vertices (about 2 s for a clean
+# 4096 x 4096 map, 8 s for a 1024 x 1024 one of 50 % noise) and well under 1 GB.
+MAX_PIXELS = 2**24  # 16 Mi cells (4096 x 4096)
+MAX_VERTICES = 2**20  # traced vertices (1 Mi): a 1024 x 1024 map of 50 % noise has 0.56 Mi
 MITRE = 1.5  # mitre limit of the growth: right angles stay sharp, sharper corners are bevelled
 KEYS = {"image", "resolution", "origin", "occupied_thresh", "free_thresh", "negate", "mode"}
 
@@ -190,7 +197,8 @@ def read_image(info: MapInfo, yaml_path: str) -> tuple[np.ndarray, np.ndarray | 
         with Image.open(info.image) as im:
             w, h = im.size
             if w < 1 or h < 1 or w * h > MAX_PIXELS:
-                raise ScenarioError(info.image, field_, f"{w} x {h} pixels: a map needs 1 to {MAX_PIXELS} cells")
+                raise ScenarioError(info.image, field_, f"{w} x {h} pixels: a map has 1 to {MAX_PIXELS} cells "
+                                                        "(4096 x 4096); crop it or coarsen its resolution")
             if im.mode in ("I", "I;16", "I;16B", "I;16L", "F"):
                 raise ScenarioError(info.image, field_, f"mode {im.mode} (16-bit or float): map_server reads "
                                                         "8-bit images (grey, RGB, with or without alpha)")
@@ -253,46 +261,69 @@ def fill_corner_touches(blocked: np.ndarray) -> int:
     >>> b = np.array([[1, 0], [0, 1]], dtype=bool); fill_corner_touches(b), b.astype(int).tolist()
     (1, [[1, 1], [0, 1]])
     """
+    # A block's pattern changes only when one of its cells is filled: after one pass over the
+    # grid, only the (at most 4) blocks around each newly filled cell are looked at again, so a
+    # chain of fills (each making the next touch) costs its length, not its length x the grid.
+    h, w = blocked.shape
+    if h < 2 or w < 2:
+        return 0
+    a, b_, c, d = blocked[:-1, :-1], blocked[:-1, 1:], blocked[1:, :-1], blocked[1:, 1:]
+    main = a & d & ~b_ & ~c  # blocked on the main diagonal only: fill the upper right
+    anti = b_ & c & ~a & ~d  # on the other diagonal only: fill the upper left
+    (my, mx), (ay, ax) = np.nonzero(main), np.nonzero(anti)
+    del a, b_, c, d, main, anti
     filled = 0
-    while True:
-        a, b_, c, d = blocked[:-1, :-1], blocked[:-1, 1:], blocked[1:, :-1], blocked[1:, 1:]
-        main = a & d & ~b_ & ~c  # blocked on the main diagonal only: fill the upper right
-        anti = b_ & c & ~a & ~d  # on the other diagonal only: fill the upper left
-        n = int(main.sum() + anti.sum())
-        if n == 0:
-            return filled
-        before = int(blocked.sum())
-        blocked[:-1, 1:] |= main
-        blocked[:-1, :-1] |= anti
-        filled += int(blocked.sum()) - before
+    while len(my) or len(ay):
+        cells = np.unique(np.concatenate((my * w + mx + 1, ay * w + ax)))
+        fy, fx = cells // w, cells % w
+        filled += len(cells)
+        blocked[fy, fx] = True
+        ny = (fy[:, None] + np.array([-1, -1, 0, 0])).ravel()  # the 4 blocks holding each filled cell
+        nx = (fx[:, None] + np.array([-1, 0, -1, 0])).ravel()
+        ok = (ny >= 0) & (ny < h - 1) & (nx >= 0) & (nx < w - 1)
+        blocks = np.unique(ny[ok] * (w - 1) + nx[ok])
+        ys, xs = blocks // (w - 1), blocks % (w - 1)
+        a, b_, c, d = blocked[ys, xs], blocked[ys, xs + 1], blocked[ys + 1, xs], blocked[ys + 1, xs + 1]
+        main, anti = a & d & ~b_ & ~c, b_ & c & ~a & ~d
+        my, mx, ay, ax = ys[main], xs[main], ys[anti], xs[anti]
+    return filled
 
 
-def staircase(blocked: np.ndarray):
+def check_vertices(blocked: np.ndarray, image: str) -> int:
+    """The number of vertices tracing ``blocked`` gives (its boundary's corners), or a
+    :class:`ScenarioError` naming ``image`` past :data:`MAX_VERTICES`.
+
+    >>> check_vertices(np.ones((3, 3), dtype=bool), "m.pgm")
+    4
+    """
+    n = int(corner_points(blocked).sum())
+    if n > MAX_VERTICES:
+        raise ScenarioError(image, "image", f"its obstacles trace to {n} vertices, over the limit of {MAX_VERTICES}: "
+                                            "clean the map (remove speckle noise) or coarsen its resolution")
+    return n
+
+
+def staircase(blocked: np.ndarray, max_vertices: int = REGION_VERTICES):
     """The exact union of the blocked cells (rows bottom-up: ``blocked[Y, X]`` is the unit
-    square [X, X+1] x [Y, Y+1]) as a shapely geometry with integer vertices.
+    square [X, X+1] x [Y, Y+1]) as a shapely geometry with integer vertices: a
+    (Multi)Polygon, or for a grid of over ``max_vertices`` vertices a GeometryCollection
+    of one MultiPolygon per region (:func:`cspace.io.trace.regions`), which abut.
+    Traced in O(n log n) (:mod:`cspace.io.trace`); no two blocked cells may touch at a
+    corner only (:func:`fill_corner_touches`).
 
     >>> staircase(np.array([[1, 1], [0, 1]], dtype=bool)).area
     3.0
     """
     import shapely
 
-    h, w = blocked.shape
-    z = np.zeros((h, w + 2), dtype=np.int8)
-    z[:, 1:-1] = blocked
-    d = np.diff(z, axis=1)
-    ys, x0 = np.nonzero(d == 1)
-    _, x1 = np.nonzero(d == -1)  # row-major order pairs each run's start with its end
-    if len(ys) == 0:
+    parts = []
+    for y0, y1, x0, x1 in regions(blocked, max_vertices):
+        polys = staircase_polygons(blocked[y0:y1, x0:x1], (x0, y0))
+        if len(polys):
+            parts.append(shapely.multipolygons(polys))
+    if not parts:
         return shapely.Polygon()
-    # Runs repeated in consecutive rows become one rectangle.
-    order = np.lexsort((ys, x1, x0))
-    ys, x0, x1 = ys[order], x0[order], x1[order]
-    new = np.ones(len(ys), dtype=bool)
-    new[1:] = (x0[1:] != x0[:-1]) | (x1[1:] != x1[:-1]) | (ys[1:] != ys[:-1] + 1)
-    first = np.flatnonzero(new)
-    last = np.append(first[1:], len(ys)) - 1
-    boxes = shapely.box(x0[first], ys[first], x1[first], ys[last] + 1)
-    return shapely.simplify(shapely.union_all(boxes), 0.0)  # collinear vertices out (exact on integers)
+    return parts[0] if len(parts) == 1 else shapely.GeometryCollection(parts)
 
 
 def simplify_conservative(geom, tolerance: float, margin: float = 0.0):
@@ -311,6 +342,8 @@ def simplify_conservative(geom, tolerance: float, margin: float = 0.0):
 
     if tolerance <= 0 or geom.is_empty:
         return geom
+    if geom.geom_type == "GeometryCollection":  # regions of a large map, one at a time (linear time)
+        return shapely.GeometryCollection([simplify_conservative(g, tolerance, margin) for g in geom.geoms])
     a = tolerance / (1.0 + MITRE)
     simple = shapely.simplify(geom, a, preserve_topology=True)
     grown = shapely.buffer(simple, a * (1.0 + 1e-6) + margin, join_style="mitre", mitre_limit=MITRE)
@@ -324,8 +357,9 @@ def polygons_of(geom) -> list:
     >>> len(polygons_of(shapely.MultiPolygon([shapely.box(0, 0, 1, 1), shapely.box(2, 0, 4, 1)])))
     2
     """
+    import shapely
+
     if geom.is_empty:
         return []
-    parts = list(geom.geoms) if hasattr(geom, "geoms") else [geom]
-    parts = [p for p in parts if p.geom_type == "Polygon" and not p.is_empty]
+    parts = [p for p in flat_parts(geom) if p.geom_type == "Polygon" and not p.is_empty]
     return sorted(parts, key=lambda p: -p.area)

@@ -23,7 +23,9 @@ its reference point is the mean of the robot's mesh vertices (Assimp's
 texture coordinate) corner of a primitive counted once; the normal of a corner
 without one is its triangle's, as ``GenNormals`` makes them), and the robot turns
 about it. The import is an SE(2) scenario (``space = "se2"``); a ``control``
-problem is planned as its geometric problem, and says so.
+problem is planned as its geometric problem, and says so. Every mesh first passes the limits of
+:mod:`cspace.io.collada_guard` (size, no DOCTYPE, declared counts, instancing, finite and bounded
+numbers): a hostile file is one line, never a blow-up or a silently wrong obstacle.
 """
 from __future__ import annotations
 
@@ -33,7 +35,7 @@ import warnings
 import numpy as np
 
 from .import_record import Imported, ImportOptions, robot_and_queries
-from .files import read_input, utf8_text
+from .files import check_input, read_input, utf8_text
 from .messages import ScenarioError
 
 IO_HINT = 'pip install -e ".[io]"  (or pip install pycollada)'
@@ -110,13 +112,21 @@ def read_mesh(cfg_path: str, key: str, name: str):
         import collada
     except ImportError:
         raise ScenarioError(cfg_path, key, f"reading COLLADA meshes needs pycollada: {IO_HINT}") from None
-    raw = read_input(mesh)
+    from . import collada_guard as guard
+
+    size = check_input(mesh).st_size
+    raw = read_input(mesh) if size <= guard.MAX_MESH_BYTES else b""
+    if size > guard.MAX_MESH_BYTES or len(raw) > guard.MAX_MESH_BYTES:  # (it may grow in between)
+        raise ScenarioError(mesh, "file", f"is {max(size, len(raw))} bytes, over the {guard.MAX_MESH_BYTES} byte "
+                                          "limit on a mesh")
+    guard.check_xml(raw, mesh)  # no DOCTYPE or entity reaches pycollada, whichever parser it uses
     with warnings.catch_warnings():  # pycollada's numpy.matrix use warns on every load
         warnings.simplefilter("ignore", PendingDeprecationWarning)
         return _read_collada(collada, raw, cfg_path, mesh, key)
 
 
 def _read_collada(collada, raw: bytes, cfg_path: str, mesh: str, key: str):
+    from . import collada_guard as guard
     from .meshes import to_plane
 
     try:
@@ -128,12 +138,14 @@ def _read_collada(collada, raw: bytes, cfg_path: str, mesh: str, key: str):
         raise ScenarioError(mesh, key, f"cannot read the COLLADA file ({type(exc).__name__}: "
                                        f"{str(exc)[:120]})") from None
     up = str(getattr(dae.assetInfo, "upaxis", "Y_UP") or "Y_UP")
-    unit = float(getattr(dae.assetInfo, "unitmeter", None) or 1.0)
-    tris, corners = [], []
+    unit = guard.check_unit(getattr(dae.assetInfo, "unitmeter", None), mesh)
+    tris, corners, owners = [], [], []
     scene = dae.scene
     if scene is None:
         raise ScenarioError(mesh, key, "no <scene> in the COLLADA file (nothing is placed)")
+    guard.check_scene(scene, mesh)  # counts, indices and transforms, before the graph is expanded
     for geom in scene.objects("geometry"):
+        field = f"geometry {str(geom.original.id)!r}"
         for prim in geom.primitives():
             if isinstance(prim, collada.polylist.BoundPolylist):
                 prim = prim.triangleset()
@@ -142,13 +154,17 @@ def _read_collada(collada, raw: bytes, cfg_path: str, mesh: str, key: str):
             idx = np.asarray(prim.vertex_index, dtype=np.int64).reshape(-1, 3)
             if len(idx) == 0:
                 continue
-            v3 = np.asarray(prim.vertex, dtype=np.float64) * unit
-            tri3 = v3[idx]  # (N, 3, 3)
+            with np.errstate(over="ignore", invalid="ignore"):
+                tri3 = np.asarray(prim.vertex, dtype=np.float64)[idx] * unit  # (N, 3, 3)
+            guard.check_coordinates(tri3, mesh, field)
+            owners.append((sum(len(t) for t in tris), field))
             tris.append(to_plane(tri3.reshape(-1, 3), up).reshape(-1, 3, 2))
             corners.append(_distinct_corners(prim, tri3, idx, up))
     if not tris or sum(len(t) for t in tris) == 0:
         raise ScenarioError(mesh, key, "the mesh has no triangles")
-    return np.concatenate(tris), np.concatenate(corners), up, unit
+    tri, corner = np.concatenate(tris), np.concatenate(corners)
+    guard.check_range(tri, owners, corner.mean(axis=0) if key == "robot" else (0.0, 0.0), mesh)
+    return tri, corner, up, unit
 
 
 def _distinct_corners(prim, tri3: np.ndarray, idx: np.ndarray, up: str) -> np.ndarray:
@@ -204,6 +220,9 @@ def import_cfg(path: str, options: ImportOptions) -> Imported:
     world_polys = polygons(world_geom)
     if not robot_polys:
         raise ScenarioError(path, "robot", f"{pb['robot']}: its triangles cover no area in the x-y plane")
+    if not world_polys:  # triangles, all flat: a singular transform or a wrong up axis, not an empty world
+        raise ScenarioError(path, "world", f"{pb['world']}: its {winfo['triangles']} triangles cover no area in the "
+                                           "x-y plane")
     pose = {}
     for end in ("start", "goal"):
         pose[end] = {"x": _number(pb, f"{end}.x", path), "y": _number(pb, f"{end}.y", path),
@@ -267,3 +286,21 @@ def import_cfg(path: str, options: ImportOptions) -> Imported:
     if control:
         imp.comments.append(f"kinodynamic in OMPL.app (control = {control}): here its geometric SE(2) problem")
     return imp
+
+
+def mesh_files(path) -> list[str]:
+    """The mesh files a cfg names (robot, then world), resolved as :func:`read_mesh` resolves
+    them, neither checked nor read: the inputs an output must not overwrite. Reads the cfg
+    only (its faults are :class:`ScenarioError` s, as the import's).
+
+    >>> import tempfile
+    >>> d = tempfile.mkdtemp(); f = os.path.join(d, "p.cfg")
+    >>> _ = open(f, "w").write("[problem]\\nrobot = r.dae\\nworld = /m/w.dae\\n")
+    >>> [os.path.relpath(m, d) if not m.startswith("/m") else m for m in mesh_files(f)]
+    ['r.dae', '/m/w.dae']
+    """
+    path = os.fspath(path)
+    problem = read_cfg(path).get("problem", {})
+    folder = os.path.dirname(os.path.abspath(path))
+    return [name if os.path.isabs(name) else os.path.join(folder, name)
+            for name in (problem.get(k) for k in ("robot", "world")) if name]

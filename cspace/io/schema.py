@@ -38,6 +38,13 @@ SPACES = ("translation", "se2", "dubins", "reeds-shepp")
 ROTATING_SPACES = ("se2", "dubins", "reeds-shepp")
 CAR_SPACES = ("dubins", "reeds-shepp")
 MAX_SLABS = 4096
+# A rotating robot's convex pieces (a part, grown by its margin) have at most this many
+# vertices: the slab build is quadratic in them (256: about a second for 32 slabs; a
+# 7 025-gon took minutes and gigabytes). A finer disk needs a larger disk_tolerance.
+MAX_ROTATING_VERTICES = 256
+# A car's turning radius lies within these factors of the scene's extent (outside, the
+# curves' lengths in radii overflow or lose every digit of the scene).
+TURNING_RADIUS_RANGE = (1e-9, 1e9)
 # Seeds: OMPL's are 32-bit and never 0 (planners.adapters.glue.SEED_LIMIT); a seed s is used as s + 1.
 MAX_SEED = 2**32 - 2
 

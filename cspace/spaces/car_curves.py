@@ -46,16 +46,47 @@ def _pose(q, name: str) -> Pose:
     return x, y, th
 
 
+# Headings beyond this magnitude are wrapped (exactly: fmod) before a curve is computed; the
+# words' own reductions lose the heading's digits there (a goal heading of 1e17 read as 0).
+WRAP_ABOVE = 2.0**20
+
+
+def _wrapped(q: Pose) -> Pose:
+    return q if abs(q[2]) <= WRAP_ABOVE else (q[0], q[1], wrap_angle(q[2]))
+
+
+# A turning radius lies in the magnitudes a scene may have (cspace.io.schema's MIN_EXTENT and
+# MAX_MAGNITUDE): a subnormal radius would scale every length of the curve to 0.
+RADIUS_LIMITS = (2.0**-400, 2.0**400)
+
+
 def _radius(radius) -> float:
     r = float(radius)
     if not (math.isfinite(r) and r > 0.0):
         raise ValueError("radius: the turning radius must be finite and positive")
+    if not RADIUS_LIMITS[0] <= r <= RADIUS_LIMITS[1]:
+        raise ValueError(f"radius: the turning radius must lie in [2^-400, 2^400], got {r!r}")
     return r
+
+
+# The poses of a curve are at most this many turning radii apart (far beyond any scene:
+# the words' arithmetic overflows near 1e300 radii).
+MAX_RADII = 1e100
+
+
+def _frame(frame: tuple[float, float, float]) -> tuple[float, float, float]:
+    if not all(math.isfinite(v) and abs(v) <= MAX_RADII for v in frame[:-1]):
+        raise ValueError(f"radius: the poses are more than {MAX_RADII:g} turning radii apart (the radius is too "
+                         "small for them)")
+    return frame
 
 
 def _segments(word: str, lengths, r: float) -> list[Segment]:
     # Scale radii to world units; a segment of exactly zero length is dropped.
-    return [(k, float(v) * r) for k, v in zip(word, lengths) if v != 0.0]
+    out = [(k, float(v) * r) for k, v in zip(word, lengths) if v != 0.0]
+    if not all(math.isfinite(v) for _, v in out):
+        raise ValueError("radius: the turning radius is too large (a segment's length overflows)")
+    return out
 
 
 def dubins_segments(q0, q1, radius: float) -> list[Segment]:
@@ -67,7 +98,7 @@ def dubins_segments(q0, q1, radius: float) -> list[Segment]:
     ['R', 'L', 'R']
     """
     q0, q1, r = _pose(q0, "q0"), _pose(q1, "q1"), _radius(radius)
-    word, lengths = dubins_word(*dubins_frame(q0, q1, r))
+    word, lengths = dubins_word(*_frame(dubins_frame(_wrapped(q0), _wrapped(q1), r)))
     return _segments(word, lengths, r)
 
 
@@ -80,7 +111,7 @@ def reeds_shepp_segments(q0, q1, radius: float) -> list[Segment]:
     [('L', 1.047198), ('R', -1.047198), ('L', 1.047198)]
     """
     q0, q1, r = _pose(q0, "q0"), _pose(q1, "q1"), _radius(radius)
-    word, lengths = reeds_shepp_word(*reeds_shepp_frame(q0, q1, r))
+    word, lengths = reeds_shepp_word(*_frame(reeds_shepp_frame(_wrapped(q0), _wrapped(q1), r)))
     return _segments(word, lengths, r)
 
 

@@ -39,6 +39,7 @@ import numpy as np
 
 from . import fastpath
 from .car_curves import advance, turning_centre
+from .pose_checks import curve_radius, curve_segments, se2_pose
 from ..kernel.slab import rotate_piece, slab_pad, wrap_angle
 
 # Initial split of an arc: intervals of at most this angle (the bound's excess over
@@ -100,9 +101,13 @@ class CarMotions:
         >>> cs.curve_free((2, 2, 0), [("S", 3), ("L", math.pi / 2), ("S", 5)], 1.0)  # up x = 6: hits
         False
         """
+        x, y, th = se2_pose(q0, "q0")  # junk raises (pose_checks); so do unbounded segments
+        radius = curve_radius(radius, self.extent)
+        segments = curve_segments(segments, radius, self.extent)
+        if q1 is not None:
+            q1 = se2_pose(q1, "q1")
         self.checks["curves"] += 1
-        radius = float(radius)
-        pose = (float(q0[0]), float(q0[1]), wrap_angle(float(q0[2])))
+        pose = (x, y, wrap_angle(th))
         fast = self._car_fast
         if fast is False:  # first curve: the compiled check, or None on the pure path
             fast = self._car_fast = fastpath.car_curve(self, MAX_HULLS, FLOOR_REL, ARC_CHUNK)

@@ -33,11 +33,12 @@ from . import fastpath
 from .broadphase import GridIndex
 from .cspace import CSpace
 from .cspace_build import check_range, decompose_obstacles, decompose_robot, inflated, pair_sums
+from .pose_checks import check_pieces, check_robot, se2_pose
 from .slab_build import build_slabs, slab_run
 from ..kernel.minkowski import minkowski_sum, reflect
 from ..kernel.polygon import is_convex, point_in_convex
 from ..io.scenario import load_scenario
-from ..io.schema import Scenario
+from ..io.schema import MAX_ROTATING_VERTICES, Scenario
 from .car_motion import CarMotions
 from .se2_motion import SE2Motions, interpolate  # noqa: F401  (interpolate: part of this module's API)
 from ..kernel.slab import (ANGLE_SLACK, TWO_PI, edge_planes, typical_gap, default_slabs, robot_radius, rotate_piece,
@@ -67,6 +68,7 @@ class SE2CSpace(SE2Motions, CarMotions):
         t0 = time.perf_counter()
         self.bounds = tuple(float(v) for v in bounds)
         obstacles = obstacles or []
+        check_robot(robot)
         check_range(self.bounds, obstacles + (robot or []))
         self.obstacle_pieces, self.obstacle_of, _ = decompose_obstacles(obstacles, obstacle_holes)
         self.robot_pieces, _ = decompose_robot(robot or [], robot_is_disk)
@@ -77,6 +79,7 @@ class SE2CSpace(SE2Motions, CarMotions):
         self.body_pieces = self.robot_pieces  # the robot itself, for clearance measures
         if self.margin:
             self.robot_pieces = inflated(self.robot_pieces, self.margin)
+        check_pieces(self.robot_pieces, MAX_ROTATING_VERTICES)
         self.grid_cells = grid_cells
         xmin, xmax, ymin, ymax = self.bounds
         self.extent = max(xmax - xmin, ymax - ymin)
@@ -245,8 +248,9 @@ class SE2CSpace(SE2Motions, CarMotions):
         return xmin <= x <= xmax and ymin <= y <= ymax
 
     def is_free(self, q) -> bool:
-        """Is the pose q = (x, y, θ) valid: reference point in bounds, robot touching nothing?"""
-        return self._pose(float(q[0]), float(q[1]), float(q[2]))
+        """Is the pose q = (x, y, θ) valid: reference point in bounds, robot touching nothing?
+        (ValueError for a non-finite pose, TypeError or ValueError for a malformed one.)"""
+        return self._pose(*se2_pose(q, "q"))
 
     def pose_test(self, tick=None, state: bool = False):
         """A fast ``(x, y, theta) -> bool`` free-pose test: the validity checker's hot path.

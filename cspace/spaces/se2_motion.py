@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from . import fastpath
+from .pose_checks import se2_pose
 from ..kernel.gjk import exact_relation
 from ..kernel.minkowski import minkowski_sum, reflect
 from ..kernel.pieces import PieceSet
@@ -82,9 +83,9 @@ class SE2Motions:
         an exact pose in collision, or (counted in ``checks["motion_floor"]``) when
         refinement reaches its floor without deciding.
         """
+        (x0, y0, a0), (x1, y1, a1) = se2_pose(q0, "q0"), se2_pose(q1, "q1")  # raises on junk
         self.checks["motions"] += 1
-        x0, y0, a0 = float(q0[0]), float(q0[1]), wrap_angle(float(q0[2]))
-        x1, y1, a1 = float(q1[0]), float(q1[1]), wrap_angle(float(q1[2]))
+        a0, a1 = wrap_angle(a0), wrap_angle(a1)
         if not (self._pose(x1, y1, a1) and self._pose(x0, y0, a0)):
             self.checks["motion_collisions"] += 1
             return False

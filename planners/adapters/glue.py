@@ -42,7 +42,7 @@ def ompl():
     global _ompl
     if _ompl is None:
         try:
-            with _quiet_fd(2):
+            with _quiet_fd(2), _sigint_held():
                 from ompl import base as ob
                 from ompl import geometric as og
                 from ompl import util as ou
@@ -52,6 +52,30 @@ def ompl():
         ou.setLogLevel(ou.LOG_NONE)
         _ompl = (ob, og, ou)
     return _ompl
+
+
+@contextlib.contextmanager
+def _sigint_held():
+    """Hold Ctrl-C while OMPL's extension starts: a KeyboardInterrupt inside it (nanobind
+    building its enums) aborts the process (``terminate called``); it is raised once the
+    import is done. Off the main thread nothing can be held (nor delivered)."""
+    import signal
+
+    hit = []
+    if signal.getsignal(signal.SIGINT) is None:  # a handler set outside Python: it cannot be put back
+        yield
+        return
+    try:
+        prev = signal.signal(signal.SIGINT, lambda *_: hit.append(1))
+    except ValueError:
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, prev)
+    if hit:
+        raise KeyboardInterrupt
 
 
 @contextlib.contextmanager

@@ -1,4 +1,4 @@
 """``python -m planners.cli``: the ``cspace`` command, as ``python -m planners``."""
-from .command import console
+from . import console
 
 console()

@@ -85,6 +85,30 @@ def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
     return vals
 
 
+def input_files(src: str, robot: str | None = None, queries: str | None = None) -> list[str]:
+    """Every file a command reads, which no output may be: the scenario (or the map YAML and
+    the image it names, or the cfg and its meshes, resolved as the import resolves them),
+    the ``--robot`` file and the ``--queries`` file. Listed without importing; a file that
+    cannot be listed (a broken YAML or cfg) is reported by the import itself."""
+    from cspace.io.imported import CFG_SUFFIXES, is_import
+    from cspace.io.messages import ScenarioError
+
+    files = [src]
+    if is_import(src):
+        try:
+            if src.lower().endswith(CFG_SUFFIXES):
+                from cspace.io.omplapp import mesh_files
+
+                files += mesh_files(src)
+            else:
+                from cspace.io.occupancy import read_map_yaml
+
+                files.append(read_map_yaml(src).image)
+        except (ScenarioError, OSError, ValueError):
+            pass
+    return files + [f for f in (robot, queries) if f is not None]
+
+
 def read_robot(path: str) -> dict:
     """The ``[robot]`` table of a TOML file (a robot file, or any scenario)."""
     from cspace.io.files import read_input, toml_reader
@@ -112,7 +136,7 @@ def run(args) -> int:
     if not is_import(src):
         raise InputError(src, "file", "expected a map YAML (.yaml, .yml) or an OMPL.app problem (.cfg)")
     check_input(src)
-    check_output(args.out, "--out", {".toml": "toml"}, inputs=[src])
+    check_output(args.out, "--out", {".toml": "toml"}, inputs=input_files(src, args.robot))
     options = import_options(args, src)
     imp = import_file(src, options)
     check_output(args.out, "--out", {".toml": "toml"}, inputs=imp.inputs)  # nor the image or a mesh
