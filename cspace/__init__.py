@@ -38,11 +38,15 @@ _NAMES = {
 }
 
 __all__ = sorted(_NAMES)
+# Names whose fast route another module registers on import (the compiled pair sum of minkowski_sum).
+_WITH = {"minkowski_sum": "spaces.fastpath"}
 __version__ = "0.1.0"
 
 
 def __getattr__(name: str):
     if name in _NAMES:
+        if name in _WITH:
+            importlib.import_module("." + _WITH[name], __name__)
         value = getattr(importlib.import_module("." + _NAMES[name], __name__), name)
         globals()[name] = value
         return value

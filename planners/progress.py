@@ -25,6 +25,11 @@ T = TypeVar("T")
 DELAY = 0.5
 # Seconds between two redraws at most (keeps a fast loop from spending its time drawing).
 MININTERVAL = 0.2
+# Seconds between two redraws of a stage without steps (its name and a running clock).
+TICK = 1.0
+# An unknown-total bar before its first step: the stage it is in and a clock, not a "0node"
+# that would not move while a long stage without steps (a C-space build) runs.
+STAGE_FORMAT = "{desc} [{elapsed}]"
 
 
 def enabled_default(stream=None) -> bool:
@@ -61,7 +66,7 @@ class Progress:
         self.n = 0
         self.total = total
         self._bar = None
-        self._stop = None
+        self._stop = self._ticker = None
         self._visible_at = time.monotonic() + delay  # a bar with a delay stays hidden until then
         if enabled is None:
             enabled = enabled_default()
@@ -73,7 +78,8 @@ class Progress:
             return
         # dynamic_ncols follows the terminal's width; mininterval keeps redraws cheap.
         self._bar = tqdm(total=total, desc=desc, unit=unit, delay=delay, leave=leave, file=sys.stderr,
-                         dynamic_ncols=True, mininterval=MININTERVAL)
+                         dynamic_ncols=True, mininterval=MININTERVAL,
+                         bar_format=STAGE_FORMAT if total is None else None)
         if tick:
             self._start_ticker(delay, tick)
 
@@ -92,7 +98,8 @@ class Progress:
                 bar.refresh()
                 stop.wait(tick)
 
-        threading.Thread(target=run, name="progress-ticker", daemon=True).start()
+        self._ticker = threading.Thread(target=run, name="progress-ticker", daemon=True)
+        self._ticker.start()
 
     @property
     def shown(self) -> bool:
@@ -103,6 +110,8 @@ class Progress:
         """Advance by ``n`` steps."""
         self.n += n
         if self._bar is not None:
+            if self.n and self._bar.bar_format is not None:  # the first step: counts from now on
+                self._bar.bar_format = None
             self._bar.update(n)
 
     def set(self, done: int, total: int | None = None) -> None:
@@ -117,7 +126,11 @@ class Progress:
         """Start counting again from 0 (a new stage of the same work)."""
         self.n, self.total = 0, total
         if self._bar is not None:
-            self._bar.reset(total=total)
+            if self._bar.total is None and total is None:  # no steps yet: the stage's name again
+                self._bar.bar_format = STAGE_FORMAT
+            self._bar.reset(total=total)  # which draws the bar, even within its delay:
+            if time.monotonic() < self._visible_at:
+                self._bar.clear()  # erased at once (work that ends quickly shows no bar)
 
     def describe(self, desc: str) -> None:
         """Change the name of the work shown before the bar (a new stage)."""
@@ -136,11 +149,18 @@ class Progress:
             self._bar.write(line, file=sys.stderr)
 
     def close(self) -> None:
-        """Remove the bar (or leave its last state, with ``leave=True``)."""
+        """Remove the bar (or leave its last state, with ``leave=True``), so that the next
+        line written starts on a line of its own."""
         if self._stop is not None:
             self._stop.set()
+            self._ticker.join(1.0)  # no redraw after the bar is cleared
         if self._bar is not None:
-            self._bar.close()
+            bar = self._bar
+            if time.monotonic() >= self._visible_at:
+                # tqdm clears (or ends with a newline) only a bar it drew in update(); the ticker's
+                # and describe()'s redraws are not counted, which left the bar on the line.
+                bar.last_print_t = max(bar.last_print_t, bar.start_t + bar.delay)
+            bar.close()
             self._bar = None
 
     def __enter__(self) -> "Progress":
@@ -176,7 +196,7 @@ def track(items: Iterable[T], desc: str, total: int | None = None, enabled: bool
             bar.update()
 
 
-def search_reporter(bar: Progress) -> Callable[[int, int, float], None]:
+def search_reporter(bar: Progress, desc: str | None = None) -> Callable[[int, int, float], None]:
     """A callback for :func:`cspace.spaces.shortest.shortest_path`'s ``on_progress``.
 
     The search calls it with (nodes settled, nodes in the graph, lower bound on the
@@ -186,6 +206,9 @@ def search_reporter(bar: Progress) -> Callable[[int, int, float], None]:
     the bar's total: A* usually stops long before settling every node, so a
     percentage and an estimated time left would mislead.
 
+    ``desc``, when given, names the stage once the first report comes (the search
+    itself, after a preparation the bar named before).
+
     >>> bar = progress(None, "search", enabled=False)
     >>> search_reporter(bar)(10, 40, 3.5)
     >>> bar.n, bar.total
@@ -193,6 +216,8 @@ def search_reporter(bar: Progress) -> Callable[[int, int, float], None]:
     """
 
     def report(settled: int, nodes: int, bound: float) -> None:
+        if desc is not None and bar.n == 0:
+            bar.describe(desc)
         bar.note(f"of {nodes}; length >= {bound:.6g}")  # before the step, which redraws
         bar.set(settled)
 

@@ -122,7 +122,9 @@ def test_every_output_option_with_exact_in_se2(tmp_path, capsys):
     r = json.loads((tmp_path / "r.json").read_text())
     assert r["solved"] and r["clearance"] == 0.02 and r["min_clearance"] >= 0.02 * (1 - 1e-9)
     rows = (tmp_path / "r.csv").read_text().splitlines()
-    assert rows[0] == "x,y,theta" and len(rows) == len(r["path"]) + 1
+    # --all-queries: every query's waypoints, with a query column (issue 39, item 8b)
+    assert rows[0] == "query,x,y,theta" and len(rows) == len(r["path"]) + 1
+    assert all(row.startswith("0,") for row in rows[1:])
 
 
 def test_undecided_states_the_resolution(capsys):
@@ -133,7 +135,7 @@ def test_undecided_states_the_resolution(capsys):
     import tomllib
 
     data = tomllib.loads(text)
-    data["planner"] = {"name": "exact", "time": 0.5}
+    data["planner"] = {"name": "exact", "time": 1.0}  # the slab build counts against it
     sc = scenario_from_dict(data, "closed-door.toml")
     res = planners.plan(sc)
     assert not res.solved and res.proof is None

@@ -13,7 +13,8 @@ from ..kernel.disk import DEFAULT_RELATIVE_ERROR
 from ..kernel.slab import wrap_angle
 from .messages import ScenarioError, short
 from .probe import CollisionProbe
-from .schema import CAR_SPACES, MAX_SLABS, MIN_EXTENT, ROTATING_SPACES, SPACES, Scenario
+from .schema import (CAR_SPACES, MAX_ROTATING_VERTICES, MAX_SLABS, MIN_EXTENT, ROTATING_SPACES, SPACES,
+                     TURNING_RADIUS_RANGE, Scenario)
 from .shapes import ShapeChecks
 
 # The keys a scenario may have at its top level (a new section adds its key here).
@@ -51,6 +52,7 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
 
     if space is not None and space not in SPACES:
         raise ScenarioError("--space", "space", f"must be one of {', '.join(SPACES)}, got {short(space)}")
+    overridden = space is not None and space != data.get("space", "translation")
     space = space or data.get("space", "translation")
     if space not in SPACES:
         raise v.err("space", f"must be one of {', '.join(repr(s) for s in SPACES)}, got {short(space)}")
@@ -74,6 +76,13 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
         if radius is None:
             raise v.err("turning_radius", f'is required for space = "{space}" (the car\'s minimum turning radius)')
         radius = v.number(radius, "turning_radius", positive=True)
+        lo, hi = (f * max(xmax - xmin, ymax - ymin) for f in TURNING_RADIUS_RANGE)
+        if not lo <= radius <= hi:
+            where = ("--turning-radius", "turning_radius") if turning_radius is not None else (path, "turning_radius")
+            raise ScenarioError(*where, f"{radius!r} is outside [{lo:.3g}, {hi:.3g}] (1e-9 to 1e9 times the "
+                                        "scene's extent)")
+    elif radius is not None and overridden and data.get("space") in CAR_SPACES:
+        radius = None  # a car's file planned as another space (--space se2): its turning radius does not apply
     elif radius is not None:
         raise v.err("turning_radius", 'applies to space = "dubins" or "reeds-shepp" only')
 
@@ -95,6 +104,8 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
     if clearance < 0:
         raise v.err("clearance", f"must be a distance >= 0, got {data.get('clearance')}")
     margin = v.margin(data.get("margin"), theta, tol)
+    if se2:
+        _rotating_size(v, robot, margin, clearance, tol)
     obstacles = v.obstacles(data.get("obstacles", []), tol)
     planner = v.planner(data.get("planner", {}))
     queries = v.queries(data.get("queries", []), se2)
@@ -142,6 +153,21 @@ def with_queries(sc: Scenario, data: dict, path: str) -> Scenario:
     for (pt, fld), hit in zip(labelled, hits):
         v.placement(out, pt, hit, fld)
     return out
+
+
+def _rotating_size(v, robot, margin, clearance: float, tol: float) -> None:
+    """A rotating robot's parts, each grown by its margin, within MAX_ROTATING_VERTICES (an
+    upper bound on its convex pieces' vertices: a convex sum has at most n + m)."""
+    from ..kernel.margin import margin_shapes
+
+    extra = sum(len(m) for m in margin_shapes(clearance, margin, tol))
+    for i, sh in enumerate(robot):
+        n = len(sh.polygon) + extra
+        if n > MAX_ROTATING_VERTICES:
+            fld = "robot" if len(robot) == 1 else f"robot.parts[{i}]"
+            hint = " (raise disk_tolerance)" if sh.disk is not None or extra else ""
+            raise v.err(fld, f"{n} vertices{' with its margin' if extra else ''}: a rotating robot part has at "
+                             f"most {MAX_ROTATING_VERTICES}{hint}")
 
 
 class _Validator(ShapeChecks):

@@ -21,6 +21,17 @@ pieces (:mod:`cspace.kernel.minkowski_scalar`), and a vectorised one for large i
 (:mod:`cspace.kernel.minkowski_sorted`: a stable sort of pseudo-angle keys, whose order
 is then certified pair by pair with the exact comparison, :mod:`cspace.kernel.minkowski_certify`;
 any doubt falls back to the scalar merge). This module owns the API and the choice of route.
+
+The compiled pair sum. The C merge of two convex polygons (``_fast.pair_sums``, in
+cspace/spaces/_build.c) is ~20x the scalar merge on small pairs, but the extension belongs to
+:mod:`cspace.spaces` and the kernel imports nothing above it (kernel <- io <- spaces). So the
+route is a hook: :func:`use_pair_sum` takes a callable ``f([P], [Q]) -> [sum or None]``, and
+:mod:`cspace.spaces.fastpath` registers its ``pair_sums`` there when the extension is loaded
+(``import cspace.spaces.fastpath``, which every C-space build and ``cspace.minkowski_sum`` do).
+Two-operand sums of at most :data:`_SCALAR_MAX` vertices go through it; the C merge writes
+only what it certifies (canonical operands, certified angle comparisons and turns), the very
+arrays the scalar merge returns, and answers None otherwise: the pure route then runs. Under
+``fastpath.disabled()`` or ``CSPACE_PURE=1`` the hook answers None (or is not registered).
 """
 from __future__ import annotations
 
@@ -33,6 +44,17 @@ from .predicates import NonFiniteError
 
 # Up to this many vertices in total the scalar merge is faster than numpy's overhead.
 _SCALAR_MAX = 96
+
+_pair_sum = None  # the compiled pair sum registered by use_pair_sum (None: the pure route)
+
+
+def use_pair_sum(fn):
+    """Route two-operand sums of small convex polygons through ``fn`` (``fn([P], [Q])`` returns
+    ``[P ⊕ Q]``, or ``[None]``/None when it cannot certify it); None restores the pure route.
+    Returns the previous hook. :mod:`cspace.spaces.fastpath` registers the compiled one."""
+    global _pair_sum
+    previous, _pair_sum = _pair_sum, fn
+    return previous
 
 
 def reflect(polygon) -> np.ndarray:
@@ -67,10 +89,24 @@ def minkowski_sum(P, Q, *more) -> np.ndarray:
         raise ValueError("minkowski_sum: the sum's coordinates overflow the double range") from None
 
 
+def _roll_lowest(p: np.ndarray) -> np.ndarray:
+    """``p`` from its lowest vertex (then the leftmost of a CCW bottom edge), cheaply: the start
+    the C merge needs. A wrong guess (CW, not convex) is only refused by its certified check."""
+    y = p[:, 1]
+    i = int(y.argmin())
+    if y[i - 1] == y[i]:  # a horizontal bottom edge: CCW, its left end comes first
+        i -= 1
+    return p if i == 0 else np.concatenate((p[i:], p[:i]))
+
+
 def _minkowski_sum(ops: list) -> np.ndarray:
     """:func:`minkowski_sum` of operands already converted to arrays."""
     if sum(len(o) for o in ops) <= _SCALAR_MAX:
         if len(ops) == 2:
+            if _pair_sum is not None and len(ops[0]) >= 3 and len(ops[1]) >= 3:
+                got = _pair_sum([_roll_lowest(ops[0])], [_roll_lowest(ops[1])])
+                if got is not None and got[0] is not None:
+                    return got[0].copy()  # a view of the call's buffer: the caller owns its array
             (P, EP), (Q, EQ) = clean_edges_small(ops[0].tolist()), clean_edges_small(ops[1].tolist())
             flat, exact = merge2_small(P, Q, EP, EQ)
             if exact:  # the exact sum, strictly convex by the exact merge

@@ -182,6 +182,12 @@ def pair_sums(pa: list, pb: list) -> list | None:
     return [out[e - c:e] if c > 0 else None for c, e in zip(count.tolist(), ends)]
 
 
+if _fast is not None:  # cspace.kernel.minkowski.minkowski_sum's small pairs go through the C merge
+    from ..kernel.minkowski import use_pair_sum
+
+    use_pair_sum(pair_sums)
+
+
 def contained(pieces: list, qs: np.ndarray, ps: np.ndarray) -> np.ndarray | None:
     """Per candidate pair (q, p): is piece p inside convex piece q? ``_fast.contained``
     (cspace/spaces/_build.c): 1 yes, 0 no, -1 not certified (the caller decides); None on

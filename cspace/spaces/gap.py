@@ -8,9 +8,11 @@ side of p (every edge of F against every sample line, vectorised). In open space
 passage it spans the passage, whatever side of it the path hugs (the exact planner's
 optimum touches the walls). The narrowest gap along the path is the minimum over
 points sampled inside every segment (not at the bends, where the perpendicular is
-ambiguous); along a passage of constant width, the middle of the narrowest run. This
-is a measure for display, not a certificate: the sampling can step over a pinch
-shorter than the spacing of the samples.
+ambiguous); along a passage of constant width, the middle of the narrowest run. Looking
+only for gaps below a width, a side with no wall within it is open space, not a gap. The
+gap found is then measured wall to wall (:func:`wall_to_wall`): a path crossing a passage
+at a slant cuts it longer than it is wide. This is a measure for display, not a
+certificate: the sampling can step over a pinch shorter than the spacing of the samples.
 """
 from __future__ import annotations
 
@@ -78,7 +80,13 @@ def narrowest_gap(pieces: list, bounds, path, samples: int = 400, free=None,
         a, b = a[near], b[near]
     t_minus, t_plus = _nearest_crossings(F, a, b, p, normal, reach=below)
     width = t_plus - t_minus
-    idx = np.flatnonzero(np.isfinite(width) & (width < (np.inf if below is None else below)))
+    real = np.isfinite(width)
+    if below is not None:
+        # A side cut at the reach found no wall within it: open space on that side, not a gap
+        # (its "width" would be the reach, not a passage's).
+        with np.errstate(invalid="ignore"):
+            real &= (t_plus < below) & (t_minus > -below) & (width < below)
+    idx = np.flatnonzero(real)
     if len(idx) == 0:
         return None
     width = width[idx]
@@ -86,8 +94,49 @@ def narrowest_gap(pieces: list, bounds, path, samples: int = 400, free=None,
     ties = idx[width <= width.min() * (1 + 1e-6)]
     i = int(ties[len(ties) // 2])
     lo, hi = p[i] + t_minus[i] * normal[i], p[i] + t_plus[i] * normal[i]
-    return Gap(float(t_plus[i] - t_minus[i]), (float(p[i, 0]), float(p[i, 1])),
-               ((float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))))
+    return wall_to_wall(F, Gap(float(t_plus[i] - t_minus[i]), (float(p[i, 0]), float(p[i, 1])),
+                               ((float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1])))))
+
+
+def wall_to_wall(F, gap: Gap) -> Gap:
+    """The gap measured between its two walls rather than across the path: a path crossing a
+    passage at a slant cuts it longer than it is wide.
+
+    Near the gap (within its width of its centre), the complement of the free space ``F``
+    falls into parts; when the gap's two ends lie on different parts, the gap becomes the
+    shortest segment between those two walls (shapely), never longer than before. Otherwise
+    (one wall on both sides, close to a corner) the gap is kept as it is.
+
+    >>> import shapely
+    >>> F = shapely.box(0, 0, 10, 10).difference(shapely.box(4, 0, 6, 4.9)).difference(shapely.box(4, 5.1, 6, 10))
+    >>> g = wall_to_wall(F, Gap(0.2 * 2 ** 0.5, (5.0, 5.0), ((4.9, 4.9), (5.1, 5.1))))  # crossed at 45 degrees
+    >>> round(g.width, 12), [round(e[1], 12) for e in g.ends]  # straight across
+    (0.2, [4.9, 5.1])
+    """
+    import shapely
+
+    (ax, ay), (bx, by) = gap.ends
+    cx, cy = gap.center
+    window = shapely.Point(cx, cy).buffer(max(gap.width, 1e-300), quad_segs=16)
+    walls = [w for w in shapely.get_parts(window.difference(F)) if not w.is_empty]
+    if len(walls) < 2:
+        return gap
+    ends = shapely.points([(ax, ay), (bx, by)])
+    near = [int(np.argmin([shapely.distance(w, e) for w in walls])) for e in ends]
+    if near[0] == near[1]:
+        return gap
+    lo, hi = walls[near[0]], walls[near[1]]
+    line = shapely.shortest_line(lo, hi)
+    width = float(line.length)
+    # Between parallel walls every perpendicular is shortest: keep the one at the path's point.
+    q = shapely.shortest_line(shapely.Point(gap.point), lo).coords[1]
+    here = shapely.shortest_line(shapely.Point(q), hi)
+    if here.length <= width * (1.0 + 1e-9):
+        line = here
+    if not width < gap.width:
+        return gap
+    (lx, ly), (hx, hy) = np.asarray(line.coords)[:2]
+    return Gap(width, gap.point, ((float(lx), float(ly)), (float(hx), float(hy))))
 
 
 def _ring_segments(F) -> tuple[np.ndarray, np.ndarray]:

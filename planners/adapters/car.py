@@ -30,9 +30,8 @@ class CarSpace(SE2Space):
 
     unsolved_hint = "try a longer --time (a car needs room to turn: check the turning radius)"
     step = "curve"
-    # The SE(2) clearance (its bound, its objective) follows OMPL's SE(2) interpolation between
-    # waypoints, not a car's curves: not inherited. A car's path clearance is not measured (yet).
-    path_clearance = None
+    # The SE(2) clearance objective follows OMPL's SE(2) interpolation between waypoints, not a
+    # car's curves: not inherited. The path's clearance is measured along the curves (path_clearance).
     clearance_functions = None
 
     def __init__(self, cspace, kind: str, radius: float, k: int | None = None):
@@ -51,6 +50,14 @@ class CarSpace(SE2Space):
         space = ob.DubinsStateSpace(r, False) if self.name == "dubins" else ob.ReedsSheppStateSpace(r)
         space.setBounds(scaled_bounds(ob, self.cspace.bounds, self.k))
         return space
+
+    def path_clearance(self, path: np.ndarray):
+        """A certified lower bound of the clearance of the ROBOT (body pieces, not inflated)
+        driven along the curves of ``path`` (:func:`cspace.spaces.car_clearance.car_path_clearance`)."""
+        from cspace.spaces.car_clearance import car_path_clearance
+
+        return car_path_clearance(path, self.segments, self.radius, self.cspace.body_pieces,
+                                  self.cspace.obstacle_pieces)
 
     # ---------------------------------------------------------------- curves
 

@@ -3,14 +3,23 @@
 OMPL 2.0's Python bindings bind ``PathLengthOptimizationObjective`` but not
 ``MaximizeMinClearanceObjective``; both clearance objectives here are Python
 subclasses of OMPL's classes (checked to run inside RRTstar and the other optimising
-planners), fed by the project's clearance (the adapter's ``clearance_functions``:
-in translation, the exact distance from the reference point, or from a motion's
-segment, to the nearest C-obstacle piece):
+planners), fed by :func:`clearance_functions` (in translation: a state's clearance is the
+exact float distance from the reference point to the nearest C-obstacle piece, through the
+grid of :class:`cspace.spaces.point_clearance.PointClearance`, computed once per state; a
+motion's is :func:`cspace.spaces.point_clearance.disc_bound` of its ends' clearances and
+its length, a certified lower bound of the segment's exact clearance that costs no
+geometry; in SE(2), the adapter's ``clearance_functions``):
 
 - ``length``: OMPL's default, path length (nothing is set: the plans of today);
 - ``clearance``: maximise the minimum clearance (OMPL's MaximizeMinClearanceObjective,
-  rewritten): a motion's cost is its clearance, costs combine by ``min``, a larger cost
-  is better, and no cost ever satisfies it (an anytime planner keeps improving);
+  rewritten): a motion's cost is minus its clearance (the bound above), costs combine by
+  ``max`` (the path's cost is minus its least motion clearance), a smaller cost is better
+  (OMPL's own comparison, kept in C++: RRTstar compares costs hundreds of times per
+  iteration, and each call into Python costs about 0.5 µs), and no cost ever satisfies it
+  (an anytime planner keeps improving). OMPL's log shows these negative costs; the plan's
+  ``min_clearance`` is the path's exact clearance, never less than the objective's value
+  (:func:`path_clearance_bound`). Per RRTstar iteration it costs about 6-8x the length
+  objective (``scripts/bench_objective.py``; a Python objective measuring nothing, 4-5x);
 - ``balanced``: the integral along the path of ``1 + w · ρ / (c + ρ)`` (c the clearance,
   ρ = ``BALANCED_SCALE`` × the scene's extent, w = ``BALANCED_WEIGHT`` = 1): far from
   obstacles (c ≫ ρ) a unit of length costs 1, grazing them (c = 0) it costs 1 + w = 2,
@@ -59,6 +68,112 @@ def check_objective(name, planner: str = "RRTstar") -> str:
     return n
 
 
+def unsolved_hint(objective: str, space_hint: str | None) -> str | None:
+    """What a failed plan suggests under ``objective``: the space's own hint under ``length``;
+    under another objective a longer budget or the length objective (the exact planner,
+    which the translation hint names, takes only the length objective).
+
+    >>> unsolved_hint("length", "try --planner exact")
+    'try --planner exact'
+    >>> "exact" in unsolved_hint("clearance", "try --planner exact")
+    False
+    """
+    if objective == "length":
+        return space_hint
+    return (f"try a longer --time (--objective {objective} costs a few times more per iteration than "
+            f"the length objective), or plan without --objective {objective}")
+
+
+CACHE_MAX = 1 << 17  # states whose clearance the translation objective remembers (then it starts over)
+
+
+def clearance_functions(adapter):
+    """``(state -> clearance, (state, state) -> clearance)`` on OMPL states, as the
+    clearance objectives read them (C-space units). Translation: a state's exact float
+    clearance (0 for a state that is not free), remembered per state; a motion's
+    :func:`cspace.spaces.point_clearance.disc_bound` of its ends (a lower bound of its
+    exact clearance). Other spaces: the adapter's ``clearance_functions``."""
+    if getattr(adapter, "name", None) != "translation":
+        return adapter.clearance_functions()
+    return _translation_functions(adapter, lambda v: -v)
+
+
+def _translation_functions(adapter, box):
+    """The translation pair of :func:`clearance_functions`, the motion's answer returned as
+    ``box(-clearance)`` (``ob.Cost`` inside the objective: one Python call per motion)."""
+    from cspace.spaces.point_clearance import PointClearance
+
+    cs, k = adapter.cspace, -adapter.k
+    near = PointClearance(cs.pieces, cs.bounds)
+    free = cs.point_test()  # (x, y) -> bool, not counted among the planner's state checks
+    unit, ldexp, hypot, sqrt, inf = math.ldexp(1.0, k), math.ldexp, math.hypot, math.sqrt, math.inf
+    cache: dict = {}  # x -> (y, clearance): a float key hashes faster than a pair
+    get = cache.get
+    lx = ly = math.nan  # the state met last and its clearance (RRTstar weighs ~100 motions to each new state)
+    lc = 0.0
+
+    def at(x: float, y: float) -> float:  # raw OMPL coordinates
+        e = get(x)
+        if e is not None and e[0] == y:
+            return e[1]
+        ux, uy = ldexp(x, k), ldexp(y, k)
+        c = near(ux, uy) if free(ux, uy) else 0.0
+        if len(cache) >= CACHE_MAX:
+            cache.clear()
+        cache[x] = (y, c)
+        return c
+
+    def state(s) -> float:
+        return at(s[0], s[1])
+
+    def motion(s1, s2):  # disc_bound, written out: called hundreds of times per iteration
+        nonlocal lx, ly, lc
+        x2 = s2[0]
+        y2 = s2[1]
+        if x2 == lx and y2 == ly:
+            c2 = lc
+        else:
+            c2 = lc = at(x2, y2)
+            lx, ly = x2, y2
+        x1 = s1[0]
+        y1 = s1[1]
+        e = get(x1)
+        c1 = e[1] if e is not None and e[0] == y1 else at(x1, y1)
+        dx, dy = x2 - x1, y2 - y1
+        d = hypot(dx, dy) * unit
+        if d >= c1 + c2:  # the discs apart
+            return box(-0.0)
+        m = c1 if c1 < c2 else c2
+        if d <= 0.0 or m == inf:  # one point (or no obstacles: both inf)
+            return box(-m)
+        a = (d * d + c1 * c1 - c2 * c2) / (2.0 * d)  # where the discs' boundaries cross
+        if a <= 0.0:
+            return box(-c1)
+        if a >= d:
+            return box(-c2)
+        h = c1 * c1 - a * a
+        h = sqrt(h) if h > 0.0 else 0.0
+        return box(-(h if h < m else m))
+
+    return state, motion
+
+
+def path_clearance_bound(adapter, path) -> float:
+    """The clearance the ``clearance`` objective gives a translation path of reference
+    points (rows x, y, C-space units): the least :func:`cspace.spaces.point_clearance.disc_bound`
+    over its motions (inf without obstacles), never more than the path's exact clearance."""
+    from cspace.spaces.point_clearance import PointClearance, disc_bound
+
+    cs = adapter.cspace
+    near = PointClearance(cs.pieces, cs.bounds)
+    pts = [(float(p[0]), float(p[1])) for p in path]
+    c = [near(x, y) if cs.is_free((x, y)) else 0.0 for x, y in pts]
+    if len(pts) == 1:
+        return c[0]
+    return min(disc_bound(c[i], c[i + 1], math.hypot(pts[i + 1][0] - pts[i][0], pts[i + 1][1] - pts[i][1]))
+               for i in range(len(pts) - 1))
+
+
 def make_objective(name: str, si, adapter):
     """An OMPL objective for ``name`` over the adapter's clearance, or None for ``length``
     (OMPL's default path length, as without the option)."""
@@ -67,7 +182,12 @@ def make_objective(name: str, si, adapter):
     from .glue import ompl
 
     ob = ompl()[0]
-    state, motion = adapter.clearance_functions()
+    if name == "clearance" and getattr(adapter, "name", None) == "translation":
+        state, cost = _translation_functions(adapter, ob.Cost)
+        obj = _min_clearance_class(ob)(si, state, None)
+        obj.motionCost = cost  # OMPL's calls find the instance's function: one Python frame per motion
+        return obj
+    state, motion = clearance_functions(adapter)
     if name == "clearance":
         return _min_clearance_class(ob)(si, state, motion)
     xmin, xmax, ymin, ymax = adapter.cspace.bounds
@@ -81,31 +201,26 @@ _classes: dict = {}
 def _min_clearance_class(ob):
     if "min" not in _classes:
         class MaximizeMinClearance(ob.OptimizationObjective):
-            """OMPL's MaximizeMinClearanceObjective in Python: cost = clearance, combined by
-            min, larger is better; a motion's cost is the clearance of its whole segment."""
+            """OMPL's MaximizeMinClearanceObjective in Python: cost = minus the clearance,
+            combined by max, smaller is better (OMPL's comparison and infinite cost, in C++);
+            a motion's cost is minus its clearance (translation: the ends' disc bound)."""
 
             def __init__(self, si, state, motion):
-                super().__init__(si)
+                super().__init__(si)  # (motion None: the caller sets the instance's motionCost)
                 self._state, self._motion = state, motion
-                self.setCostThreshold(ob.Cost(math.inf))  # never satisfied: keep improving
+                self.setCostThreshold(ob.Cost(-math.inf))  # never satisfied: keep improving
 
             def stateCost(self, s):
-                return ob.Cost(self._state(s))
+                return ob.Cost(-self._state(s))
 
             def motionCost(self, s1, s2):
-                return ob.Cost(self._motion(s1, s2))
-
-            def isCostBetterThan(self, c1, c2):
-                return c1.value() > c2.value()
+                return ob.Cost(-self._motion(s1, s2))
 
             def combineCosts(self, c1, c2):
-                return ob.Cost(min(c1.value(), c2.value()))
+                return c1 if c1.value() >= c2.value() else c2
 
             def identityCost(self):
-                return ob.Cost(math.inf)
-
-            def infiniteCost(self):
-                return ob.Cost(-math.inf)
+                return ob.Cost(-math.inf)  # no motion: no clearance spent
 
         _classes["min"] = MaximizeMinClearance
     return _classes["min"]

@@ -52,7 +52,7 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
             bound = db.lower_bound if math.isfinite(db.lower_bound) else None
             entry = {"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
                      "space": sc.space, "slabs": cs.slabs, "upper": None}
-            note = f"lower bound {bound:.6g} ({db.message})" if bound else db.message
+            note = db.message  # "lower bound L (inscribed disk r = ...)", or why there is none
             if sc.space == "se2":  # a car cannot follow the exact planner's turns in place
                 ex = plan(sc, planner="exact", cspace=cs)
                 entry.update(upper=float(ex.length) if ex.solved else None, exact_s=ex.timings.get("solve"),

@@ -12,7 +12,9 @@ import argparse
 import importlib
 import importlib.util
 import os
+import re
 import sys
+import traceback
 import warnings
 
 COMMANDS = {
@@ -23,6 +25,7 @@ COMMANDS = {
     "generate": "planners.cli.generate",
     "import": "planners.cli.imports",
     "check-proof": "planners.cli.check_proof",
+    "view": "planners.cli.view",
 }
 # Each command's one-line help, for the listing of ``cspace --help`` (and a bare
 # ``cspace``), which then imports no command module, nor numpy: start-up stays short.
@@ -35,6 +38,7 @@ HELP = {
     "generate": "write a random scenario (random, maze, narrow, disks, office)",
     "import": "convert a ROS map (.yaml) or an OMPL.app problem (.cfg) to a scenario",
     "check-proof": "re-check a proof that no path exists (from plan --proof)",
+    "view": "plan a scenario and write one offline, interactive HTML page of the plan",
 }
 
 
@@ -49,14 +53,26 @@ def clip(text: str, limit: int) -> str:
     return _clip(text, limit)
 
 
+# A value that starts with a minus and a digit is a value, not an option: footprints about
+# their reference point start with one (``--polygon "-0.2,-0.15;..."``, ``--start -1,2``,
+# ``--theta -1.57``). argparse's own rule accepts a lone number only; no option of ours
+# looks like a number, so the wider rule is unambiguous (``--start=-1,2`` works as well).
+NEGATIVE_VALUE = re.compile(r"^-\.?\d")
+
+
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kw):
+        super().__init__(*args, **kw)
+        self._negative_number_matcher = NEGATIVE_VALUE  # argparse's hook for this rule
+
     def error(self, message):  # one short line, exit 2, like every other input fault
         sys.stderr.write(f"error: {self.prog}: {clip(message, 240)}\n")
         sys.exit(2)
 
 
 def version_line() -> str:
-    """``cspace X.Y.Z (Python ..., numpy ..., shapely ..., ompl ...)``: what a bug report needs.
+    """``cspace X.Y.Z (Python ..., numpy ..., shapely ..., ompl ...; compiled fast path: on)``: what a
+    bug report needs (the last part says whether the compiled routines run, or the pure path).
 
     The versions come from the installed packages' metadata, so OMPL is not imported.
 
@@ -74,7 +90,22 @@ def version_line() -> str:
             deps.append(f"{dist} {metadata.version(dist)}")
         except metadata.PackageNotFoundError:
             deps.append(f"{dist} not installed")
-    return f"cspace {cspace.__version__} (Python {platform.python_version()}, {', '.join(deps)})"
+    return f"cspace {cspace.__version__} (Python {platform.python_version()}, {', '.join(deps)}; {fast_path()})"
+
+
+def fast_path() -> str:
+    """Whether the compiled routines of :mod:`cspace.spaces.fastpath` are in use, and why not.
+
+    >>> fast_path().startswith(("compiled fast path: on", "pure Python path"))
+    True
+    """
+    from cspace.spaces import fastpath
+
+    if fastpath.compiled():
+        return "compiled fast path: on"
+    if os.environ.get("CSPACE_PURE", "") not in ("", "0"):
+        return "pure Python path: CSPACE_PURE is set; slower"
+    return "pure Python path: not compiled at install (no C compiler?); slower"
 
 
 class _Version(argparse.Action):
@@ -135,8 +166,12 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         code = 141  # 128 + SIGPIPE, as a shell reports a process killed by it
     except Exception as exc:  # a bug, not bad input: still one line unless --verbose
-        if getattr(args, "verbose", False):
-            raise
+        if _SIGINT:  # Ctrl-C, which a library turned into another error (numpy: an ImportError)
+            sys.stderr.write("interrupted\n")
+            return 130
+        if getattr(args, "verbose", False):  # the traceback, and still "internal error", not "not solved"
+            traceback.print_exc()
+            return 3
         sys.stderr.write(f"internal error: {type(exc).__name__}: {clip(str(exc), 240)} "
                          "(run with --verbose for the traceback)\n")
         code = 3
@@ -155,23 +190,68 @@ def _silence_stdout() -> None:
     os.close(devnull)
 
 
+_SIGINT: list = []  # Ctrl-C came (console's handler notes it; some libraries turn it into other errors)
+
+
+def _on_sigint(signum, frame):
+    """Python's own Ctrl-C handler (KeyboardInterrupt), which also notes that it came."""
+    _SIGINT.append(signum)
+    raise KeyboardInterrupt
+
+
 def console() -> None:
     """Entry point of the installed ``cspace`` script.
 
     OMPL's bindings print a ``nanobind: leaked ...`` report at interpreter exit; a
     command-line user should not see it, so the process ends with ``os._exit`` once
     its output is flushed (unless ``--verbose`` asks to see everything).
+
+    Ctrl-C at any moment is ``interrupted`` and exit 130, also while the parser and the
+    command's modules load (outside :func:`main`'s handler) and when a library turned it
+    into another error; once the exit code is known, a late Ctrl-C is ignored. An
+    interrupted run also ends with ``os._exit``: Python would otherwise re-raise SIGINT at
+    exit if a library's C code let the KeyboardInterrupt through (exit -2, not 130).
     """
-    code = main()
+    import signal
+
     try:
-        sys.stdout.flush()
-    except BrokenPipeError:
-        _silence_stdout()
-        code = 141
+        signal.signal(signal.SIGINT, _on_sigint)
+    except ValueError:  # not the main thread: no handler to install
+        pass
+    try:
+        code = main()
+        try:
+            sys.stdout.flush()
+        except BrokenPipeError:
+            _silence_stdout()
+            code = 141
+    except Exception:
+        if not _SIGINT:
+            raise
+        code = _interrupted()
+    except KeyboardInterrupt:
+        code = _interrupted()
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:
+        pass
+    if _SIGINT:  # (a normal end flushed stdout above)
+        try:
+            sys.stdout.flush()
+        except (BrokenPipeError, ValueError):
+            _silence_stdout()
     sys.stderr.flush()
-    if "ompl" in sys.modules and "--verbose" not in sys.argv and "-v" not in sys.argv:
+    if _SIGINT or ("ompl" in sys.modules and "--verbose" not in sys.argv and "-v" not in sys.argv):
+        output = sys.modules.get("planners.output")
+        if output is not None:  # what os._exit skips: the atexit removal of our temporaries
+            output.clean_stale()
         os._exit(code)
     sys.exit(code)
+
+
+def _interrupted() -> int:
+    sys.stderr.write("interrupted\n")
+    return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -88,7 +88,7 @@ def generate(kind: str, seed: int = 0, size: int | None = None, ratio: float = 1
     from .. import progress as pg
 
     make = {"random": _random, "maze": _maze, "narrow": _narrow, "disks": _disks, "office": _office}[kind]
-    bar = pg.progress(None, f"generate {kind}", enabled=progress, delay=pg.DELAY, unit="node", tick=1.0)
+    bar = pg.progress(None, f"generate {kind}", enabled=progress, delay=pg.DELAY, tick=pg.TICK)
     failures: dict = {}
     with bar:
         for attempt in range(ATTEMPTS):

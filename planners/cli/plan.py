@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 import time
 
-from ..adapters.glue import OMPL_HINT, ompl_available
+from ..adapters.glue import OMPL_HINT
 from ..output import PLOT_FORMATS, check_distinct, check_output, write_json
 
 
@@ -28,15 +28,21 @@ def register(sub) -> None:
                                                          "reeds-shepp); default: the scenario's")
     p.add_argument("--plot", help="save a picture of the path (.png, .svg or .pdf)")
     p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
+    p.add_argument("--html", help="write one offline, interactive page of the plan (.html; needs plotly), "
+                                  "as `cspace view` does")
     p.add_argument("--json", help="write the result as JSON")
     p.add_argument("--csv", help="write the path's waypoints as CSV (x,y or x,y,theta, with a header)")
     p.add_argument("--proof", help="a rotating robot or a car proven to have no path: write the proof (JSON), "
                                    "which `cspace check-proof SCENARIO PROOF` re-checks independently")
     p.add_argument("--clearance", type=number, help="safety margin D: keep the robot at least D from every "
                                                      "obstacle (default: the scenario's clearance, else 0)")
-    p.add_argument("--objective", choices=("length", "clearance", "balanced"), default="length",
-                   help="what optimising planners (RRTstar, PRMstar, BITstar, ...) minimise: path length "
-                        "(default), the inverse of the minimum clearance, or length weighted by clearance")
+    from ..adapters.objectives import OBJECTIVE_PLANNERS, OBJECTIVES
+
+    takers = f"{', '.join(OBJECTIVE_PLANNERS[:-1])} or {OBJECTIVE_PLANNERS[-1]}"
+    p.add_argument("--objective", choices=OBJECTIVES, default="length",
+                   help="what the planner minimises: path length (default), the inverse of the minimum "
+                        "clearance, or length weighted by clearance; clearance and balanced only with "
+                        f"the planners {takers}, in space translation or se2")
     p.add_argument("--verbose", "-v", action="store_true", help="print the C-space report and OMPL's messages")
     from .imports import add_import_options
 
@@ -52,6 +58,14 @@ def add_space_options(p) -> None:
                         "of a minimum turning radius); default: the scenario's, else translation")
     p.add_argument("--slabs", type=integer, help="SE(2): angle slabs of the sliced C-space (default: derived "
                                                  "from the robot and the scene)")
+
+
+def ompl_available() -> bool:
+    """Whether OMPL can be imported (:func:`planners.adapters.glue.ompl_available`, which holds
+    Ctrl-C while OMPL's extension starts)."""
+    from ..adapters import glue
+
+    return glue.ompl_available()
 
 
 def number(s: str) -> float:
@@ -122,18 +136,25 @@ def run(args) -> int:
                 if getattr(options, key) is None and _pose(first.get(key)) is not None:
                     setattr(options, key, _pose(first.get(key)))
                     from_queries.add(key)
-    inputs = [src] + ([args.queries] if args.queries is not None else [])
+    from .imports import input_files
+
+    inputs = input_files(src, args.robot, args.queries)  # every file read, the import's included
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=inputs) if args.plot is not None else None
     if args.animate is not None:
         check_output(args.animate, "--animate", {".gif": "gif"}, inputs=inputs)
+    if args.html is not None:
+        check_output(args.html, "--html", {".html": "html", ".htm": "html"}, inputs=inputs)
+        from ..pictures.view import check_plotly
+
+        check_plotly(args.html, "--html")
     if args.json is not None:
         check_output(args.json, "--json", inputs=inputs)
     if args.csv is not None:
         check_output(args.csv, "--csv", inputs=inputs)
     if args.proof is not None:
         check_output(args.proof, "--proof", inputs=inputs)
-    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.csv, "--csv"),
-                    (args.proof, "--proof")])
+    check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
+                    (args.csv, "--csv"), (args.proof, "--proof")])
     from ..core.plan import plan
 
     if args.verbose and args.planner != "exact":
@@ -187,12 +208,7 @@ def run(args) -> int:
     if args.json is not None:
         write_json(args.json, res.as_dict(), "--json")
     if args.csv is not None:
-        from ..output import write_csv
-
-        if res.solved:
-            write_csv(args.csv, res.path, res.path.shape[1] if res.path.ndim == 2 else 2)
-        else:
-            sys.stderr.write(f"note: --csv {args.csv}: no path to write (not solved)\n")
+        write_paths_csv(args.csv, res)
     if args.plot is not None:
         from ..pictures.plot import plot_result
 
@@ -203,10 +219,35 @@ def run(args) -> int:
         animate_path(res, args.animate)
     elif args.animate:
         sys.stderr.write(f"note: --animate {args.animate}: nothing to animate (not solved)\n")
+    if args.html is not None:
+        from ..pictures.view import write_view
+
+        write_view(res, args.html)
     results = res.queries or [res]
     if args.proof is not None:
         write_proof(args.proof, results)
     return 0 if all(r.solved for r in results) else 1
+
+
+def write_paths_csv(path: str, res) -> None:
+    """``--csv``: the path's waypoints; with several queries (``--all-queries``, ``--queries``)
+    every solved query's, with a ``query`` column (a note names the unsolved ones)."""
+    from ..output import queries_csv, write_csv, write_text
+
+    dim = res.path.shape[1] if res.path.ndim == 2 else 2
+    if not res.queries:
+        if res.solved:
+            write_csv(path, res.path, dim)
+        else:
+            sys.stderr.write(f"note: --csv {path}: no path to write (not solved)\n")
+        return
+    solved = [(i, r.path) for i, r in enumerate(res.queries) if r.solved]
+    missing = [str(i) for i, r in enumerate(res.queries) if not r.solved]
+    if solved:
+        dim = solved[0][1].shape[1] if solved[0][1].ndim == 2 else 2
+        write_text(path, queries_csv(solved, dim), "--csv")
+    if missing:
+        sys.stderr.write(f"note: --csv {path}: no path for query {', '.join(missing)} (not solved)\n")
 
 
 def _pose(value):

@@ -16,8 +16,9 @@ def register(sub) -> None:
     from .imports import add_import_options
 
     add_import_options(p)
-    p.add_argument("--theta", type=number, default=0.0,
-                   help="SE(2): draw the C-space of the angle slab that holds this angle (radians, default 0)")
+    p.add_argument("--theta", type=number,
+                   help="a rotating robot or a car (--space se2, dubins or reeds-shepp): draw the C-space of "
+                        "the angle slab that holds this angle (radians, default 0)")
     p.add_argument("--clearance", type=number, help="safety margin D: the C-obstacles of the robot inflated by "
                                                      "the disk of radius D (default: the scenario's)")
     p.add_argument("--verbose", "-v", action="store_true")
@@ -35,10 +36,13 @@ def run(args) -> int:
 
         if fault := clearance_fault(args.clearance):
             raise InputError(args.scenario, "--clearance", fault)
+    from .imports import input_files
+
     check_input(args.scenario)
-    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=[args.scenario]) if args.plot is not None else None
+    inputs = input_files(args.scenario, args.robot)  # a map's image, a cfg's meshes, the robot file too
+    fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=inputs) if args.plot is not None else None
     if args.json is not None:
-        check_output(args.json, "--json", inputs=[args.scenario])
+        check_output(args.json, "--json", inputs=inputs)
     check_distinct([(args.json, "--json"), (args.plot, "--plot")])
     from cspace.spaces.cspace import CSpace
 
@@ -51,6 +55,10 @@ def run(args) -> int:
         sc = dataclasses.replace(sc, clearance=float(args.clearance))
     if sc.rotates:
         return _show_se2(sc, args, fmt)
+    for value, option in ((args.theta, "--theta"), (args.slabs, "--slabs")):
+        if value is not None:  # a translation scene has one C-space: the option would be ignored
+            raise InputError(args.scenario, option, f"applies to a rotating robot only: add --space se2 "
+                                                    f"(the scenario's space is {sc.space!r})")
     cs = CSpace.from_scenario(sc)
     rep = cs.report()
     margin = f" (with a margin: clearance {sc.clearance:g})" if sc.margins() else ""
@@ -81,6 +89,8 @@ def _show_se2(sc, args, fmt) -> int:
 
     from ..errors import InputError
 
+    if args.theta is None:
+        args.theta = 0.0
     if not math.isfinite(args.theta):
         raise InputError(args.scenario, "--theta", f"must be a finite angle in radians, got {args.theta}")
     if args.slabs is not None and not 4 <= args.slabs <= 4096:

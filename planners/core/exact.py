@@ -34,9 +34,12 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
     from .. import progress as pg
 
     t = time.perf_counter()
-    with pg.progress(None, "exact search", enabled=progress, unit="node", delay=pg.DELAY, tick=1.0) as bar:
+    # The free space, its reflex vertices and its mesh come first (no steps, possibly seconds):
+    # the bar names that stage, then the A* search's settled nodes once they come.
+    with pg.progress(None, "exact search: building the free space", enabled=progress, unit="node",
+                     delay=pg.DELAY, tick=pg.TICK) as bar:
         sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit,
-                                on_progress=pg.search_reporter(bar) if bar.shown else None)
+                                on_progress=pg.search_reporter(bar, "exact search: A*") if bar.shown else None)
     dt = time.perf_counter() - t
     d = getattr(sc, "clearance", 0.0)
     if sp.solved and d > 0:

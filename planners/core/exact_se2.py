@@ -29,6 +29,10 @@ from .result import PlanResult
 QUICK_SHARE = 0.1   # of the time limit, at most, for the proof before sampling
 QUICK_MAX = 1.0     # seconds, at most, whatever the limit
 CAR_SLABS = 128     # the finest partition a car's proof-only search tries
+# The proof before sampling refines the first 8 slabs once, where the POSSIBLE graph still joins
+# start and goal (16 slabs at most): ~2-3x the 8 slabs' cost (~20 ms on the bundled scenes, the
+# regions kept for the next query), and it proves a corner a long robot cannot turn.
+QUICK_WIDTH = 2 * math.pi / 16
 _REGIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> its SlabRegions
 
 
@@ -95,9 +99,13 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
                                   f"slab graph's POSSIBLE regions separate start and goal; {graph})",
                           proof=res.proof, **base)
     if car:
+        from ..adapters.glue import ompl_available
+
+        then = ("use a sampling planner such as RRTConnect" if ompl_available() else
+                "a car's path needs OMPL's sampling planners (not installed)")
         raise ScenarioError(source, "planner", f"a car (space = \"{sc.space}\") cannot turn in place, so exact answers "
                                                f"it only with a proof that no path exists, and the slab graph found "
-                                               f"none ({graph}): use a sampling planner such as RRTConnect")
+                                               f"none ({graph}): {then}")
     if res.status == "undecided":
         why = st.get("error") or st.get("reason", "")
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
@@ -149,11 +157,11 @@ def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:
 
 
 def quick_proof(sc, cspace, query, time_limit: float) -> PlanResult | None:
-    """Before a sampling planner spends its budget: the POSSIBLE graph at the first slabs, within
-    a small share of the time limit. A result (not solved, proven unsolvable) when it separates
+    """Before a sampling planner spends its budget: the POSSIBLE graph at the first slabs, refined
+    once (:data:`QUICK_WIDTH`), within a small share of the time limit. A result (not solved, proven unsolvable) when it separates
     start and goal, else None (the planner runs)."""
     budget = min(QUICK_SHARE * time_limit, QUICK_MAX)
-    res = search(cspace, query, budget, possible_only=True, refine=False)
+    res = search(cspace, query, budget, possible_only=True, min_width=QUICK_WIDTH)
     if res.status != "unsolvable":
         return None
     return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,

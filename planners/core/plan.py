@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 
 import numpy as np
 
@@ -79,7 +80,8 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
-    (defaults: RRTConnect, 1 s, seed 0). ``iterations`` adds a deterministic budget
+    (defaults: RRTConnect, 1 s, seed 0; without OMPL, a call that names no planner plans
+    with ``exact`` and warns, as ``cspace plan`` does). ``iterations`` adds a deterministic budget
     in planner iterations. With ``all_queries`` every ``[[queries]]`` entry is
     planned on the same C-space (and, for PRM-family planners, the same roadmap),
     each query with its own seeded random stream; the result then carries
@@ -91,13 +93,15 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     the path's rows are (x, y, theta), the C-space is the sliced
     :class:`cspace.spaces.se2.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
     derived from the scene) and every motion is certified along OMPL's SE(2)
-    interpolation. There is no exact planner in SE(2); ``planner="exact"`` there
-    answers only when the inscribed-disk rule proves the scene unsolvable.
+    interpolation. ``planner="exact"`` there searches the slab graph
+    (:mod:`planners.core.exact_se2`): a certified path, a proof that none exists, or the
+    resolution it reached.
 
     ``space="dubins"`` or ``"reeds-shepp"`` (with ``turning_radius``, or the file's
     ``turning_radius``) plans a car: the same poses and C-space, but every motion is the
     shortest Dubins (forward only) or Reeds–Shepp (forward and reverse) curve, certified
-    segment by segment; ``PlanResult.curves`` holds each motion's segments.
+    segment by segment; ``PlanResult.curves`` holds each motion's segments. ``exact``
+    answers a car only with a proof that no path exists.
 
     ``clearance=D`` (over the file's ``clearance``) inflates the robot by a polygon
     containing the disk of radius D (:mod:`cspace.kernel.margin`): every path then keeps the
@@ -111,6 +115,13 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
     (True, [1.0, 1.0], [9.0, 9.0])
     """
+    if planner is None:
+        from ..adapters.glue import OMPL_HINT, ompl_available
+
+        if not ompl_available():  # as `cspace plan` does: the exact planner, and a note
+            warnings.warn(f"OMPL is not installed: planning with the exact planner instead ({OMPL_HINT})",
+                          stacklevel=2)
+            planner = "exact"
     sc, name, tlim, sd, load_s = _resolve(scenario, planner, time, seed, iterations, space, turning_radius)
     sc = _with_clearance(sc, clearance)
     try:
@@ -152,7 +163,13 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
                        if sc.clearance > 0 else " with the margin" if sc.margin is not None else "")
                 raise ScenarioError(src, label, f"{pt} is not a free state of the C-space{why}")
         poses.append(pair)
-    if name == "exact" and se2:
+    # A rotating robot: the load, the decomposition and the slabs built so far (the start and
+    # goal checks build the slabs of a small scene) count against the time limit.
+    built_s = load_s + (_now() - wall0) if se2 else 0.0
+    tlim -= built_s
+    if tlim <= 0:
+        results = [_out_of_time(sc, name, sd, q, built_s) for q in queries]
+    elif name == "exact" and se2:
         from .exact_se2 import exact_se2
 
         results = [exact_se2(sc, cspace, adapter, q, src, time_limit=tlim, simplify=simplify) for q in queries]
@@ -198,6 +215,14 @@ def _now() -> float:
     return time.perf_counter()
 
 
+def _out_of_time(sc: Scenario, name: str, seed: int, q, spent: float) -> PlanResult:
+    """A query not planned: loading the scene and building its C-space used the whole time limit."""
+    return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,
+                      planner=name, seed=seed, timings={"setup": 0.0, "solve": 0.0, "simplify": 0.0, "verify": 0.0},
+                      checks={"states": 0, "motions": 0}, stages=[], start=tuple(q.start), goal=tuple(q.goal),
+                      message=f"not solved within the time limit (C-space build took {spent:.3g} s)")
+
+
 def _with_clearance(sc: Scenario, clearance) -> Scenario:
     """The scenario with the margin D of ``plan(clearance=D)`` (the file's when None)."""
     if clearance is None:
@@ -225,13 +250,17 @@ def _check_margin(sc: Scenario, cspace) -> None:
 
 def _measure_clearance(r: PlanResult, adapter) -> None:
     """Fill a solved result's min_clearance (timed as ``clearance``) and ``touches``."""
-    measure = getattr(adapter, "path_clearance", None)  # a car's curves: not measured (yet)
+    measure = getattr(adapter, "path_clearance", None)
     if not r.solved or not len(r.path) or measure is None:
         return
     t = _now()
     c = measure(r.path)
     r.timings["clearance"] = _now() - t
     r.min_clearance, r.min_clearance_bound = float(c.distance), c.bound
+    if c.bound == "lower" and r.clearance > r.min_clearance:
+        # every motion was certified free for the robot grown by a polygon holding the disk of
+        # radius D: D itself is a certified lower bound, tighter than a loose measurement
+        r.min_clearance = float(r.clearance)
     r.min_clearance_at = tuple(c.where) or None
     r.min_clearance_obstacle = tuple(c.obstacle_point) or None
     r.touches = c.distance == 0.0 and c.bound == "exact"
@@ -249,7 +278,10 @@ def build_cspace(sc: Scenario, slabs: int | None = None):
     if sc.rotates:
         from cspace.spaces.se2 import SE2CSpace
 
-        return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)
+        try:
+            return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)
+        except ValueError as exc:  # a robot the slabs cannot take (too many vertices with the margin)
+            raise ScenarioError(sc.path or "<scenario>", "robot", str(exc).removeprefix("robot: ")) from None
     return CSpace.from_scenario(sc)
 
 

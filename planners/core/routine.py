@@ -133,7 +133,7 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
     simp_s = _now() - t2 if found and simplify else 0.0
     path = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
     t3 = _now()
-    ok, message = space.verify(path, start, goal) if found else (False, failure_message(status, space))
+    ok, message = space.verify(path, start, goal) if found else (False, failure_message(status, space, objective))
     if found and not ok:
         message = f"OMPL's path failed the exact check ({message}): not solved"
     verify_s = _now() - t3
@@ -233,7 +233,7 @@ def _solve(ss, space, key, time_limit, iterations, slices, on_progress):
     return first, progress
 
 
-def failure_message(status, space=None) -> str:
+def failure_message(status, space=None, objective: str = "length") -> str:
     """Why a sampling planner did not solve, in plain words (OMPL's status explained).
 
     >>> failure_message("Timeout")
@@ -245,7 +245,9 @@ def failure_message(status, space=None) -> str:
                "comes near the goal, it does not reach it)")
     else:
         msg = f"no path found within the budget (OMPL: {text})"
-    hint = getattr(space, "unsolved_hint", None)
+    from ..adapters.objectives import unsolved_hint
+
+    hint = unsolved_hint(objective, getattr(space, "unsolved_hint", None))
     return msg + (f"; {hint}" if hint else "")
 
 

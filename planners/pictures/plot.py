@@ -169,7 +169,6 @@ def draw_closest(ax, scenario, res) -> list[str]:
     if not res.solved or not res.min_clearance_obstacle or not res.min_clearance_at:
         return []
     from cspace.kernel.gjk import gjk_distance
-    from cspace.kernel.slab import rotate
 
     pose = tuple(res.min_clearance_at) + (0.0,) * (3 - len(res.min_clearance_at))
     x, y, th = pose[:3]
@@ -178,16 +177,12 @@ def draw_closest(ax, scenario, res) -> list[str]:
     near = min((gjk_distance(p, ob[None, :]) for p in parts), key=lambda d: d.distance).point_a
     keys = ["closest"]
     draw_robot(ax, scenario, x, y, th, color=CLOSEST, alpha=0.8, fill=False)
-    margins = scenario.margins()
-    if margins:
-        from cspace.kernel.minkowski import minkowski_sum
+    from .grown import grown_robot
 
-        body = [s.polygon for s in scenario.robot] or [np.zeros((1, 2))]
-        for part in body:
-            ops = [rotate(m, th) if th else m for m in margins]
-            inflated = minkowski_sum(rotate(part, th) if th else part, *ops) + (x, y)
-            ax.add_patch(poly_patch(inflated, facecolor="none", edgecolor=CLOSEST, linewidth=0.9, ls="--"))
-        keys.append("margin")
+    grown = grown_robot(scenario, x, y, th)  # non-convex robots too: the union of the pieces' sums
+    for shell, holes in grown:
+        ax.add_patch(poly_patch(shell, holes, facecolor="none", edgecolor=CLOSEST, linewidth=0.9, ls="--"))
+    keys += ["margin"] if grown else []
     ax.plot([near[0], ob[0]], [near[1], ob[1]], ":", color=CLOSEST, linewidth=1.2)
     ax.plot([ob[0]], [ob[1]], "*", color=CLOSEST, markersize=11, markeredgecolor="black", markeredgewidth=0.4)
     word = "≥" if res.min_clearance_bound == "lower" else "="
