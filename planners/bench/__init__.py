@@ -7,8 +7,12 @@ the exact shortest path (or, in SE(2), a lower bound on it).
 - :mod:`~planners.bench.pool`: forked children (one per run) and fresh processes where fork
   is missing;
 - :mod:`~planners.bench.sweep`: the sweep over the tasks (local or on Dask) and its summary;
+- :mod:`~planners.bench.cluster`: ``--scheduler``, batches of runs on a Dask cluster;
 - :mod:`~planners.bench.outputs`: results.csv, results.json, OMPL's benchmark logs;
 - :mod:`~planners.bench.clearance`: the ``--objective`` checks and the summary's clearance cell.
+- :mod:`~planners.bench.campaign`: ``--db``/``--resume``, each run stored as it finishes, in
+  :mod:`~planners.bench.arena_db`'s database (Planner Arena's schema);
+  :mod:`~planners.bench.ompl_log`: ``--log``, OMPL's benchmark logs from that database.
 
 The figure is :mod:`planners.pictures.bench_figure`; the command line :mod:`planners.cli.bench`.
 The names below load on first use (PEP 562).

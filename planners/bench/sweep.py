@@ -2,7 +2,8 @@
 in its own process (a planner that segfaults or hangs costs one row, recorded as
 ``crashed`` or ``timeout``, never the sweep): locally a forked child of this process,
 which built each scenario's C-space once (:mod:`planners.bench.pool`, at most ``--workers``
-at a time), a fresh process where fork is missing, or on a Dask cluster (``--scheduler``).
+at a time), a fresh process where fork is missing, or on a Dask cluster (``--scheduler``,
+in batches: :mod:`planners.bench.cluster`).
 Each run is :func:`planners.bench.rows.run_one`, which calls :func:`planners.core.plan.plan`
 as ``cspace plan`` does.
 
@@ -13,7 +14,6 @@ their first solution are).
 """
 from __future__ import annotations
 
-from ..errors import InputError
 from ..pictures.bench_figure import curves
 from ..progress import BenchBar
 from .rows import complete_row, hard_limit, live_children, stop_event
@@ -29,13 +29,17 @@ def isolated_run(task: dict, limit: float | None = None) -> dict | None:
 # ---------------------------------------------------------------- the sweep
 
 def sweep(tasks: list[dict], workers: int = 1, scheduler: str | None = None,
-          progress: bool = False, held: dict | None = None) -> tuple[list[dict], bool]:
+          progress: bool = False, held: dict | None = None, on_row=None,
+          on_batch=None) -> tuple[list[dict], bool]:
     """Run every task; returns ``(rows sorted in task order, interrupted)``.
 
     With ``held`` (file -> (scenario, cspace), from :func:`reference`) and ``os.fork``,
     runs are forked children of this process (:mod:`planners.bench.pool`); otherwise
     (or on a Dask cluster) each run is a fresh process. Ctrl-C stops the sweep:
-    running children are killed, finished rows are kept.
+    running children are killed, finished rows are kept. ``on_row(row)``, if given, gets each
+    finished row as it arrives (``cspace bench --db`` stores it then). On a cluster
+    (``scheduler``: an address or a ``distributed.Client``, :mod:`planners.bench.cluster`) runs
+    go in batches, and ``on_batch(rows)``, if given, gets each finished batch's rows instead.
     """
     from ..children import CAN_FORK
     from .pool import run_forked
@@ -45,21 +49,24 @@ def sweep(tasks: list[dict], workers: int = 1, scheduler: str | None = None,
     bar = BenchBar(len(tasks), progress)
     interrupted = False
 
-    def on_row(task, row, wall):
+    hook = on_row or (lambda row: None)
+
+    def on_forked(task, row, wall):
         rows.append(complete_row(task, row, wall))
         bar.step(rows[-1])
+        hook(rows[-1])
 
     try:
         if scheduler:
-            _sweep_dask(tasks, scheduler, rows, bar)
+            _sweep_dask(tasks, scheduler, rows, bar, hook, on_batch)
         elif held is not None and CAN_FORK and all(t["file"] in held for t in tasks):
             from ..adapters.glue import ompl
             from ..core import plan  # noqa: F401  (imported once, before forking)
 
             ompl()
-            run_forked(tasks, held, workers, lambda t: hard_limit(t["time_budget"]), on_row)
+            run_forked(tasks, held, workers, lambda t: hard_limit(t["time_budget"]), on_forked)
         else:
-            _sweep_local(tasks, workers, rows, bar)
+            _sweep_local(tasks, workers, rows, bar, hook)
     except KeyboardInterrupt:
         interrupted = True
         stop_event.set()
@@ -72,7 +79,7 @@ def sweep(tasks: list[dict], workers: int = 1, scheduler: str | None = None,
     return rows, interrupted
 
 
-def _sweep_local(tasks, workers, rows, bar) -> None:
+def _sweep_local(tasks, workers, rows, bar, hook) -> None:
     from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
     pool = ThreadPoolExecutor(max_workers=workers)
@@ -86,31 +93,25 @@ def _sweep_local(tasks, workers, rows, bar) -> None:
                 if row is not None:
                     rows.append(row)
                     bar.step(row)
+                    hook(row)
     finally:
         pool.shutdown(wait=False, cancel_futures=True)
 
 
-def _sweep_dask(tasks, scheduler, rows, bar) -> None:
-    try:
-        from distributed import Client, as_completed
-    except ImportError:
-        raise InputError("bench", "--scheduler", "needs dask[distributed] (pip install 'cspace[cluster]')") from None
-    try:
-        client = Client(scheduler, timeout="10s")
-    except OSError as exc:
-        raise InputError("bench", "--scheduler", f"cannot connect to {scheduler}: {exc}") from None
-    futures = client.map(isolated_run, tasks, pure=False)
-    try:
-        for fut in as_completed(futures):
-            row = fut.result()
-            if row is not None:
-                rows.append(row)
-                bar.step(row)
-    except KeyboardInterrupt:
-        client.cancel(futures)
-        raise
-    finally:
-        client.close()
+def _sweep_dask(tasks, scheduler, rows, bar, hook, on_batch) -> None:
+    from .cluster import sweep_on_cluster
+
+    def got(batch):
+        rows.extend(batch)
+        for row in batch:
+            bar.step(row)
+        if on_batch is not None:
+            on_batch(batch)
+        else:
+            for row in batch:
+                hook(row)
+
+    sweep_on_cluster(tasks, scheduler, got)
 
 
 # ---------------------------------------------------------------- statistics
@@ -142,11 +143,31 @@ def summary(rows: list[dict], scenarios: list[dict] | None = None) -> str:
                          + (f" {'+0.0000' if s['upper'] is not None else '-':>9}" if upper else "")
                          + f"  ({s['exact_s']:.3g} s: {s['exact_message']})")
     if bounded:
-        lines.append("<= : SE(2) scenes have no exact optimum: length / (inscribed-disk lower bound) - 1, an upper "
-                     "bound on the error")
+        lines.append(f"<= : {space_names(bounded, scenarios)} scenes have no exact optimum: length / (inscribed-disk "
+                     "lower bound) - 1, an upper bound on the error")
     if lower:
-        lines.append(">= : an SE(2) path's min clearance is a certified lower bound")
+        lines.append(f">= : the min clearance of {space_names(lower, scenarios)} paths is a certified lower bound")
     if upper:
         lines.append("vs exact: length / (the exact planner's certified path length) - 1; that path is an upper bound "
                      "on the optimum")
     return "\n".join(lines)
+
+
+SPACE_NAMES = {"se2": "SE(2)", "dubins": "Dubins car", "reeds-shepp": "Reeds-Shepp car"}
+
+
+def space_names(scens: set, scenarios: list[dict] | None) -> str:
+    """The spaces of these scenarios in words (from :func:`reference`'s ``scenarios``).
+
+    >>> space_names({"a"}, [{"scenario": "a", "space": "dubins"}])
+    'Dubins car'
+    >>> space_names({"a", "b"}, [{"scenario": "a", "space": "se2"}, {"scenario": "b", "space": "reeds-shepp"}])
+    'SE(2) and Reeds-Shepp car'
+    >>> space_names({"a"}, None)
+    'rotating-robot or car'
+    """
+    spaces = {s.get("space") for s in scenarios or [] if s["scenario"] in scens}
+    names = [SPACE_NAMES[k] for k in SPACE_NAMES if k in spaces]
+    if not names or len(spaces) != len(names):
+        return "rotating-robot or car"
+    return " and ".join(names) if len(names) < 3 else ", ".join(names[:-1]) + " and " + names[-1]

@@ -8,7 +8,7 @@ import time
 
 from ..adapters.objectives import OBJECTIVES
 from ..bench.clearance import check_planners, check_scenarios, default_planners
-from ..bench.outputs import clear_outputs, write_deferring_sigint
+from ..bench.outputs import OUTPUTS, clear_outputs, write_deferring_sigint
 from ..bench.reference import make_tasks, reference
 from ..bench.rows import HARD_FACTOR, HARD_MARGIN
 from ..bench.sweep import summary, sweep
@@ -40,11 +40,16 @@ def register(sub) -> None:
     p.add_argument("--iterations", type=int, help="also stop each run after this many planner iterations")
     p.add_argument("--workers", type=int, default=1, help="runs in parallel (local processes)")
     p.add_argument("--out", default="bench_out", help="output folder (created if missing)")
-    p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on")
+    p.add_argument("--scheduler", help="address of a Dask distributed scheduler to run on (tcp://HOST:8786): "
+                                       "runs go in batches, each worker builds a scenario's C-space once")
     p.add_argument("--objective", choices=OBJECTIVES, default="length",
                    help="what the optimising planners (RRTstar, SORRTstar, BITstar) optimise: path length "
                         "(default), the minimum clearance, or length weighted by clearance")
     p.add_argument("--no-plot", action="store_true", help="skip error_vs_time.png")
+    p.add_argument("--db", help="benchmark database (SQLite, Planner Arena's schema): each finished run is "
+                                "stored as it arrives; created if missing")
+    p.add_argument("--resume", action="store_true", help="with --db: skip the runs the database already holds")
+    p.add_argument("--log", metavar="DIR", help="write OMPL benchmark logs (one per experiment) into DIR")
     from ..cli.plan import add_space_options
 
     add_space_options(p)
@@ -102,8 +107,44 @@ def parse_times(text: str, source: str = "bench") -> list[float]:
     return sorted(out)
 
 
+def check_inputs_kept(files: list[str], out: str) -> None:
+    """Refuse a sweep that would write or clear one of its inputs (a scenario, a map's image,
+    a cfg's mesh): results.json, results.csv, error_vs_time.png and ompl/*.log in ``out``."""
+    from ..output import check_not_input
+    from .imports import input_files
+
+    inputs = [f for src in files for f in input_files(src)]
+    targets = [os.path.join(out, name) for name in OUTPUTS]
+    logs = os.path.join(out, "ompl")
+    if os.path.isdir(logs):
+        targets += [os.path.join(logs, name) for name in sorted(os.listdir(logs)) if name.endswith(".log")]
+    for target in targets:
+        try:
+            st = os.stat(target)
+        except (OSError, ValueError):
+            st = None
+        check_not_input(target, "--out", inputs, st)
+
+
+def check_campaign(db: str | None, log: str | None, resume: bool, out: str) -> None:
+    """--db, --log and --resume: exit 2 on a combination or a path that cannot work."""
+    from ..output import check_folder
+
+    if resume and not db:
+        raise InputError("bench", "--resume", "needs --db (the database of the sweep to resume)")
+    if db is not None:
+        if not db.strip() or os.path.isdir(db):
+            raise InputError("bench", "--db", f"not a file name: {db!r}")
+        parent = os.path.dirname(os.path.abspath(db))
+        if not os.path.isdir(parent):
+            raise InputError("bench", "--db", f"folder {parent} does not exist")
+    if log is not None:
+        check_folder(log, "--log")
+
+
 def run(args) -> int:
-    from ..adapters.glue import OMPL_HINT, ompl_available
+    from ..adapters.glue import OMPL_HINT
+    from .plan import ompl_available  # (Ctrl-C held while OMPL loads)
 
     objective = getattr(args, "objective", "length")
     planners = parse_planners(args.planners or ",".join(default_planners(objective, DEFAULT_PLANNERS)))
@@ -126,16 +167,33 @@ def run(args) -> int:
     from ..output import check_folder
 
     check_folder(out, "--out")
+    check_inputs_kept(args.scenario, out)
     held: dict = {}
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
+    db, log = getattr(args, "db", None), getattr(args, "log", None)
+    check_campaign(db, log, getattr(args, "resume", False), out)
     scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
     check_scenarios(objective, held)
     os.makedirs(out, exist_ok=True)
     tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on, objective)
+    campaign = None
+    if db or log:
+        from ..bench.campaign import Campaign
+
+        campaign = Campaign(db, tasks)
+        n = len(tasks)
+        tasks = campaign.select(tasks, getattr(args, "resume", False))
+        if not args.quiet and len(tasks) < n:
+            sys.stderr.write(f"--resume: {n - len(tasks)} of {n} runs already in {db}\n")
     t0 = time.perf_counter()
-    rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
-                              held=held)
+    try:
+        rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
+                                  held=held, on_row=campaign.on_row if campaign else None,
+                                  on_batch=campaign.add if campaign else None)
+    finally:
+        if campaign is not None:
+            campaign.finish(log)
     meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
             "iterations": args.iterations, "objective": objective, "workers": args.workers, "scheduler": args.scheduler,
             "wall_s": time.perf_counter() - t0, "complete": not interrupted,

@@ -1,0 +1,177 @@
+"""``cspace bench --scheduler ADDRESS``: the sweep on a Dask distributed cluster.
+
+Dask's scheduler costs about a millisecond per task, more than a short planning run's share,
+so runs travel in batches (:func:`batches`): runs of one scenario, grouped until their summed
+budgets reach :data:`BATCH_SECONDS`. A worker runs a batch with :func:`run_batch`: it loads the
+scenario and builds its C-space once per worker process (a module-level cache keyed by the
+scenario file's SHA-256, space and slab count), then forks a child per run as the local sweep
+does (:func:`planners.bench.pool.run_forked`: a planner that crashes or hangs costs one row, not
+the worker). The client (:func:`sweep_on_cluster`) takes batches as they finish
+(``as_completed``) and hands each one's rows on at once (``cspace bench --db`` stores a batch in
+one transaction).
+
+A worker that dies mid-batch (killed, out of memory, a lost machine) loses its batch; the
+scheduler runs it again on another worker (and ``retries`` covers a batch that raised). A batch
+gives one result, so a row reaches the client once; the client also drops a row it already
+has, and the database refuses a run it already holds, so a retried batch never doubles a row.
+
+Every worker reads the scenario files at the path the client gave (a shared folder, or the
+same checkout on every machine); a worker that finds another file there refuses the batch.
+"""
+from __future__ import annotations
+
+import os
+
+from ..errors import InputError
+
+BATCH_SECONDS = 0.1  # summed time budget of one batch (at least)
+
+
+RETRIES = 2  # a batch that raised (not a run that crashed: that is a row) is run again this often
+
+
+_held: dict[tuple, tuple] = {}  # in a worker process: (sha256, space, slabs) -> (scenario, cspace)
+
+
+_builds = [0]  # C-spaces this process built (the cache's test: never more than it holds)
+
+
+def batches(tasks: list[dict], seconds: float = BATCH_SECONDS) -> list[list[dict]]:
+    """Runs of one scenario (file, space, slabs), in task order, grouped until their summed budgets
+    reach ``seconds`` (the last batch of a scenario may be shorter).
+
+    >>> ts = [{"file": f, "space": None, "slabs": None, "time_budget": b} for f in "ab" for b in (0.03, 0.05, 0.1)]
+    >>> [[(t["file"], t["time_budget"]) for t in b] for b in batches(ts)]
+    [[('a', 0.03), ('a', 0.05), ('a', 0.1)], [('b', 0.03), ('b', 0.05), ('b', 0.1)]]
+    >>> [len(b) for b in batches(ts, 0.05)]
+    [2, 1, 2, 1]
+    """
+    groups: dict[tuple, list[list[dict]]] = {}
+    for t in tasks:
+        runs = groups.setdefault((t["file"], t.get("space"), t.get("slabs")), [[]])
+        if sum(float(x["time_budget"]) for x in runs[-1]) >= seconds:
+            runs.append([])
+        runs[-1].append(t)
+    return [b for runs in groups.values() for b in runs if b]
+
+
+def held_scenario(file: str, sha: str, space: str | None, slabs: int | None) -> tuple:
+    """``(scenario, cspace)`` of a scenario file, built once per process (the worker's cache)."""
+    key = (sha, space, slabs)
+    if key not in _held:
+        from cspace.io.scenario import load_scenario
+
+        from ..core.plan import build_cspace, plan
+        from .arena_db import file_hash
+
+        try:
+            found = file_hash(file)
+        except OSError as exc:
+            raise RuntimeError(f"worker on {os.uname().nodename}: cannot read {file}: {exc}") from None
+        if found != sha:
+            raise RuntimeError(f"worker on {os.uname().nodename}: {file} is not the client's file "
+                               "(different content)")
+        sc = load_scenario(file, space=space)
+        # As :func:`planners.bench.reference.reference` leaves it: the slabs built, and the exact
+        # planner run once, which fills the C-space's lazy parts (its clearance measure...) here,
+        # not in every forked run (whose work is lost when it exits).
+        if sc.rotates:
+            cs = build_cspace(sc, slabs)
+            for k in range(cs.slabs):
+                cs.slab(k)
+            if sc.space == "se2":
+                plan(sc, planner="exact", cspace=cs)
+        else:
+            cs = plan(sc, planner="exact").cspace
+        _held[key] = (sc, cs)
+        _builds[0] += 1
+    return _held[key]
+
+
+def clear_held() -> int:
+    """Forget this process's C-spaces (benchmarks start each repeat cold); returns how many."""
+    n = len(_held)
+    _held.clear()
+    _builds[0] = 0
+    return n
+
+
+def held_stats() -> tuple[int, int]:
+    """``(C-spaces held, C-spaces built)`` in this process since it started or was cleared."""
+    return len(_held), _builds[0]
+
+
+def run_batch(batch: list[dict], sha: str) -> list[dict]:
+    """On a worker: every run of one batch (one scenario), each in a forked child; the full rows."""
+    from ..children import CAN_FORK
+    from .pool import isolated_run, run_forked
+    from .rows import complete_row, hard_limit
+
+    t = batch[0]
+    if not CAN_FORK:  # a fresh process per run (no C-space to share)
+        return [isolated_run(task) for task in batch]
+    from ..adapters.glue import ompl
+    from ..core import plan  # noqa: F401  (imported once, before forking)
+
+    ompl()
+    sc_cs = held_scenario(t["file"], sha, t.get("space"), t.get("slabs"))
+    rows: list[dict] = []
+    run_forked(batch, {t["file"]: sc_cs}, 1, lambda task: hard_limit(task["time_budget"]),
+               lambda task, row, wall: rows.append(complete_row(task, row, wall)))
+    return rows
+
+
+def connect(scheduler: str):
+    """A Dask client of the scheduler at this address (exit 2 if dask or the scheduler is missing)."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise InputError("bench", "--scheduler", "needs dask[distributed] (pip install 'cspace[cluster]')") from None
+    try:
+        return Client(scheduler, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise InputError("bench", "--scheduler", f"cannot connect to {scheduler}: {exc}") from None
+
+
+def sweep_on_cluster(tasks: list[dict], scheduler, on_batch, seconds: float = BATCH_SECONDS) -> None:
+    """Run ``tasks`` on the cluster; ``on_batch(rows)`` gets each finished batch's rows (each run once).
+
+    ``scheduler``: an address, or a connected ``distributed.Client`` (left open).
+    KeyboardInterrupt cancels the batches not finished and propagates.
+    """
+    from distributed import as_completed
+
+    from .arena_db import file_hash
+
+    shas: dict[str, str] = {}
+    for t in tasks:
+        if t["file"] not in shas:
+            try:
+                shas[t["file"]] = file_hash(t["file"])
+            except OSError as exc:
+                raise InputError(t["file"], "scenario", f"cannot read: {exc}") from None
+    client = connect(scheduler) if isinstance(scheduler, str) else scheduler
+    futures = as_completed(loop=client.loop)
+    seen: set = set()
+    try:
+        futures.update([client.submit(run_batch, b, shas[b[0]["file"]], pure=False, retries=RETRIES)
+                        for b in batches(tasks, seconds)])
+        for fut in futures:
+            try:
+                got = fut.result()
+            except Exception as exc:  # a batch that failed on every try (a worker lacks the file...)
+                raise InputError("bench", "--scheduler", f"a batch failed on the cluster: {exc}") from None
+            fut.release()  # the worker may drop it (lost with a worker later, it is not run again)
+            fresh = []
+            for row in filter(None, got):
+                key = (row["file"], row["planner"], float(row["time_budget"]), int(row["seed"]))
+                if key not in seen:
+                    seen.add(key)
+                    fresh.append(row)
+            on_batch(fresh)
+    except BaseException:
+        client.cancel(list(futures.futures))
+        raise
+    finally:
+        if isinstance(scheduler, str):
+            client.close()
