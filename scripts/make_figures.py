@@ -10,7 +10,15 @@ Each figure is a plan with a fixed seed (``cspace plan --plot``), a C-space pict
 :mod:`planners.pictures.bench_figure` from the sweep's results.json), or the stability chart. PNGs
 are written atomically (temporary file, then rename; :mod:`planners.pictures.plot` does it for
 the pictures it draws), so an interrupted run never leaves a half-written picture.
-``--only`` takes figure names or group names (see ``--list``). The whole set takes
+``--only`` takes figure names or group names (see ``--list``); positional names do the same
+(``python scripts/make_figures.py basic_plan maze_cspace``).
+
+Deterministic output: the pictures of :mod:`planners.pictures.plot` are saved here at their own
+figure size and a fixed dpi, without ``bbox_inches="tight"`` (which sized each PNG by its title's
+and legend's text, so a changed label changed the PNG's pixel size); every plan has a fixed seed.
+Each such PNG records its legend entries in its metadata (the PNG text key ``Legend``, one
+label a line: :func:`legend_labels` reads it back), so tests/test_docs_drift.py can compare a fresh
+drawing with the committed one. The whole set takes
 well under two minutes on a laptop core; the acceptance sweep behind
 ``error_vs_time.png`` takes about ten and runs only when named (``--only acceptance``).
 """
@@ -30,6 +38,8 @@ SCENARIOS = os.path.join(ROOT, "scenarios")
 # One picture per scenario family (plan and C-space), with the seed each plan uses.
 FAMILIES = ("maze", "bug_trap", "narrow_passage", "random_polygons", "disks", "office", "combs", "parts", "theta")
 SEED = 1
+DPI = 130  # the pictures of planners.pictures.plot (the bench, slab and stability charts keep their own 110)
+LEGEND_KEY = "Legend"  # PNG text key holding the legend entries, one a line
 
 
 @dataclass
@@ -40,6 +50,83 @@ class Figure:
     group: str
     what: str
     draw: Callable[[str], str]  # output path -> one-line summary
+
+
+def figure_legend(fig) -> list[str]:
+    """The legend entries of a matplotlib Figure (figure legends, then each axis's), in order."""
+    labels = []
+    for leg in list(fig.legends) + [ax.get_legend() for ax in fig.axes]:
+        if leg is not None:
+            labels += [t.get_text() for t in leg.get_texts()]
+    return labels
+
+
+def save_fixed(fig, out: str, fmt: str | None = None) -> None:
+    """Write ``fig`` atomically at its own size and :data:`DPI` (no tight bounding box, so the
+    pixel size never depends on the text drawn), its legend entries in the PNG metadata; close it."""
+    from planners.output import atomic_path
+    from planners.pictures.plot import mpl
+
+    plt = mpl()[0]
+    fmt = fmt or os.path.splitext(out)[1].lstrip(".").lower() or "png"
+    fig.tight_layout()
+    _fit_inside(fig)
+    meta = {LEGEND_KEY: "\n".join(figure_legend(fig))} if fmt == "png" else None
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=DPI, metadata=meta)
+    plt.close(fig)
+
+
+def _fit_inside(fig, margin: float = 0.04) -> None:
+    """Shrink the subplot area until everything drawn (labels, legend, a zoom inset beside the
+    axis) lies inside the fixed canvas: tight_layout alone may leave an inset's overhang out."""
+    W, H = fig.get_size_inches()
+    for _ in range(4):
+        bb = fig.get_tightbbox(fig.canvas.get_renderer())
+        over = (max(0.0, margin - bb.x0) / W, max(0.0, bb.x1 - W + margin) / W,
+                max(0.0, margin - bb.y0) / H, max(0.0, bb.y1 - H + margin) / H)
+        if not any(over):
+            return
+        sp = fig.subplotpars
+        left, bottom = min(sp.left + over[0], 0.4), min(sp.bottom + over[2], 0.4)
+        right, top = max(sp.right - over[1], left + 0.2), max(sp.top - over[3], bottom + 0.2)
+        if (left, right, bottom, top) == (sp.left, sp.right, sp.bottom, sp.top):
+            return  # cannot fit (a title wider than the page): leave it as it is
+        fig.subplots_adjust(left=left, right=right, bottom=bottom, top=top)
+
+
+class fixed_size_saves:
+    """While active, :mod:`planners.pictures.plot` saves through :func:`save_fixed` (its
+    ``plot_result``/``plot_scene`` and the CLI's ``--plot`` look ``save`` up at call time)."""
+
+    def __enter__(self):
+        import planners.pictures.plot as plot
+
+        self._plot, self._saved = plot, plot.save
+        plot.save = save_fixed
+        return self
+
+    def __exit__(self, *exc):
+        self._plot.save = self._saved
+        return False
+
+
+def legend_labels(png: str) -> list[str] | None:
+    """The legend entries recorded in a PNG by :func:`save_fixed` (None when it has none recorded)."""
+    from PIL import Image
+
+    with Image.open(png) as im:
+        text = im.info.get(LEGEND_KEY)
+    return None if text is None else (text.split("\n") if text else [])
+
+
+def png_size(png: str) -> tuple[int, int]:
+    """(width, height) in pixels of a PNG, read from its header."""
+    import struct
+
+    with open(png, "rb") as fh:
+        head = fh.read(24)
+    return struct.unpack(">II", head[16:24])
 
 
 def _scenario(name: str) -> str:
@@ -211,7 +298,7 @@ ACCEPTANCE_ARGS = ["scenarios/basic.toml", "scenarios/maze.toml", "scenarios/nar
                    "scenarios/bug_trap.toml", "--runs", "10", "--workers", "2", "--quiet", "--no-plot"]
 
 
-LONG_GROUPS = ("acceptance",)
+LONG_GROUPS = ("acceptance", "view", "arena")  # view: needs chromium and plotly; arena: chromium and plannerarena
 
 
 def figures() -> list[Figure]:
@@ -249,7 +336,33 @@ def figures() -> list[Figure]:
     out.append(Figure("error_vs_time", "acceptance", "cspace bench: the acceptance sweep (4 scenarios, 4 planners)",
                       bench_figure(ACCEPTANCE_ARGS)))
     out.append(Figure("stability", "stability", "stability catalogue", stability_figure))
+    out.append(Figure("view_bar_door", "view", "cspace view: bar_door's offline page in headless Chromium", view_figure))
+    out.append(Figure("planner_arena", "arena", "Planner Arena on a cspace bench --db database, in headless Chromium",
+                      arena_figure))
     return out
+
+
+def view_figure(out: str) -> str:
+    """scripts/make_view_screenshots.py's screenshot of bar_door's ``cspace view`` page."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_view_screenshots",
+                                                  os.path.join(ROOT, "scripts", "make_view_screenshots.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mod.bar_door_screenshot(out)
+    return "the page drawn by headless Chromium, the bar half way through the door"
+
+
+def arena_figure(out: str) -> str:
+    """scripts/make_arena_screenshot.py's screenshot of Planner Arena showing a small sweep's database."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_arena_screenshot",
+                                                  os.path.join(ROOT, "scripts", "make_arena_screenshot.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.arena_screenshot(out)
 
 
 def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
@@ -266,13 +379,22 @@ def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
     return [f for f in all_figs if f.name in keys or f.group in keys]
 
 
+def draw_figure(fig: Figure, path: str) -> str:
+    """Draw one figure to ``path`` at its fixed size; returns its one-line summary."""
+    with fixed_size_saves():
+        return fig.draw(path)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "figures"), help="folder for the PNGs")
     ap.add_argument("--only", help="comma-separated figure names or groups (basic, families, se2, maps, circles, bench, "
                                    "stability; acceptance, the long sweep, only when named)")
     ap.add_argument("--list", action="store_true", help="list the figures and exit")
+    ap.add_argument("names", nargs="*", help="figure names or groups (as --only)")
     args = ap.parse_args(argv)
+    if args.names:
+        args.only = ",".join(filter(None, [args.only, *args.names]))
     figs = select(figures(), args.only)
     if args.list:
         for f in figs if args.only else figures():
@@ -283,8 +405,9 @@ def main(argv: list[str] | None = None) -> int:
     for f in figs:
         path = os.path.join(args.out, f"{f.name}.png")
         t = time.perf_counter()
-        note = f.draw(path)
-        print(f"{path}: {f.what}; {note} ({time.perf_counter() - t:.1f} s)", flush=True)
+        note = draw_figure(f, path)
+        w, h = png_size(path)
+        print(f"{path}: {f.what}; {note} ({w}x{h} px, {time.perf_counter() - t:.1f} s)", flush=True)
     print(f"{len(figs)} figures in {time.perf_counter() - t_all:.1f} s")
     return 0
 
