@@ -107,6 +107,7 @@ RUN_PROPS = (
     ("first solution time", "REAL", lambda r: _num(r.get("first_solution_s"))),
     ("state checks", "INTEGER", lambda r: r.get("state_checks")),
     ("motion checks", "INTEGER", lambda r: r.get("motion_checks")),
+    ("graph states", "INTEGER", lambda r: r.get("graph_states")),
     ("seed", "INTEGER", lambda r: int(r["seed"])),
     ("wall time", "REAL", lambda r: _num(r.get("wall_s"))),
 )

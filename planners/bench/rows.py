@@ -25,6 +25,7 @@ FIELDS = (
     "length", "length_unsimplified", "optimum", "reference", "error", "error_unsimplified",
     "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks",
     "wall_s", "message", "min_clearance", "min_clearance_bound", "clearance_s", "upper", "error_upper",
+    "graph_states",
 )
 
 
@@ -73,7 +74,8 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
         "upper": task.get("upper"), "error_upper": _error(length, task.get("upper")),
         "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings["solve"],
         "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
-        "motion_checks": int(res.checks["motions"]), "wall_s": None,
+        "motion_checks": int(res.checks["motions"]), "graph_states": res.checks.get("graph_states"),
+        "wall_s": None,
         "message": res.message, "progress": res.progress,
         # Measured by plan() on the solved path after its solve (None: unsolved, or a car).
         "min_clearance": res.min_clearance, "min_clearance_bound": res.min_clearance_bound,

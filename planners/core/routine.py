@@ -138,18 +138,34 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
         message = f"OMPL's path failed the exact check ({message}): not solved"
     verify_s = _now() - t3
     c1 = space.counts()
+    checks = {"states": c1[0] - c0[0], "motions": c1[1] - c0[1]}
+    if slices:  # the bench's run: the planner's graph size, as OMPL's benchmark records it
+        checks["graph_states"] = graph_states(ss)
     if ok and key in ANYTIME and iterations is None and solve_s >= 0.9 * time_limit:
         message += " (anytime planner: ran to its time limit)"
     return PlanResult(
         scenario=scenario, solved=ok, exact=ok, path=path if ok else np.zeros((0, space.dim)),
         length=space.length(path) if ok else math.inf, planner=name, seed=seed,
         timings={"setup": setup_s, "solve": solve_s, "simplify": simp_s, "verify": verify_s},
-        checks={"states": c1[0] - c0[0], "motions": c1[1] - c0[1]},
+        checks=checks,
         stages=["setup", "solve"] + (["simplify"] if found and simplify else []) + ["verify"],
         start=tuple(start), goal=tuple(goal), message=message,
         length_unsimplified=space.length(raw) if ok else None,
         first_solution=first if ok else None, progress=progress,
     )
+
+
+def graph_states(ss) -> int | None:
+    """The number of vertices in the planner's graph (OMPL's "graph states"), or None where
+    the planner cannot say."""
+    from ..adapters.glue import ompl
+
+    try:
+        data = ompl()[0].PlannerData(ss.getSpaceInformation())
+        ss.getPlannerData(data)
+        return int(data.numVertices())
+    except Exception:  # a planner without planner data: not known
+        return None
 
 
 class _Interrupt:
