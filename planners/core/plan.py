@@ -190,8 +190,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         if se2:
             for r, t in zip(results, spent):
                 r.timings = {"proof": t, **r.timings}
-        if se2:
-            _explain_se2_failures(sc, queries, results)
+        # (No inscribed-disk rule after a failure: the proof before sampling is at least as strong,
+        # since every POSSIBLE region lies in the disk's free space, and the rule's C-space build,
+        # seconds on a large map, would run past --time.)
         if hasattr(adapter, "curves"):
             for r in results:
                 r.curves = adapter.curves(r.path) if r.solved else []
@@ -318,19 +319,6 @@ def _proofs_before_sampling(sc: Scenario, cspace, queries, tlim: float, name: st
         out.append(r)
         spent.append(_now() - t)
     return out, spent
-
-
-def _explain_se2_failures(sc: Scenario, queries, results) -> None:
-    """A rotating robot's plan that failed: does the inscribed-disk rule prove it unsolvable?"""
-    from .bounds import disk_bound
-
-    for q, r in zip(queries, results):
-        if not r.solved and r.proof is None:  # a proof from the slab graph says more already
-            t = _now()
-            db = disk_bound(sc, q, time_limit=5.0)
-            r.timings["disk_bound"] = _now() - t
-            if db.proven_unsolvable:
-                r.message = db.message
 
 
 def run_planner(*args, **kwargs):
