@@ -12,26 +12,11 @@ import pytest
 
 from conftest import ROOT
 
+import test_cli  # noqa: E402  (its scenario text)
+
 BASIC = os.path.join(ROOT, "scenarios", "basic.toml")
 
-TWO_QUERIES = """
-name = "two"
-[bounds]
-xmin = 0
-xmax = 10
-ymin = 0
-ymax = 10
-[robot]
-polygon = [[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]]
-[[obstacles]]
-polygon = [[4, 0], [6, 0], [6, 7], [4, 7]]
-[start]
-x = 1
-y = 1
-[goal]
-x = 9
-y = 1
-[[queries]]
+TWO_QUERIES = test_cli.BASIC.replace('name = "cli"', 'name = "two"') + """[[queries]]
 start = [1, 9]
 goal = [9, 9]
 """
