@@ -20,9 +20,9 @@ from __future__ import annotations
 import importlib
 
 _NAMES = {"plan": ".core.plan", "PlanResult": ".core.result", "path_length": ".adapters.frame",
-          "shortest_path": ".core.plan"}
+          "shortest_path": ".core.plan", "write_view": ".pictures.view"}
 
-__all__ = ["plan", "shortest_path", "PlanResult", "path_length"]
+__all__ = ["plan", "shortest_path", "PlanResult", "path_length", "write_view"]
 
 
 def __getattr__(name: str):
