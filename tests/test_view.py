@@ -107,6 +107,24 @@ def test_car_curves_and_reverse(results):
     assert len(fwd["x"]) > 10 * len(res.path)
 
 
+def test_the_narrowest_gap_is_marked_only_where_a_path_crosses_one():
+    """A door 1.001 times the robot: marked with the static plot's width, which equals the
+    distance between the two C-obstacles (shapely); open space (clearance.toml): no mark."""
+    import shapely
+
+    from planners.pictures.plot import narrow_gap
+
+    res = planners.plan(os.path.join(SCENARIOS, "narrow_passage.toml"))
+    marks = [t for t in figure_dict(res)["data"] if t.get("name", "").startswith("narrowest gap")]
+    gap = narrow_gap(res.scenario_data, res.cspace, [res])
+    assert len(marks) == 1 and gap is not None and marks[0]["name"] == f"narrowest gap, {gap.width:.3g} wide"
+    walls = [shapely.Polygon(p) for p in res.cspace.pieces]
+    a, b = shapely.Point(gap.ends[0]), shapely.Point(gap.ends[1])
+    assert min(w.distance(a) for w in walls) < 1e-9 and min(w.distance(b) for w in walls) < 1e-9
+    open_space = planners.plan(os.path.join(SCENARIOS, "clearance.toml"))
+    assert not [t for t in figure_dict(open_space)["data"] if t.get("name", "").startswith("narrowest gap")]
+
+
 def test_point_robot_has_no_angle_slider(tmp_path):
     res = planners.plan(os.path.join(SCENARIOS, "ompl", "empty.toml"), space="se2", planner="RRTConnect", time=1)
     fig = figure_dict(res, angles=32)

@@ -218,3 +218,30 @@ def _nearest_crossings(F, a: np.ndarray, b: np.ndarray, p: np.ndarray, n: np.nda
         t_minus[k[~up & ~down]] = np.nan
         t_plus[k[~up & ~down]] = np.nan
     return t_minus, t_plus
+
+
+GAP_FRACTION = 0.01  # a gap is shown when narrower than this share of the scene's larger side
+
+
+def narrowest_gap_of_paths(pieces: list, bounds, paths: list, fraction: float = GAP_FRACTION) -> Gap | None:
+    """The narrowest gap across any of ``paths`` narrower than ``fraction`` of the scene's larger
+    side, else None (what the pictures zoom on and the offline page marks). 400 samples in all.
+
+    >>> walls = [np.array([[4., 0], [6, 0], [6, 4.99], [4, 4.99]]),
+    ...          np.array([[4., 5.01], [6, 5.01], [6, 10], [4, 10]])]
+    >>> round(narrowest_gap_of_paths(walls, (0, 10, 0, 10), [np.array([[1., 5], [9, 5]])]).width, 12)
+    0.02
+    >>> narrowest_gap_of_paths(walls, (0, 10, 0, 10), [np.array([[1., 5], [9, 5]])], fraction=0.001) is None
+    True
+    """
+    from .shortest import free_space
+
+    paths = [p for p in paths if len(p) > 1]
+    if not paths:
+        return None
+    xmin, xmax, ymin, ymax = bounds
+    below = fraction * max(xmax - xmin, ymax - ymin)
+    free = free_space(pieces, bounds)
+    samples = max(16, 400 // len(paths))  # 400 in all: many queries are each sampled less
+    gaps = [narrowest_gap(pieces, bounds, p, samples=samples, free=free, below=below) for p in paths]
+    return min((g for g in gaps if g is not None), key=lambda g: g.width, default=None)

@@ -29,7 +29,7 @@ GAP = "#7b2cbf"
 CLOSEST = "#e67e00"  # the closest approach: orange, apart from every other colour
 
 # A passage narrower than this fraction of the scene's size gets an inset zoom.
-GAP_FRACTION = 0.01
+from cspace.spaces.gap import GAP_FRACTION  # noqa: E402  (the pictures' threshold)
 
 
 def mpl():
@@ -299,19 +299,14 @@ def _new_figure(sc, wide: bool = False):
 # ---------------------------------------------------------------- narrow passages
 
 def narrow_gap(sc, cspace, results: list):
-    """The narrowest gap along the solved paths when under :data:`GAP_FRACTION` of the scene, else None."""
-    from cspace.spaces.gap import narrowest_gap
-    from cspace.spaces.shortest import free_space
+    """The narrowest gap along the solved paths when under :data:`GAP_FRACTION` of the scene, else None
+    (:func:`cspace.spaces.gap.narrowest_gap_of_paths`)."""
+    from cspace.spaces.gap import narrowest_gap_of_paths
 
-    paths = [r.path for r in results if r.solved and len(r.path) > 1]
-    if not paths or cspace is None:
+    if cspace is None:
         return None
-    xmin, xmax, ymin, ymax = sc.bounds
-    below = GAP_FRACTION * max(xmax - xmin, ymax - ymin)
-    free = free_space(cspace.pieces, cspace.bounds)
-    samples = max(16, 400 // len(paths))  # 400 in all: many queries are each sampled less
-    gaps = [narrowest_gap(cspace.pieces, cspace.bounds, p, samples=samples, free=free, below=below) for p in paths]
-    return min((g for g in gaps if g is not None), key=lambda g: g.width, default=None)
+    return narrowest_gap_of_paths(cspace.pieces, cspace.bounds, [r.path for r in results if r.solved],
+                                  GAP_FRACTION)
 
 
 def draw_inset(ax, sc, cspace, results: list, gap) -> object:

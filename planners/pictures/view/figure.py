@@ -39,13 +39,14 @@ def figure_dict(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DE
         data += first
         frames += slab_frames
         sliders += [slider] if slider else []
-    elif not sc.is_point_robot:
+    else:
         cs = res.cspace
         if cs is None:
             from cspace.spaces.cspace import CSpace
 
             cs = CSpace.from_scenario(sc)
-        data.append(tr.cobstacle_trace(cs.pieces, nd))
+        if not sc.is_point_robot:
+            data.append(tr.cobstacle_trace(cs.pieces, nd))
     data.append(tr.obstacle_trace(sc, nd))
     dense = None
     if res.solved and len(res.path):
@@ -53,6 +54,11 @@ def figure_dict(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DE
         data += lines
     data += tr.start_goal_traces(sc, res, nd)
     data += tr.closest_traces(sc, res, nd)
+    if not sc.rotates:  # a passage narrower than 1 % of the scene, crossed by a path (as the plot's zoom)
+        from cspace.spaces.gap import narrowest_gap_of_paths
+
+        data += tr.gap_traces(narrowest_gap_of_paths(cs.pieces, cs.bounds,
+                                                     [r.path for r in (res.queries or [res]) if r.solved]), nd)
     if dense is not None:
         moving = len(data)
         along = pick_poses(sc, res, dense, poses)

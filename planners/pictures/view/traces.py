@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from ..plot import BOUNDS, CLOSEST, COBSTACLE, GOAL, OBSTACLE, PATH, PIECE_EDGE, REVERSE, ROBOT
+from ..plot import GAP as GAP_COLOUR
 
 GAP = np.full((1, 2), np.nan)  # between two rings of one trace
 PROOF = "#4c9f70"  # the free components a proof lists (slab_pair.py's FREE colour)
@@ -250,3 +251,20 @@ def proof_trace(rings, nd: int) -> dict:
     """
     return filled("proof: the slab's POSSIBLE components (free at some angle, perhaps)", rings, PROOF, nd,
                   opacity=0.4, line="#1d4d33")
+
+
+def gap_traces(gap, nd: int) -> list[dict]:
+    """The narrowest gap the path crosses (:func:`cspace.spaces.gap.narrowest_gap_of_paths`), as a
+    segment from wall to wall, its width in the legend; none without such a gap.
+
+    >>> gap_traces(None, 3)
+    []
+    """
+    if gap is None:
+        return []
+    label = f"narrowest gap, {gap.width:.3g} wide"
+    x, y = line_xy([np.asarray(gap.ends[0], dtype=np.float64), np.asarray(gap.ends[1], dtype=np.float64)], nd)
+    return [{"type": "scatter", "mode": "lines+markers", "name": label, "x": x, "y": y,
+             "line": {"color": GAP_COLOUR, "width": 2},
+             "marker": {"symbol": "line-ns-open", "size": 10, "color": GAP_COLOUR},
+             "hovertext": [label, label], "hoverinfo": "text"}]
