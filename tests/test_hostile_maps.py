@@ -116,7 +116,9 @@ def test_a_noisy_map_within_the_limits_imports_exactly(tmp_path, capsys):
     assert filled > 1000 and shapely.get_num_interior_rings(shapely.get_parts(union)).sum() > 1000
     assert union.area == oracle.area == blocked.sum()
     assert shapely.symmetric_difference(union, oracle).area == 0.0
-    assert union.covers(squares(occupied, res))
+    # every occupied cell inside (by area: GEOS 3.13's covers, shapely 2.1's, misjudges these huge
+    # multipolygons that share edges exactly; the set equality above is already exact)
+    assert shapely.difference(squares(occupied, res), union).area == 0.0
     # The default tolerance: fewer vertices, every occupied cell still inside, within the tolerance.
     code, err, out = run_import(capsys, tmp_path, y, "--start", f"{start[0]},{start[1]}",
                                 "--goal", f"{goal[0]},{goal[1]}")
