@@ -101,12 +101,17 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize("argv,inputs", CASES, ids=lambda v: " ".join(v) if isinstance(v, list) else None)
-@pytest.mark.parametrize("option", list(OUTPUTS))
-def test_plan_never_writes_over_an_input(work, capsys, argv, inputs, option):
+def refused_every_way(work, capsys, argv, option, inputs):
+    """Each input, named as ``option``'s output in every spelling, is refused and left as it was."""
     for target in inputs:
         for out in spellings(work, target, OUTPUTS[option], free=option in FREE):
             refused(work, capsys, argv, option, out, target)
+
+
+@pytest.mark.parametrize("argv,inputs", CASES, ids=lambda v: " ".join(v) if isinstance(v, list) else None)
+@pytest.mark.parametrize("option", list(OUTPUTS))
+def test_plan_never_writes_over_an_input(work, capsys, argv, inputs, option):
+    refused_every_way(work, capsys, argv, option, inputs)
 
 
 @pytest.mark.parametrize("argv,inputs", [
@@ -116,9 +121,7 @@ def test_plan_never_writes_over_an_input(work, capsys, argv, inputs, option):
 ])
 @pytest.mark.parametrize("option", ["--plot", "--json"])
 def test_show_never_writes_over_an_input(work, capsys, argv, inputs, option):
-    for target in inputs:
-        for out in spellings(work, target, OUTPUTS[option], free=option in FREE):
-            refused(work, capsys, argv, option, out, target)
+    refused_every_way(work, capsys, argv, option, inputs)
 
 
 @pytest.mark.parametrize("argv,inputs", [
