@@ -144,7 +144,7 @@ def check_campaign(db: str | None, log: str | None, resume: bool, out: str) -> N
 
 def run(args) -> int:
     from ..adapters.glue import OMPL_HINT
-    from .plan import ompl_available  # (Ctrl-C held while OMPL loads)
+    from ..adapters.glue import ompl_available  # (Ctrl-C held while OMPL loads)
 
     objective = getattr(args, "objective", "length")
     planners = parse_planners(args.planners or ",".join(default_planners(objective, DEFAULT_PLANNERS)))

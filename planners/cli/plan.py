@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 import time
 
-from ..adapters.glue import OMPL_HINT
+from ..adapters.glue import OMPL_HINT, ompl_available
 from ..output import PLOT_FORMATS, check_distinct, check_output, write_json
 
 
@@ -58,14 +58,6 @@ def add_space_options(p) -> None:
                         "of a minimum turning radius); default: the scenario's, else translation")
     p.add_argument("--slabs", type=integer, help="SE(2): angle slabs of the sliced C-space (default: derived "
                                                  "from the robot and the scene)")
-
-
-def ompl_available() -> bool:
-    """Whether OMPL can be imported (:func:`planners.adapters.glue.ompl_available`, which holds
-    Ctrl-C while OMPL's extension starts)."""
-    from ..adapters import glue
-
-    return glue.ompl_available()
 
 
 def number(s: str) -> float:
