@@ -61,8 +61,8 @@ def held_scenario(file: str, sha: str, space: str | None, slabs: int | None) -> 
     if key not in _held:
         from cspace.io.scenario import load_scenario
 
-        from ..core.plan import build_cspace, plan
         from .arena_db import file_hash
+        from .reference import warmed
 
         try:
             found = file_hash(file)
@@ -72,17 +72,7 @@ def held_scenario(file: str, sha: str, space: str | None, slabs: int | None) -> 
             raise RuntimeError(f"worker on {os.uname().nodename}: {file} is not the client's file "
                                "(different content)")
         sc = load_scenario(file, space=space)
-        # As :func:`planners.bench.reference.reference` leaves it: the slabs built, and the exact
-        # planner run once, which fills the C-space's lazy parts (its clearance measure...) here,
-        # not in every forked run (whose work is lost when it exits).
-        if sc.rotates:
-            cs = build_cspace(sc, slabs)
-            for k in range(cs.slabs):
-                cs.slab(k)
-            if sc.space == "se2":
-                plan(sc, planner="exact", cspace=cs)
-        else:
-            cs = plan(sc, planner="exact").cspace
+        cs, _ = warmed(sc, slabs)  # as reference() leaves it
         _held[key] = (sc, cs)
         _builds[0] += 1
     return _held[key]

@@ -17,13 +17,29 @@ import sys
 from ..errors import InputError
 
 
+def warmed(sc, slabs: int | None = None) -> tuple:
+    """``(cspace, exact result or None)``: a scenario's C-space as the runs use it, its lazy parts
+    filled once here rather than in every forked run (whose work is lost when it exits). A
+    rotating robot: every slab built and, in SE(2), the exact planner run on it (None for a car,
+    which cannot follow its turns in place); translation: the exact planner's C-space and result."""
+    from ..core.plan import build_cspace, plan
+
+    if sc.rotates:
+        cs = build_cspace(sc, slabs)
+        for k in range(cs.slabs):
+            cs.slab(k)
+        return cs, (plan(sc, planner="exact", cspace=cs) if sc.space == "se2" else None)
+    res = plan(sc, planner="exact")
+    return res.cspace, res
+
+
 def reference(files: list[str], quiet: bool = True, held: dict | None = None, space: str | None = None,
               slabs: int | None = None) -> list[dict]:
     """Load each scenario and compute its reference length once.
 
     Returns ``[{"file", "scenario", "optimum", "reference", "space", "slabs"}]``.
     Translation: ``optimum`` is the exact shortest path's length (``reference`` is
-    ``"optimum"``; None if no path exists). SE(2) has no exact planner: ``optimum`` is
+    ``"optimum"``; None if no path exists). SE(2) has no exact optimum: ``optimum`` is
     the inscribed-disk lower bound on the reference point's path length
     (:mod:`planners.core.bounds`; ``reference`` is ``"lower_bound"``), so a row's
     ``error = length / lower bound - 1`` is an upper bound on its true error.
@@ -34,37 +50,30 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
     """
     from cspace.io.scenario import load_scenario
 
-    from ..core.plan import build_cspace, plan
-
     out = []
     for f in files:
         full = os.path.abspath(f)
         if any(o["file"] == full for o in out):
             raise InputError(f, "scenario", "given twice")
         sc = load_scenario(f, space=space)
+        cs, ex = warmed(sc, slabs)
         if sc.rotates:  # SE(2) or a car: the inscribed disk gives a lower bound on the length
             from ..core.bounds import disk_bound
 
-            cs = build_cspace(sc, slabs)
-            for k in range(cs.slabs):  # built once here, not lazily in every forked run
-                cs.slab(k)
             db = disk_bound(sc, sc.all_queries()[0])
             bound = db.lower_bound if math.isfinite(db.lower_bound) else None
             entry = {"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
                      "space": sc.space, "slabs": cs.slabs, "upper": None}
             note = db.message  # "lower bound L (inscribed disk r = ...)", or why there is none
-            if sc.space == "se2":  # a car cannot follow the exact planner's turns in place
-                ex = plan(sc, planner="exact", cspace=cs)
+            if ex is not None:  # SE(2); a car cannot follow the exact planner's turns in place
                 entry.update(upper=float(ex.length) if ex.solved else None, exact_s=ex.timings.get("solve"),
                              exact_total_s=ex.timings.get("total"), exact_message=ex.message)
                 note += f"; exact: {ex.message}"
             out.append(entry)
         else:
-            res = plan(sc, planner="exact")
-            cs = res.cspace
-            out.append({"file": full, "scenario": sc.name, "optimum": float(res.length) if res.solved else None,
+            out.append({"file": full, "scenario": sc.name, "optimum": float(ex.length) if ex.solved else None,
                         "reference": "optimum", "space": "translation", "slabs": None})
-            note = f"exact shortest path {res.length:.6g} ({res.message})"
+            note = f"exact shortest path {ex.length:.6g} ({ex.message})"
         if held is not None:
             held[full] = (sc, cs)
         if not quiet:
