@@ -190,3 +190,37 @@ def test_verbose_reports_the_sliced_cspace(capsys):
     assert main(["plan", DOOR, "-v", "--time", "30"]) == 0
     out = capsys.readouterr().out
     assert "slabs (" in out and "slabs built in" in out and "checks: {" in out
+
+
+def test_first_path_cpu_counts_from_the_call_to_the_first_path():
+    # exact: up to its certified, re-verified path (before OMPL's shortening); RRTConnect: up to
+    # OMPL's first solution (after the proof before sampling); both inside the call's CPU time and
+    # past its C-space; none without a path, nor for an anytime planner whose first solution is
+    # not timed (no bench slices).
+    import time
+
+    sc = load_scenario(os.path.join(SCENARIOS, "se2", "bar_door.toml"))
+    for planner in ("exact", "RRTConnect"):
+        c = time.process_time()
+        r = planners.plan(sc, planner=planner, time=5, seed=1)
+        spent = time.process_time() - c
+        assert r.solved and 0.0 < r.first_path_cpu <= spent, (planner, r.first_path_cpu, spent)
+    r = planners.plan(sc, planner="RRTstar", time=0.3, seed=1)
+    assert r.solved and r.first_path_cpu is None
+    r = planners.plan(os.path.join(SCENARIOS, "se2", "wide_square.toml"), planner="RRTConnect", time=5)
+    assert not r.solved and r.first_path_cpu is None
+    r = planners.plan(os.path.join(SCENARIOS, "basic.toml"), planner="exact")
+    assert r.solved and r.first_path_cpu > 0.0
+
+
+def test_bench_se2_exact_runs_and_counts_from_the_call(tmp_path, capsys):
+    bench = load_script("bench_se2_exact")
+    out = tmp_path / "rows.json"
+    assert bench.main(["--seeds", "1", "--time", "2", "--scenes", "bar_door,wide_square", "--json", str(out)]) == 0
+    rows = {r["scene"]: r for r in json.loads(out.read_text())}
+    assert rows["bar_door"]["exact_answer"] == "solved" and rows["bar_door"]["solvable"]
+    assert 0 < rows["bar_door"]["exact_path_cpu_s"] <= rows["bar_door"]["exact_total_cpu_s"]
+    assert rows["wide_square"]["exact_answer"] == "proven unsolvable" and not rows["wide_square"]["solvable"]
+    assert rows["wide_square"]["exact_path_cpu_s"] == math.inf  # (JSON's Infinity)
+    text = capsys.readouterr().out
+    assert "time to a path from plan()'s start" in text and "/1 solvable scenes" in text

@@ -281,3 +281,24 @@ def test_proofs_pass_the_independent_checker(name):
     assert r.status == "unsolvable"
     verdict = checker.check_proof(sc, r.proof)
     assert verdict.valid, verdict
+
+
+
+def test_free_first_and_ends_joined_directly():
+    # An open scene solved at the first slabs: FREE alone answers (no POSSIBLE region is
+    # built), and ends free at every angle of their slab join it directly (no zero-width
+    # region at their angle): 8 FREE regions in all.
+    box = [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])]
+    bar = [np.array([[-0.5, -0.1], [0.5, -0.1], [0.5, 0.1], [-0.5, 0.1]])]
+    bounds = (0, 10, 0, 10)
+    r = exact_se2_search(box, bar, bounds, (1, 1, 0.1), (9, 9, 0.2))
+    assert r.status == "solved" and r.stats["refinements"] == 0
+    assert r.stats["regions_built"] == {"free_built": 8, "possible_built": 0, "links_built": 8}
+    assert swept_violations(r.path, [shapely.Polygon(box[0])], bar, bounds) == []
+    # The bar level at (3.495, 5), 0.005 from the box at its own angle, meets it at other angles
+    # of its slab [0, pi/4) (at atan(0.2) its far corners reach x = 3.495 + 0.26 ** 0.5 > 4): that
+    # end joins through the FREE at its own angle (one more region).
+    r = exact_se2_search(box, bar, bounds, (3.495, 5, 0.0), (9, 9, 0.2))
+    assert r.status == "solved" and r.stats["regions_built"]["free_built"] == 9
+    assert tuple(r.path[0]) == (3.495, 5.0, 0.0)
+    assert swept_violations(r.path, [shapely.Polygon(box[0])], bar, bounds) == []

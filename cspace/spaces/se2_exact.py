@@ -7,15 +7,19 @@ polygons with holes, and their connected components.
 
 - FREE graph: nodes (slab, component); components of adjacent slabs are linked when they
   overlap with an interior (the robot turns in place at a point deep inside the overlap,
-  through the shared boundary angle). The start pose joins through the FREE region at its
-  own angle (a zero-width slab): its component there is linked to the FREE components of
-  the slab(s) holding θs that overlap it; the goal likewise. A walk from start to goal is a
+  through the shared boundary angle). The start pose joins the FREE component of a slab
+  holding θs that contains its (x, y) (free at every angle of the slab); where none does,
+  it joins through the FREE region at its own angle (a zero-width slab): its component
+  there is linked to the FREE components of the slab(s) holding θs that overlap it. The
+  goal likewise. A walk from start to goal is a
   certified path: translations at a fixed angle (exact shortest paths inside one component)
   and rotations in place.
 - POSSIBLE graph: nodes (slab, component); components of adjacent slabs are linked when their
   closures meet (within a tolerance, toward more links); start and goal belong to every
   POSSIBLE component of their slab(s) whose closure is within the tolerance of their (x, y).
   If no walk joins them, no collision-free path exists at any resolution: the proof.
+- Each round builds FREE first and stops at its walk; POSSIBLE is built, and the proof
+  looked for, only when FREE does not join start and goal.
 - Otherwise slabs are bisected: those on a cheapest POSSIBLE walk from start to goal whose
   nodes or links FREE does not yet reproduce ("FREE breaks there"), else those anywhere in
   the start's POSSIBLE component where it breaks, else all. The search stops at ``min_width``
@@ -36,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kernel.slab import TWO_PI, slab_range, wrap_angle
-from .slab_graph import SlabRegions
+from .slab_graph import SlabRegions, point_free
 from .se2_exact_path import AssemblyError, assemble, holding
 
 PROOF_FORMAT = "cspace-se2-proof/1"
@@ -180,6 +184,24 @@ class _Search:
                 raise ValueError(f"exact_se2_search: the {name} pose {(x, y, t)} is not free")
         try:
             while True:
+                # FREE first: where its graph already joins start and goal (most solvable scenes, at
+                # the first slabs) the POSSIBLE regions are never built; they are built, and the
+                # proof looked for, only when it does not.
+                freg = None if self.possible_only else self._regions("free")
+                if freg is not None:
+                    t = time.perf_counter()
+                    fadj = self._free_graph(freg)
+                    walk = _shortest_walk(fadj, S_NODE, G_NODE, self.start[:2], self.goal[:2], self._turn_cost)
+                    self.times["graphs"] += time.perf_counter() - t
+                    if walk is not None:
+                        t = time.perf_counter()
+                        try:
+                            path = assemble(walk, self.part, freg, self.R, self.start, self.goal)
+                        except AssemblyError as exc:  # a certified walk whose exact re-check failed
+                            self.times["path"] += time.perf_counter() - t
+                            return self._result("undecided", error=str(exc))
+                        self.times["path"] += time.perf_counter() - t
+                        return self._result("solved", path=path)
                 preg = self._regions("possible")
                 t = time.perf_counter()
                 padj, s_p, g_p, p_edges = self._possible_graph(preg)
@@ -187,24 +209,10 @@ class _Search:
                 self.times["graphs"] += time.perf_counter() - t
                 if G_NODE not in reached:
                     return self._result("unsolvable", proof=self._proof(preg, s_p, g_p, p_edges))
-                if self.possible_only:
+                if freg is None:
                     if not self._split(self._wide()):
                         return self._result("undecided", reason="POSSIBLE graph only: no proof found")
                     continue
-                freg = self._regions("free")
-                t = time.perf_counter()
-                fadj = self._free_graph(freg)
-                walk = _shortest_walk(fadj, S_NODE, G_NODE, self.start[:2], self.goal[:2], self._turn_cost)
-                self.times["graphs"] += time.perf_counter() - t
-                if walk is not None:
-                    t = time.perf_counter()
-                    try:
-                        path = assemble(walk, self.part, freg, self.R, self.start, self.goal)
-                    except AssemblyError as exc:  # a certified walk whose exact re-check failed
-                        self.times["path"] += time.perf_counter() - t
-                        return self._result("undecided", error=str(exc))
-                    self.times["path"] += time.perf_counter() - t
-                    return self._result("solved", path=path)
                 t = time.perf_counter()
                 split = self._select(preg, freg, padj, fadj, reached)
                 self.times["graphs"] += time.perf_counter() - t
@@ -279,8 +287,21 @@ class _Search:
                 adj[(k, i)].append(((k2, j), pt))
                 adj[(k2, j)].append(((k, i), pt))
                 n_edges += 1
+        same = self.start[2] == self.goal[2]
         ends = {}
         for virtual, (x, y, th) in ((S_NODE, self.start), (G_NODE, self.goal)):
+            # An end whose (x, y) is free at every angle of a slab holding its angle joins that
+            # slab's component there, with the end itself as the link point (no translation at
+            # its own angle first): the FREE at its angle alone is built only when none holds it.
+            direct = [] if same else [(k, c) for k in holding(self.part, th)
+                                      for c in [self.R.containing(freg[k], x, y)]
+                                      if c is not None and point_free(freg[k].pieces, self.R.bounds, x, y)]
+            for k, c in direct:
+                adj[virtual].append(((k, c), (x, y)))
+                adj[(k, c)].append((virtual, (x, y)))
+                n_edges += 1
+            if direct:
+                continue
             zero = self.R.free_at(th)
             c0 = self.R.containing(zero, x, y)
             ends[virtual] = c0
@@ -292,12 +313,11 @@ class _Search:
                         adj[virtual].append(((k, j), pt))
                         adj[(k, j)].append((virtual, pt))
                         n_edges += 1
-        if self.start[2] == self.goal[2] and ends[S_NODE] is not None and ends[S_NODE] == ends[G_NODE]:
+        if same and ends[S_NODE] is not None and ends[S_NODE] == ends[G_NODE]:
             adj[S_NODE].append((G_NODE, None))  # one translation at the common angle
         for n in adj:
             adj[n].sort(key=lambda e: e[0])
         self.graph_sizes["free"] = {"nodes": len(adj) - 2, "edges": n_edges}
-        self._free_ends = ends
         return adj
 
     def _turn_cost(self, n, m) -> float:

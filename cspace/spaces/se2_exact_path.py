@@ -92,7 +92,8 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
         return np.array(poses, dtype=np.float64)
     K = len(part)
     m = len(nodes) - 1
-    _translate(poses, regions.free_at(ts).pieces, bounds, (xs, ys), pts[0], ts)
+    if tuple(pts[0]) != (xs, ys):  # (an end joined its slab directly: nothing to translate at its angle)
+        _translate(poses, regions.free_at(ts).pieces, bounds, (xs, ys), pts[0], ts)
     for i in range(1, m):
         k = nodes[i][0]
         a, b = part[k]
@@ -116,7 +117,8 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
                 _turn(poses, p_out, a)
             else:
                 raise AssemblyError(f"slabs {k} and {nxt} are not adjacent")
-    _translate(poses, regions.free_at(tg).pieces, bounds, pts[-1], (xg, yg), tg)
+    if tuple(pts[-1]) != (xg, yg):
+        _translate(poses, regions.free_at(tg).pieces, bounds, pts[-1], (xg, yg), tg)
     return np.array(poses, dtype=np.float64)
 
 

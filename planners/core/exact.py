@@ -41,6 +41,7 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
         sp = geometric_shortest(cspace.pieces, cspace.bounds, query.start, query.goal, time_limit=time_limit,
                                 on_progress=pg.search_reporter(bar, "exact search: A*") if bar.shown else None)
     dt = time.perf_counter() - t
+    found_cpu = time.process_time() if sp.solved else None
     d = getattr(sc, "clearance", 0.0)
     if sp.solved and d > 0:
         message = (f"exact shortest path keeping clearance {d:g} (it touches the C-obstacles inflated by "
@@ -58,5 +59,5 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
         length=float(sp.length) if sp.solved else math.inf, planner="exact", seed=0,
         timings={"solve": dt}, checks=dict(sp.stats.get("counts", {})) if isinstance(sp.stats, dict) else {},
         stages=["visibility"], start=tuple(query.start), goal=tuple(query.goal), message=message,
-        length_unsimplified=float(sp.length) if sp.solved else None,
+        length_unsimplified=float(sp.length) if sp.solved else None, first_path_cpu=found_cpu,
     )

@@ -115,6 +115,7 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     t1 = time.perf_counter()
     ok, why = adapter.verify(raw, query.start, query.goal)
     timings["verify"] = time.perf_counter() - t1
+    found_cpu = time.process_time()
     if not ok:  # the slab graph certifies its path; this re-check is the second opinion
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
                           message=f"the slab graph's path failed the certified re-check ({why}): not solved", **base)
@@ -127,7 +128,7 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     length, raw_len = adapter.length(path), adapter.length(raw)
     return PlanResult(solved=True, exact=True, path=path, length=length, timings=timings,
                       message=f"certified path from the slab graph ({graph}; length {raw_len:.6g}, {note})",
-                      length_unsimplified=raw_len, **base)
+                      length_unsimplified=raw_len, first_path_cpu=found_cpu, **base)
 
 
 def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:

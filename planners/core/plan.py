@@ -115,6 +115,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     >>> res.solved, res.path[0].tolist(), res.path[-1].tolist()
     (True, [1.0, 1.0], [9.0, 9.0])
     """
+    cpu0 = _cpu()
     if planner is None:
         from ..adapters.glue import OMPL_HINT, ompl_available
 
@@ -200,6 +201,8 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         r.clearance, r.objective = sc.clearance, objective
         _measure_clearance(r, adapter)
         r.timings = {"load": load_s, "cspace": build_s, **r.timings}
+        if r.first_path_cpu is not None:
+            r.first_path_cpu -= cpu0
         r.stages = _stage_names(report) + r.stages
         r.cspace_report = report
     first = results[0]
@@ -210,6 +213,10 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         first.queries = results
     first.scenario_data, first.cspace = sc, cspace
     return first
+
+
+def _cpu() -> float:
+    return time.process_time()
 
 
 def _now() -> float:

@@ -37,6 +37,12 @@ class PlanResult:
     # solve) and [time, best raw length] pairs along the run (the bench's anytime curve).
     first_solution: float | None = None
     progress: list = field(default_factory=list)
+    # CPU seconds from the start of plan() until this query's first path existed (OMPL's first
+    # solution, before shortening; exact's certified path, re-verified, before shortening),
+    # the scenario's load and C-space included; None without a path (or for an anytime planner
+    # run without the bench's slices, whose first solution is not timed). The planners stamp
+    # time.process_time() here and plan() makes it relative.
+    first_path_cpu: float | None = None
     # Clearance (filled by plan() on solved paths; cspace.spaces.clearance): the smallest distance
     # between the ROBOT (not inflated) swept along the path and any obstacle, the reference
     # pose where it occurs, the obstacle's closest point, "exact" (translation) or "lower"
