@@ -107,7 +107,7 @@ def test_the_objective_object_reaches_the_planner(monkeypatch):
     sc = {"file": BASIC, "scenario": "basic", "optimum": 1.0}
     task = bench.make_tasks([sc], ["RRTstar"], [30.0], 1, iterations=300, objective="clearance")[0]
     row = bench.run_one(task)
-    assert [type(o).__name__ for o in made] == ["MaximizeMinClearance"]
+    assert [type(o).__name__ for o in made] == ["SoftMinClearance"]
     assert row["solved"] and row["min_clearance"] > 0
 
 

@@ -129,12 +129,13 @@ def test_motion_value_is_the_disc_bound_and_below_the_swept_robots_clearance(bug
 
 def test_plan_under_the_clearance_objective_is_free_and_its_cost_is_what_ompl_reports():
     """RRTstar under the objective solves a small scene; every segment of the path is free;
-    OMPL's cost of its path is minus path_clearance_bound of the same waypoints, which is
-    at most the path's exact min_clearance."""
+    OMPL's cost of its path, read as a clearance (softmin_value: −σ·ln(cost)), lies within
+    σ·ln(n) below path_clearance_bound of the same n motions, which is at most the path's exact
+    min_clearance."""
     pytest.importorskip("ompl")
     from planners import plan
     from planners.adapters.glue import make_setup, set_query, termination
-    from planners.adapters.objectives import make_objective, path_clearance_bound
+    from planners.adapters.objectives import make_objective, path_clearance_bound, softmin_sigma, softmin_value
     from planners.core.plan import make_adapter
 
     res = plan(BASIC, planner="RRTstar", time=60.0, seed=2, objective="clearance", iterations=1500)
@@ -154,9 +155,17 @@ def test_plan_under_the_clearance_objective_is_free_and_its_cost_is_what_ompl_re
     assert ss.haveExactSolutionPath()
     path = ss.getSolutionPath()
     pts = adapter.path_array(path)
-    reported = -path.cost(obj).value()
-    assert reported == pytest.approx(path_clearance_bound(adapter, pts), rel=1e-9, abs=1e-12)
+    sigma = softmin_sigma(adapter)
+    reported, bound = softmin_value(path.cost(obj).value(), sigma), path_clearance_bound(adapter, pts)
+    assert bound - sigma * math.log(len(pts) - 1) - 1e-12 <= reported <= bound + 1e-12
     assert reported > 0.0
+    # the cost is the sum of the motions' exp(-c / sigma), as OMPL adds them
+    from planners.adapters.objectives import clearance_functions
+
+    _, motion = clearance_functions(adapter)
+    space, st = _states(adapter, pts)
+    total = sum(math.exp(-motion(a, b) / sigma) for a, b in zip(st, st[1:]))
+    assert path.cost(obj).value() == pytest.approx(total, rel=1e-12)
 
 
 def test_failure_hint_under_the_clearance_objective_does_not_send_to_the_exact_planner():
@@ -181,3 +190,51 @@ def test_cli_failure_under_the_clearance_objective(capsys):
     text = out.out + out.err
     assert code == 1 and "NOT solved" in text and "--time" in text, text
     assert "exact" not in text, text
+
+
+def test_compiled_motion_cost_is_the_python_one_to_the_bit(bug_trap):
+    """The compiled disc bound (cspace/spaces/_disccost.c) against the Python objective's motion
+    cost: the same doubles on random motions (repeated states, zero-length motions, ends inside
+    C-obstacles), with a table small enough to start over many times."""
+    from cspace.spaces import fastpath
+    from planners.adapters import objectives
+
+    if not fastpath.compiled():
+        pytest.skip("the compiled fast path is not built")
+    sc, cs, adapter, obstacles, robot = bug_trap
+    sigma = objectives.softmin_sigma(adapter)
+    inv = 1.0 / sigma
+    state, motion = objectives.clearance_functions(adapter)
+
+    def py_cost(a, b):  # the pure objective's cost: exp((-c) * inv), c the Python disc bound
+        return math.exp(-motion(a, b) * inv)
+
+    def raw(x, y):
+        return state((x, y))
+
+    calls = []
+
+    def counted(x, y):
+        calls.append((x, y))
+        return raw(x, y)
+
+    c_cost = fastpath.disc_cost(math.ldexp(1.0, -adapter.k), sigma, float, counted, slots_log2=4)
+    rng = np.random.default_rng(11)
+    pts = [tuple(p) for p in rng.uniform(-1, 21, (60, 2))]  # some outside the bounds, some blocked
+    space, states = _states(adapter, pts)
+    raws = [(float(s[0]), float(s[1])) for s in states]
+    n = 0
+    for _ in range(3000):
+        i, j = rng.integers(0, len(raws), 2)
+        a, b = raws[i], raws[j] if rng.random() < 0.9 else raws[i]
+        assert c_cost(a, b) == py_cost(a, b), (a, b)
+        n += 1
+    assert {c for c in calls} <= set(raws) and len(calls) > len(raws)  # the 16-slot table started over
+    assert any(raw(*p) == 0.0 for p in raws) and any(raw(*p) > 0.0 for p in raws)
+    # a plan under the objective takes the compiled cost where built, the same path as the pure one
+    from planners import plan
+
+    r = plan(BASIC, planner="RRTstar", seed=4, iterations=400, time=60.0, objective="clearance")
+    with fastpath.disabled():
+        p = plan(BASIC, planner="RRTstar", seed=4, iterations=400, time=60.0, objective="clearance")
+    assert r.solved and np.array_equal(r.path, p.path)

@@ -4,7 +4,8 @@
    (chord polygons), _gjk.c (the GJK loop of min_clearance), _nearest.c (min_clearance's
    search over its pairs), _se2motion.c and _carmotion.c (the compiled SE(2) motion and car
    curve checks: they share the angle wrap, the slab lookup and the handles' helpers below),
-   _carwords.c (Dubins and Reeds-Shepp words).
+   _carwords.c (Dubins and Reeds-Shepp words), _disccost.c (the clearance objective's motion
+   cost in translation).
 
    The one certified predicate they share: the sign of a cross product of two edge
    vectors, decided only where floats certify it (Shewchuk's stage-A filter, the same
@@ -211,5 +212,7 @@ PyObject *fast_car_handle(PyObject *self, PyObject *args);                     /
 PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carmotion.c */
 PyObject *fast_reeds_shepp_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */
 PyObject *fast_dubins_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */
+PyObject *fast_disc_cost_handle(PyObject *self, PyObject *args);               /* _disccost.c */
+PyObject *fast_disc_cost(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _disccost.c */
 
 #endif

@@ -332,6 +332,26 @@ def se2_handle(cs):
                      len(entries), xmin, xmax, ymin, ymax, cs.pad, cs._pg_x0, cs._pg_y0, cs._pg_iw, cs._pg_ih)
 
 
+
+def disc_cost(unit: float, sigma: float, cost_type, at, slots_log2: int = 18):
+    """The clearance objective's motion cost in translation, compiled
+    (cspace/spaces/_disccost.c), or None on the pure path: ``(s1, s2) -> cost_type(exp(-c /
+    sigma))``, c the disc bound of the motion's ends' clearances (``at(x, y)`` on raw OMPL
+    coordinates, called once per state, then remembered in a table of 2^``slots_log2`` slots
+    that starts over when half full) and of its length × ``unit``: the same doubles as
+    :func:`planners.adapters.objectives.clearance_functions`'s motion.
+
+    >>> f = disc_cost(1.0, 1.0, float, lambda x, y: 1.0)
+    >>> f is None or f((0.0, 0.0), (1.0, 0.0)) == math.exp(-math.sqrt(0.75))
+    True
+    """
+    if _fast is None:
+        return None
+    import functools
+
+    return functools.partial(_fast.disc_cost, _fast.disc_cost_handle(float(unit), float(sigma), cost_type, at,
+                                                                     int(slots_log2)))
+
 @contextlib.contextmanager
 def disabled():
     """Within the block, C-spaces are built on the pure path (no compiled handle): the
