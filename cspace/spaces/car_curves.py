@@ -37,6 +37,10 @@ Pose = tuple[float, float, float]
 
 
 def _pose(q, name: str) -> Pose:
+    if type(q) is tuple and len(q) == 3:  # the usual call: three finite floats, returned as they are
+        x, y, th = q
+        if type(x) is float and type(y) is float and type(th) is float and x - x == y - y == th - th == 0.0:
+            return q
     try:
         x, y, th = (float(v) for v in q)
     except (TypeError, ValueError):
@@ -75,7 +79,8 @@ MAX_RADII = 1e100
 
 
 def _frame(frame: tuple[float, float, float]) -> tuple[float, float, float]:
-    if not all(math.isfinite(v) and abs(v) <= MAX_RADII for v in frame[:-1]):
+    x, y = frame[0], frame[1]
+    if not (abs(x) <= MAX_RADII and abs(y) <= MAX_RADII):  # NaN fails the comparison, as inf exceeds it
         raise ValueError(f"radius: the poses are more than {MAX_RADII:g} turning radii apart (the radius is too "
                          "small for them)")
     return frame
@@ -84,7 +89,7 @@ def _frame(frame: tuple[float, float, float]) -> tuple[float, float, float]:
 def _segments(word: str, lengths, r: float) -> list[Segment]:
     # Scale radii to world units; a segment of exactly zero length is dropped.
     out = [(k, float(v) * r) for k, v in zip(word, lengths) if v != 0.0]
-    if not all(math.isfinite(v) for _, v in out):
+    if not all(v - v == 0.0 for _, v in out):  # finite (inf - inf and NaN are NaN)
         raise ValueError("radius: the turning radius is too large (a segment's length overflows)")
     return out
 

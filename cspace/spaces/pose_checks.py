@@ -95,10 +95,12 @@ def check_pieces(pieces: list, limit: int) -> None:
 
 def curve_radius(radius, extent: float) -> float:
     """The turning radius of a curve check: a real number within :data:`RADIUS_RANGE` x extent."""
+    lo, hi = RADIUS_RANGE[0] * extent, RADIUS_RANGE[1] * extent
+    if type(radius) is float and lo <= radius <= hi:  # the usual call (NaN fails the comparison)
+        return radius
     if isinstance(radius, bool):
         raise TypeError(f"radius: the turning radius is a number, got {radius!r}")
     r = _real(radius, "radius", "the turning radius is a number")
-    lo, hi = RADIUS_RANGE[0] * extent, RADIUS_RANGE[1] * extent
     if not lo <= r <= hi:
         raise ValueError(f"radius: the turning radius must lie in [{lo:.3g}, {hi:.3g}] (1e-9 to 1e9 times the "
                          f"scene's extent), got {r!r}")
@@ -108,6 +110,10 @@ def curve_radius(radius, extent: float) -> float:
 def curve_segments(segments, radius: float, extent: float) -> list[tuple[str, float]]:
     """The segments as (kind, float length) pairs: kind "L", "S" or "R", the length finite, at
     most :data:`MAX_SEGMENT_EXTENTS` extents, an arc at most :data:`MAX_ARC_TURNS` turns."""
+    if type(segments) is list:  # the usual call (a car's curve from car_curves): checked fast
+        fast = _segments_fast(segments, radius, extent)
+        if fast is not None:
+            return fast
     if isinstance(segments, (str, bytes, dict)):
         raise TypeError(f"segments: a list of (kind, length) pairs, got {_show(segments)}")
     try:
@@ -134,3 +140,19 @@ def curve_segments(segments, radius: float, extent: float) -> list[tuple[str, fl
                              f"{abs(v) / radius / (2 * math.pi):.3g}")
         out.append((kind, v))
     return out
+
+
+def _segments_fast(segments: list, radius: float, extent: float) -> list[tuple[str, float]] | None:
+    """:func:`curve_segments` for a list of (kind, float) tuples that pass its every bound (the
+    same tests, without the type dispatch), else None: the full check decides and words the error."""
+    longest = MAX_SEGMENT_EXTENTS * extent
+    turns = MAX_ARC_TURNS * 2.0 * math.pi * radius
+    for seg in segments:
+        if type(seg) is not tuple or len(seg) != 2:
+            return None
+        kind, v = seg
+        if type(v) is not float or not abs(v) <= longest:  # NaN fails the comparison; inf exceeds it
+            return None
+        if type(kind) is not str or (kind != "S" and (kind not in ("L", "R") or abs(v) > turns)):
+            return None
+    return list(segments)

@@ -88,8 +88,8 @@ class CarSpace(SE2Space):
         >>> CarSpace.__new__(CarSpace)._len_of([("L", 1.5), ("S", -2.0)])
         3.5
         """
-        path = np.asarray(path, dtype=np.float64)
-        return float(sum(self._len_of(self.segments(tuple(a), tuple(b))) for a, b in zip(path[:-1], path[1:])))
+        rows = [tuple(r) for r in np.asarray(path, dtype=np.float64).tolist()]  # Python floats: the fast paths
+        return float(sum(self._len_of(self.segments(a, b)) for a, b in zip(rows[:-1], rows[1:])))
 
     @staticmethod
     def _len_of(segments) -> float:

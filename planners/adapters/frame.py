@@ -52,13 +52,15 @@ def verify_path(path: np.ndarray, start: tuple, goal: tuple, step_free, *, step:
     >>> verify_path(np.array([[0., 0], [1, 0]]), (0.0, 0.0), (2.0, 0.0), lambda a, b: True)
     (False, 'path does not run exactly from start to goal')
     """
-    if len(path) < 2:
-        same = len(path) == 1 and tuple(path[0]) == start == goal
+    # Rows as tuples of Python floats (not NumPy scalars): the checks' fast paths take them as they are.
+    rows = [tuple(r) for r in np.asarray(path).tolist()]
+    if len(rows) < 2:
+        same = len(rows) == 1 and rows[0] == start == goal
         return same, "start equals goal" if same else "empty path"
-    if tuple(path[0]) != start or tuple(path[-1]) != goal:
+    if rows[0] != start or rows[-1] != goal:
         return False, f"path does not run exactly from {ends}"
-    for i in range(len(path) - 1):
-        if not step_free(tuple(path[i]), tuple(path[i + 1])):
+    for i in range(len(rows) - 1):
+        if not step_free(rows[i], rows[i + 1]):
             return False, f"{step} {i} failed the {test} test"
     return True, f"{test} solution"
 

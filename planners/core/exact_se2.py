@@ -34,6 +34,11 @@ CAR_SLABS = 128     # the finest partition a car's proof-only search tries
 # regions kept for the next query), and it proves a corner a long robot cannot turn.
 QUICK_WIDTH = 2 * math.pi / 16
 _REGIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> its SlabRegions
+# C-space -> the (start, goal) pairs whose proof before sampling ran to its end and found no proof.
+# That search is deterministic (the same regions, slabs and graph), so asking again answers the same;
+# a search cut short by its time budget is not remembered (a longer one might still prove).
+NO_QUICK_PROOF = "POSSIBLE graph only: no proof found"
+_NO_PROOF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def search(cspace, query, time_limit: float | None, *, possible_only: bool = False, refine: bool = True,
@@ -160,10 +165,17 @@ def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:
 def quick_proof(sc, cspace, query, time_limit: float) -> PlanResult | None:
     """Before a sampling planner spends its budget: the POSSIBLE graph at the first slabs, refined
     once (:data:`QUICK_WIDTH`), within a small share of the time limit. A result (not solved, proven unsolvable) when it separates
-    start and goal, else None (the planner runs)."""
+    start and goal, else None (the planner runs). A query whose search ran to its end without a
+    proof is remembered with the C-space (:data:`_NO_PROOF`): the next seed skips the search."""
+    key = (tuple(map(float, query.start)), tuple(map(float, query.goal)))
+    tried = _NO_PROOF.setdefault(cspace, set())
+    if key in tried:  # this search ran to its end before and found no proof: it would again
+        return None
     budget = min(QUICK_SHARE * time_limit, QUICK_MAX)
     res = search(cspace, query, budget, possible_only=True, min_width=QUICK_WIDTH)
     if res.status != "unsolvable":
+        if res.stats.get("reason") == NO_QUICK_PROOF:
+            tried.add(key)
         return None
     return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,
                       planner="", seed=0, start=tuple(query.start), goal=tuple(query.goal),
