@@ -1,7 +1,7 @@
 """GJK distance and EPA depth: per-query time, iterations, and peers in the same run.
 
 Pairs of random convex 8- and 64-gons, separated, touching (moved into contact along x)
-and overlapping. Peers: coal (C++, via its Python bindings; 2-D polygons as unit prisms) when it
+and overlapping. Peers: coal (C++, via its Python bindings; 2-D polygons as prisms) when it
 imports, and shapely's distance. EPA depths are checked against the exact depth of the
 materialised difference, for ours and for coal. Medians over repetitions; ratios printed.
 Usage: python scripts/bench_gjk.py [--pairs N] [--plot FILE]
@@ -34,32 +34,17 @@ def median_time(fn, pairs, reps=20):
 
 
 def coal_api():
-    """coal's distance and penetration on 2-D polygons as unit-height prisms, or None.
+    """coal's distance and penetration on 2-D polygons as prisms, or None.
 
-    coal is 3-D: a polygon becomes a prism (bottom and top fans plus two triangles per
-    side), built once per shape outside the timing. Two query styles are timed: a
+    coal is 3-D: a polygon becomes a prism (se2_peers.prism: bottom and top fans plus two
+    triangles per side, z in [-1, 1]), built once per shape outside the timing. Two query styles are timed: a
     fresh request/result per query (what a caller usually writes) and reused ones.
     """
     try:
         import coal
     except ImportError:
         return None
-
-    def prism(P):
-        n = len(P)
-        v = coal.StdVec_Vec3s()
-        for z in (-0.5, 0.5):
-            for x, y in P:
-                v.append(np.array([x, y, z]))
-        t = coal.StdVec_Triangle()
-        for i in range(1, n - 1):
-            t.append(coal.Triangle(0, i + 1, i))
-            t.append(coal.Triangle(n, n + i, n + i + 1))
-        for i in range(n):
-            j = (i + 1) % n
-            t.append(coal.Triangle(i, j, n + j))
-            t.append(coal.Triangle(i, n + j, n + i))
-        return coal.Convex(v, t)
+    from se2_peers import prism  # the SE(2) benches' prism (scripts/ is on the path of a script)
 
     eye = coal.Transform3s()
     req, res = coal.DistanceRequest(), coal.DistanceResult()
