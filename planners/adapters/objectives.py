@@ -21,7 +21,7 @@ geometry; in SE(2), the adapter's ``clearance_functions``):
   three calls into Python per neighbour (8x the length objective per iteration on bug_trap,
   and a median clearance of 0.08 there against this one's 0.31, 3 seeds of 3000 iterations). In translation the motion's cost is compiled
   (:func:`cspace.spaces.fastpath.disc_cost`, the same doubles; this Python one is its oracle and
-  the pure path): ~3-3.6x the length objective per RRTstar iteration (the Python motion
+  the pure path): ~3-4x the length objective per RRTstar iteration (the Python motion
   cost over a compiled C-space: 4-7x; all pure: 1.4-1.8x; ``scripts/bench_objective.py``);
 - ``balanced``: the integral along the path of ``1 + w · ρ / (c + ρ)`` (c the clearance,
   ρ = ``BALANCED_SCALE`` × the scene's extent, w = ``BALANCED_WEIGHT`` = 1): far from
