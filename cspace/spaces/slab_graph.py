@@ -11,8 +11,9 @@ in the body frame, O_j the convex obstacle pieces, B the reference point's bound
   ``rotate_piece(P_i, θ)`` summed with the square [−δ, δ]² (δ = the slab pad): the exact
   translation C-space of the turned robot, shrunk by δ, so that a shortest path, which may
   run along the boundary, still keeps the robot off the obstacles (touching is collision).
-- POSSIBLE(S) = B − ⋃ O_j ⊕ (−C_i), C_i = :func:`slab_inner` of P_i over [a, b] (the *core*:
-  inside R_θ P_i for every θ of S); a piece whose core is empty contributes nothing. A
+- POSSIBLE(S) = B − ⋃ O_j ⊕ (−C_i), C_i = :func:`slab_inner` of P_i over [a − c, b + c]
+  (c = ``CORE_SLACK``; the *core*: inside R_θ P_i for every θ of S); a piece whose core is
+  empty contributes nothing. A
   pose (x, y, θ), θ in S, whose (x, y) is outside POSSIBLE(S) collides.
 
 Reflection: O ⊕ (−R) is the set of reference points q where R + q meets O (q ∈ O − R), so the
@@ -55,6 +56,16 @@ from .cspace_build import pair_sums
 from .shortest import free_space
 
 EPS_REL = 2.0**-34  # POSSIBLE's extra shrink of the cores, relative to S'
+# A core is computed over [a - CORE_SLACK, b + CORE_SLACK]: inside the robot at every angle of the
+# wider interval, so inside it on the slab (a smaller core: more POSSIBLE, the proof's side), and
+# still inside where an independent check unsure of an angle's last bits looks just past a slab's
+# end (planners.core.proof_check counts a sinusoid's peak within 1e-9 rad of the slab: a core
+# vertex touching the robot's edge at the slab's end, inside by the pads only, failed it there).
+CORE_SLACK = 1e-8
+# ... and with its edges moved in by ε / 16 more than the slab pad (2^-38 S', a 64th of ε at
+# 4 pads per edge): far above the independent check's margin (1e-12 relative to the edge's and
+# the vertex's magnitudes), which a core at its pads alone met only just (a short end edge).
+CORE_PAD = 1.0 / 16.0
 TOL_REL = 2.0**-30  # link / membership tolerance, and the depth of a certified link point
 
 
@@ -152,12 +163,13 @@ class SlabRegions:
             t = time.perf_counter()
             a, b = key
             cores, used = [], []
+            lo, hi, pad = a - CORE_SLACK, b + CORE_SLACK, self.pad + CORE_PAD * self.eps
             for p in self.robot:
-                c = slab_inner(p, a, b, self.pad)
+                c = slab_inner(p, lo, hi, pad)
                 cores.append(c if len(c) >= 3 else np.zeros((0, 2)))
                 if len(c) >= 3:
                     # slab_inner lowers every offset by 4·pad·|n|: pad + ε/4 moves each edge ε further in.
-                    s = slab_inner(p, a, b, self.pad + 0.25 * self.eps)
+                    s = slab_inner(p, lo, hi, pad + 0.25 * self.eps)
                     if len(s) >= 3:
                         used.append(s)
             self._possible[key] = self._region(a, b, "possible", used, cores, t)
