@@ -47,6 +47,7 @@ PROOF_FORMAT = "cspace-se2-proof/1"
 # A proof's start and goal join the POSSIBLE components of every slab within this many radians of
 # their angle (more nodes: a weaker claim), 10 x the independent checker's angle tolerance.
 ANGLE_NEAR = 1e-8
+NO_PROOF_FOUND = "POSSIBLE graph only: no proof found"  # the reason a proof-only search ends without one
 S_NODE, G_NODE = (-1, 0), (-2, 0)  # the virtual start and goal nodes (sort before slab nodes)
 
 
@@ -211,7 +212,7 @@ class _Search:
                     return self._result("unsolvable", proof=self._proof(preg, s_p, g_p, p_edges))
                 if freg is None:
                     if not self._split(self._wide()):
-                        return self._result("undecided", reason="POSSIBLE graph only: no proof found")
+                        return self._result("undecided", reason=NO_PROOF_FOUND)
                     continue
                 t = time.perf_counter()
                 split = self._select(preg, freg, padj, fadj, reached)

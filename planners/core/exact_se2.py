@@ -37,7 +37,6 @@ _REGIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> 
 # C-space -> the (start, goal) pairs whose proof before sampling ran to its end and found no proof.
 # That search is deterministic (the same regions, slabs and graph), so asking again answers the same;
 # a search cut short by its time budget is not remembered (a longer one might still prove).
-NO_QUICK_PROOF = "POSSIBLE graph only: no proof found"
 _NO_PROOF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -167,6 +166,8 @@ def quick_proof(sc, cspace, query, time_limit: float) -> PlanResult | None:
     once (:data:`QUICK_WIDTH`), within a small share of the time limit. A result (not solved, proven unsolvable) when it separates
     start and goal, else None (the planner runs). A query whose search ran to its end without a
     proof is remembered with the C-space (:data:`_NO_PROOF`): the next seed skips the search."""
+    from cspace.spaces.se2_exact import NO_PROOF_FOUND
+
     key = (tuple(map(float, query.start)), tuple(map(float, query.goal)))
     tried = _NO_PROOF.setdefault(cspace, set())
     if key in tried:  # this search ran to its end before and found no proof: it would again
@@ -174,7 +175,7 @@ def quick_proof(sc, cspace, query, time_limit: float) -> PlanResult | None:
     budget = min(QUICK_SHARE * time_limit, QUICK_MAX)
     res = search(cspace, query, budget, possible_only=True, min_width=QUICK_WIDTH)
     if res.status != "unsolvable":
-        if res.stats.get("reason") == NO_QUICK_PROOF:
+        if res.stats.get("reason") == NO_PROOF_FOUND:
             tried.add(key)
         return None
     return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,

@@ -119,13 +119,13 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
     set_query(ss, space, start, goal)
     setup_s = _now() - t0
     c0 = space.counts()
-    t1, c1 = _now(), time.process_time()
+    t1, cpu1 = _now(), time.process_time()
     first, progress = _solve(ss, space, key, time_limit, iterations, slices, on_progress)
     solve_s = _now() - t1
     # an anytime planner's first solution came before the end of its solve: known when the
     # bench's slices timed it, else not
     timed = slices and key in SLICED and not iterations and first is not None
-    found_cpu = time.process_time() if key not in ANYTIME else c1 + first if timed else None
+    found_cpu = time.process_time() if key not in ANYTIME else cpu1 + first if timed else None
     status = ss.getLastPlannerStatus()
     found = ss.haveExactSolutionPath()
     raw = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
