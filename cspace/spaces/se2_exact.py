@@ -12,7 +12,8 @@ polygons with holes, and their connected components.
   it joins through the FREE region at its own angle (a zero-width slab): its component
   there is linked to the FREE components of the slab(s) holding θs that overlap it. The
   goal likewise. A walk from start to goal is a
-  certified path: translations at a fixed angle (exact shortest paths inside one component)
+  certified path: translations at a fixed angle (short paths inside one component, checked
+  exactly: :mod:`cspace.spaces.se2_exact_path`)
   and rotations in place.
 - POSSIBLE graph: nodes (slab, component); components of adjacent slabs are linked when their
   closures meet (within a tolerance, toward more links); start and goal belong to every

@@ -9,8 +9,9 @@ becomes, in order:
   along its boundary keeps the robot off the obstacles);
 - for each slab node n_i: a turn in place at p_{i-1} to its angle α_i (θs for the first
   node, the slab's middle otherwise), a translation at α_i inside c_i from p_{i-1} to p_i
-  (the exact shortest path of :func:`cspace.spaces.shortest.shortest_path` over that slab's
-  FREE pieces, checked by it against them with exact predicates), a turn at p_i to β_i
+  (the straight segment, else the shortest path within a triangle channel of that slab's FREE
+  (:func:`cspace.spaces.shortest.shortest_path`, method "channel"), checked by it against the FREE
+  pieces with exact predicates), a turn at p_i to β_i
   (θg for the last node, the middle otherwise), and, when the next node is a slab node, a
   turn to the boundary angle the two slabs share;
 - a translation at θg inside G's component from p_{m-1} to the goal.
@@ -88,12 +89,12 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
     pts = [p for _, p in walk[:-1]]
     poses = [(xs, ys, wrap_angle(ts))]
     if len(nodes) == 2:  # the start's and goal's components at one common angle: one translation
-        _translate(poses, regions.free_at(ts).pieces, bounds, (xs, ys), (xg, yg), ts)
+        _translate(poses, regions.free_at(ts), bounds, (xs, ys), (xg, yg), ts)
         return np.array(poses, dtype=np.float64)
     K = len(part)
     m = len(nodes) - 1
     if tuple(pts[0]) != (xs, ys):  # (an end joined its slab directly: nothing to translate at its angle)
-        _translate(poses, regions.free_at(ts).pieces, bounds, (xs, ys), pts[0], ts)
+        _translate(poses, regions.free_at(ts), bounds, (xs, ys), pts[0], ts)
     for i in range(1, m):
         k = nodes[i][0]
         a, b = part[k]
@@ -107,7 +108,7 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
             if not point_free(pieces, bounds, p[0], p[1]):
                 raise AssemblyError(f"turn point {p} is not free in slab {k} [{a!r}, {b!r}]")
         _turn(poses, p_in, alpha)
-        _translate(poses, pieces, bounds, p_in, p_out, alpha)
+        _translate(poses, freg[k], bounds, p_in, p_out, alpha)
         _turn(poses, p_out, beta)
         nxt = nodes[i + 1][0]
         if nxt >= 0:  # into the next slab through the boundary the two share
@@ -118,7 +119,7 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
             else:
                 raise AssemblyError(f"slabs {k} and {nxt} are not adjacent")
     if tuple(pts[-1]) != (xg, yg):
-        _translate(poses, regions.free_at(tg).pieces, bounds, pts[-1], (xg, yg), tg)
+        _translate(poses, regions.free_at(tg), bounds, pts[-1], (xg, yg), tg)
     return np.array(poses, dtype=np.float64)
 
 
@@ -132,10 +133,13 @@ def _turn(poses: list, p, theta: float) -> None:
         poses.append((x, y, th))
 
 
-def _translate(poses: list, pieces: list, bounds, p, q, theta: float) -> None:
-    """Translate at θ from p (the last pose's position) to q: the straight segment if the exact
-    segment test (:func:`path_violations`) finds it free, else the exact shortest path through the
-    free space of ``pieces`` (its exact check included)."""
+def _translate(poses: list, region, bounds, p, q, theta: float) -> None:
+    """Translate at θ from p (the last pose's position) to q inside the FREE ``region`` (a
+    :class:`cspace.spaces.slab_graph.Region`): the straight segment if the exact segment test
+    (:func:`path_violations`) finds it free against the region's pieces, else a short path through
+    their free space (the shortest within a triangle channel, checked exactly against the pieces:
+    :func:`cspace.spaces.shortest.shortest_path`'s "channel"; OMPL's simplifier shortens it later)."""
+    pieces = region.pieces
     x, y, t = poses[-1]
     th = wrap_angle(float(theta))
     if (x, y) != (float(p[0]), float(p[1])) or th != t:
@@ -146,7 +150,7 @@ def _translate(poses: list, pieces: list, bounds, p, q, theta: float) -> None:
     if not path_violations([(x, y), q], pieces, bounds):  # the straight segment is free: it is the shortest
         poses.append((q[0], q[1], th))
         return
-    sp = shortest_path(pieces, bounds, (x, y), (float(q[0]), float(q[1])))
+    sp = shortest_path(pieces, bounds, (x, y), (float(q[0]), float(q[1])), method="channel", free=region.components)
     if not sp.solved:
         raise AssemblyError(f"no certified translation from {p} to {q} at {th!r}: {sp.stats.get('reason')}")
     for px, py in sp.path[1:].tolist():

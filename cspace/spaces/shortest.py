@@ -18,7 +18,12 @@ a triangulation that fails its exact checks use the older lazy search
 (:mod:`cspace.spaces.shortest_lazy`: every bitangent candidate pushed, each tested with
 GEOS's ``covers`` when popped), which gives the same lengths. ``time_limit`` bounds
 either search and says so when it stops. Queries on the same pieces and bounds
-share F, its corners and its mesh (a one-scene cache keyed by content).
+share F, its corners and its mesh (the 64 most recent scenes, keyed by content:
+the exact SE(2) planner translates in one slab's scene after another).
+
+``method="channel"`` asks for a certified short path instead, for callers that shorten
+it themselves: the shortest path within a channel of mesh triangles
+(:mod:`cspace.spaces.channel`), checked exactly like the others.
 
 Tolerance: F's vertices come from GEOS's union, whose new vertices (edge crossings
 of overlapping pieces) are rounded to doubles; the length is exact for that F,
@@ -27,6 +32,7 @@ in the same polygon of F, so an unsolvable query is *proven* unsolvable.
 """
 from __future__ import annotations
 
+import collections
 import gc
 import math
 import time
@@ -82,9 +88,18 @@ def _orient(geom):
 
 def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = None,
                   on_progress: Callable[[int, int, float], None] | None = None,
-                  method: str = "auto") -> ShortestPath:
+                  method: str = "auto", free: list | None = None) -> ShortestPath:
     """The shortest path from start to goal through the free C-space.
 
+    ``method``: "auto" (the mesh search, the lazy one where there is no mesh), "mesh", "lazy",
+    or "channel": a certified short path, not always the shortest, for callers that shorten it
+    themselves: the shortest path inside the triangle channel that A* over F's mesh picks
+    (:mod:`cspace.spaces.channel`; a large open map in milliseconds, where the visibility search
+    settles hundreds of corners), checked exactly like the others; where there is no mesh, or its
+    path fails the check, the "auto" search. ``length`` is then that path's length.
+    ``free``: the polygons of F (as :func:`free_space` makes them for these pieces and bounds)
+    when the caller has them, used instead of a new union where the scene is not cached
+    (every path is still checked against the pieces themselves).
     ``time_limit`` (seconds) bounds the search: past it the result is unsolved with
     ``stats["reason"] == "time limit"`` (never a silent wrong answer, never a hang).
     ``on_progress(settled, nodes, bound)``, when given, is called every
@@ -101,21 +116,21 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
     >>> calls[-1][:2], round(calls[-1][2], 12)  # all 4 nodes settled; the bound reached the length
     ((4, 4), 3.828427124746)
     """
-    if method not in ("auto", "mesh", "lazy"):
-        raise ValueError(f"shortest_path: method: expected 'auto', 'mesh' or 'lazy', got {method!r}")
+    if method not in ("auto", "mesh", "lazy", "channel"):
+        raise ValueError(f"shortest_path: method: expected 'auto', 'mesh', 'lazy' or 'channel', got {method!r}")
 
     # The search makes many small tuples and no cycles: the cyclic collector, which would
     # rescan them over and over (~15 % of the time), is paused while it runs.
     paused = gc.isenabled()
     gc.disable()
     try:
-        return _shortest(pieces, bounds, start, goal, time_limit, on_progress, method)
+        return _shortest(pieces, bounds, start, goal, time_limit, on_progress, method, free)
     finally:
         if paused:
             gc.enable()
 
 
-def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method) -> ShortestPath:
+def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method, free) -> ShortestPath:
     import shapely
 
     from .pathcheck import Degenerate, path_violations, split_pieces
@@ -126,7 +141,7 @@ def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method) -> S
     pieces = [as_array(p, copy=False, nonempty=True) for p in pieces]  # the one input gate: finite (N, 2) reals
     s, g = _point(start, "start"), _point(goal, "goal")
     bounds = tuple(_point(bounds[:2], "bounds")) + tuple(_point(bounds[2:], "bounds"))
-    scene = _scene(pieces, bounds)
+    scene = _scene(pieces, bounds, free)
     parts = scene.parts
     ps, pg = shapely.Point(s), shapely.Point(g)
     comp_s = next((k for k, p in enumerate(parts) if p.covers(ps)), None)
@@ -154,6 +169,13 @@ def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method) -> S
     pts = np.array([s, g] + nodes, dtype=np.float64).reshape(-1, 2)
     deadline = None if time_limit is None else t0 + float(time_limit)
     path = None
+    if method == "channel" and deg is None:
+        found = _channel(scene, comp_s, s, g, pieces, bounds, deadline)
+        if found is not None:
+            stats["method"] = "channel"
+            stats["counts"]["corners"] = len(found) - 2
+            stats["time"] = time.perf_counter() - t0
+            return ShortestPath(True, found, float(np.hypot(*np.diff(found, axis=0).T).sum()), False, stats)
     if method != "lazy" and deg is None:  # zero-area pieces are outside F's mesh: the lazy search
         from .freemesh import MeshError
         from .visibility import mesh_astar
@@ -183,15 +205,33 @@ def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method) -> S
     return ShortestPath(True, pts[path], length, False, stats)
 
 
+def _channel(scene, comp: int, s, g, pieces, bounds, deadline) -> np.ndarray | None:
+    """The channel path (:func:`cspace.spaces.channel.channel_path`) in component ``comp``, if
+    there is a mesh and the path passes the exact check against the pieces; else None."""
+    from .channel import channel_path
+    from .freemesh import MeshError
+    from .pathcheck import path_violations
+
+    try:
+        mesh = scene.mesh(comp)
+    except MeshError:
+        return None
+    found = channel_path(mesh, s, g, deadline)
+    if found is None:
+        return None
+    pts = np.array(found, dtype=np.float64)
+    return None if path_violations(pts, pieces, bounds) else pts
+
+
 class _Scene:
     """F's components for one set of pieces and bounds, with each component's reflex
     corners and mesh made on first use (queries on one C-space share them)."""
 
-    def __init__(self, pieces: list, bounds: tuple):
+    def __init__(self, pieces: list, bounds: tuple, free: list | None = None):
         import shapely
 
-        F = free_space(pieces, bounds)
-        self.parts = [p for p in shapely.get_parts(F) if p.geom_type == "Polygon" and not p.is_empty]
+        parts = shapely.get_parts(free_space(pieces, bounds)) if free is None else free
+        self.parts = [p for p in parts if p.geom_type == "Polygon" and not p.is_empty]
         for p in self.parts:
             shapely.prepare(p)
         self._reflex: dict = {}
@@ -216,12 +256,17 @@ class _Scene:
         return self._mesh[k]
 
 
-_LAST: list = []  # [(key, _Scene)]: the last scene searched
+# The scenes searched lately, most recent last, keyed by content. More than one: the exact SE(2)
+# planner translates inside the slabs of one scene in turn (8 slabs or more per query), and each
+# slab's pieces are another scene; a cache of one rebuilt F and its mesh at every slab change.
+_SCENES: "collections.OrderedDict[bytes, _Scene]" = collections.OrderedDict()
+SCENES_KEPT = 64
 
 
-def _scene(pieces: list, bounds: tuple) -> _Scene:
-    """The :class:`_Scene` of these pieces and bounds, reused when the last call had the same
-    ones (compared by content: a digest of every coordinate and piece size)."""
+def _scene(pieces: list, bounds: tuple, free: list | None = None) -> _Scene:
+    """The :class:`_Scene` of these pieces and bounds, reused when a recent call had the same
+    ones (compared by content: a digest of every coordinate and piece size); the
+    :data:`SCENES_KEPT` most recently used are kept."""
     import hashlib
 
     h = hashlib.blake2b(np.asarray(bounds, dtype=np.float64).tobytes(), digest_size=20)
@@ -229,17 +274,43 @@ def _scene(pieces: list, bounds: tuple) -> _Scene:
     for p in pieces:
         h.update(np.ascontiguousarray(p, dtype=np.float64).tobytes())
     key = h.digest()
-    if not _LAST or _LAST[0][0] != key:
-        _LAST[:] = [(key, _Scene(pieces, bounds))]
-    return _LAST[0][1]
+    scene = _SCENES.get(key)
+    if scene is None:
+        scene = _SCENES[key] = _Scene(pieces, bounds, free)
+        while len(_SCENES) > SCENES_KEPT:
+            _SCENES.popitem(last=False)
+    else:
+        _SCENES.move_to_end(key)
+    return scene
+
+
+def warm(pieces: list, bounds, free: list | None = None) -> int:
+    """Build and keep F of these pieces and bounds and every component's mesh (``free``: F's
+    polygons, when the caller has them), so that the next searches on them pay for neither;
+    returns the number of meshes built (a component GEOS cannot mesh keeps the lazy search).
+
+    >>> warm([np.array([[1., 1], [2, 1], [2, 2], [1, 2]])], (0, 3, 0, 3))
+    1
+    """
+    from .freemesh import MeshError
+
+    scene = _scene([np.asarray(p, dtype=np.float64) for p in pieces], tuple(map(float, bounds)), free)
+    built = 0
+    for k in range(len(scene.parts)):
+        try:
+            scene.mesh(k)
+            built += 1
+        except MeshError:
+            pass
+    return built
 
 
 def clear_cache() -> None:
-    """Forget the last scene's F and mesh (benchmarks time the preparation with it).
+    """Forget the scenes' F and meshes (benchmarks time the preparation with it).
 
     >>> clear_cache()
     """
-    _LAST.clear()
+    _SCENES.clear()
 
 
 def _point(p, what: str) -> tuple[float, float]:

@@ -54,15 +54,24 @@ def search(cspace, query, time_limit: float | None, *, possible_only: bool = Fal
                             **({} if min_width is None else {"min_width": min_width}))
 
 
-def prepare(cspace) -> float:
+def prepare(cspace, exact: bool = False) -> float:
     """Build the POSSIBLE regions of the first slabs (what :func:`quick_proof` reads) for a C-space
-    that will serve many queries; returns the seconds it took."""
+    that will serve many queries, and with ``exact`` also their FREE regions and the meshes their
+    translations search (what :func:`exact_se2` reads first); returns the seconds it took."""
     from cspace.spaces.se2_exact import initial_partition
+    from cspace.spaces.shortest import warm
 
     t = time.perf_counter()
     regions = _regions_of(cspace)
-    for a, b in initial_partition():
+    part = initial_partition()
+    for a, b in part:
         regions.possible(a, b)
+        if exact:
+            free = regions.free(a, b)
+            warm(free.pieces, regions.bounds, free.components)
+    if exact:  # the links between neighbouring slabs' FREE components
+        for (a, b), (c, d) in zip(part, part[1:] + part[:1]):
+            regions.free_links(regions.free(a, b), regions.free(c, d))
     return time.perf_counter() - t
 
 
