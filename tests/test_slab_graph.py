@@ -124,3 +124,36 @@ def test_deep_point_and_point_free():
     sq = np.array([[1., 1], [2, 1], [2, 2], [1, 2]])
     assert not point_free([sq], (0, 3, 0, 3), 2.0, 2.0)  # touching is collision
     assert not point_free([sq], (0, 3, 0, 3), 3.5, 0.5)  # out of bounds
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10**6))
+def test_point_free_with_a_regions_boxes_is_shapelys_answer(seed):
+    # the region's kept piece boxes (the exact planner's turn points) and the boxes made per call
+    # give the same answers, and both are shapely's (closed pieces: touching is collision)
+    rng = np.random.default_rng(seed)
+    sr = SlabRegions(BOXES, [TRI], BOUNDS)
+    a = float(rng.uniform(-math.pi, math.pi - 0.3))
+    reg = sr.free(a, a + 0.3)
+    obs = shapely.union_all([shapely.Polygon(p) for p in reg.pieces])
+    corners = np.concatenate(reg.pieces)
+    pts = np.concatenate([rng.uniform(0, 10, (40, 2)) * [1, 0.8], corners[rng.integers(0, len(corners), 10)]])
+    for x, y in pts.tolist():
+        truth = BOUNDS[0] <= x <= BOUNDS[1] and BOUNDS[2] <= y <= BOUNDS[3] and not obs.intersects(shapely.Point(x, y))
+        assert point_free(reg.pieces, sr.bounds, x, y, reg.piece_boxes) == point_free(reg.pieces, sr.bounds, x, y)
+        if obs.distance(shapely.Point(x, y)) > 1e-9 or not truth:  # (shapely's float test is the oracle off the edges)
+            assert point_free(reg.pieces, sr.bounds, x, y) == truth, (x, y)
+
+
+def test_possible_links_and_near_agree_with_measured_distances():
+    # overlapping components are linked by the prepared intersects test without a distance: the
+    # same pairs as measuring every one
+    sr = SlabRegions(BOXES, [TRI], BOUNDS)
+    for a in np.linspace(-math.pi, math.pi - 0.4, 9):
+        p1, p2 = sr.possible(a, a + 0.2), sr.possible(a + 0.2, a + 0.4)
+        measured = [(i, j) for i in range(len(p1.components)) for j in range(len(p2.components))
+                    if shapely.distance(p1.components[i], p2.components[j]) <= sr.tol]
+        assert sr.possible_links(p1, p2) == measured
+        for x, y in ((1.0, 1.0), (3.0, 4.0), (5.0, 5.5), (9.5, 7.5)):
+            assert sr.near(p1, x, y) == [i for i, c in enumerate(p1.components)
+                                         if shapely.distance(c, shapely.Point(x, y)) <= sr.tol]

@@ -105,7 +105,7 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
             raise AssemblyError(f"slab {k} [{a!r}, {b!r}] does not hold the start's or goal's angle")
         p_in, p_out = pts[i - 1], pts[i]
         for p in (p_in, p_out):  # turn points: free at every angle of the slab, exactly
-            if not point_free(pieces, bounds, p[0], p[1]):
+            if not point_free(pieces, bounds, p[0], p[1], freg[k].piece_boxes):
                 raise AssemblyError(f"turn point {p} is not free in slab {k} [{a!r}, {b!r}]")
         _turn(poses, p_in, alpha)
         _translate(poses, freg[k], bounds, p_in, p_out, alpha)

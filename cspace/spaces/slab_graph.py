@@ -83,6 +83,7 @@ class Region:
     boxes: np.ndarray
     cores: list = field(default_factory=list)
     seconds: float = 0.0
+    piece_boxes: np.ndarray | None = None  # (len(pieces), 4) boxes of the pieces, for point_free
 
 
 class SlabRegions:
@@ -187,7 +188,8 @@ class SlabRegions:
         comps = [comps[i] for i in order]
         for c in comps:
             shapely.prepare(c)
-        return Region(a, b, kind, pieces, comps, boxes[order].reshape(-1, 4), cores, time.perf_counter() - t)
+        return Region(a, b, kind, pieces, comps, boxes[order].reshape(-1, 4), cores, time.perf_counter() - t,
+                      piece_boxes(pieces))
 
     # -- links ---------------------------------------------------------------------------
 
@@ -214,8 +216,11 @@ class SlabRegions:
         if key not in self._links:
             import shapely
 
+            # (components that overlap, the usual case between neighbouring slabs, are at distance
+            # 0: the prepared intersects test answers them without measuring)
             out = [(i, j) for i, j in _box_pairs(r1.boxes, r2.boxes, self.tol)
-                   if shapely.distance(r1.components[i], r2.components[j]) <= self.tol]
+                   if shapely.intersects(r1.components[i], r2.components[j])
+                   or shapely.distance(r1.components[i], r2.components[j]) <= self.tol]
             self._links[key] = out
             self.counts["links_built"] += 1
         return self._links[key]
@@ -232,7 +237,9 @@ class SlabRegions:
 
         pt = shapely.Point(float(x), float(y))
         return [i for i in range(len(region.components))
-                if _box_near(region.boxes[i], x, y, self.tol) and shapely.distance(region.components[i], pt) <= self.tol]
+                if _box_near(region.boxes[i], x, y, self.tol)
+                and (shapely.intersects_xy(region.components[i], float(x), float(y))
+                     or shapely.distance(region.components[i], pt) <= self.tol)]
 
     def containing(self, region: Region, x: float, y: float) -> int | None:
         """The component of ``region`` that covers (x, y), or None.
@@ -264,8 +271,9 @@ class SlabRegions:
         return self._links[key]
 
 
-def point_free(pieces: list, bounds, x: float, y: float) -> bool:
-    """Is (x, y) in the bounds and outside every closed piece (exact predicates)?
+def point_free(pieces: list, bounds, x: float, y: float, boxes: np.ndarray | None = None) -> bool:
+    """Is (x, y) in the bounds and outside every closed piece (exact predicates)? ``boxes``:
+    the pieces' :func:`piece_boxes`, when the caller keeps them (a region's ``piece_boxes``).
 
     >>> point_free([np.array([[1., 1], [2, 1], [2, 2], [1, 2]])], (0, 3, 0, 3), 1.0, 1.5)
     False
@@ -275,11 +283,29 @@ def point_free(pieces: list, bounds, x: float, y: float) -> bool:
     xmin, xmax, ymin, ymax = bounds
     if not (xmin <= x <= xmax and ymin <= y <= ymax):
         return False
-    for p in pieces:
-        lo, hi = p.min(axis=0), p.max(axis=0)
-        if lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1] and point_in_convex(p, x, y) >= 0:
-            return False
-    return True
+    if boxes is None:
+        boxes = piece_boxes(pieces)
+    near = np.flatnonzero((boxes[:, 0] <= x) & (x <= boxes[:, 2]) & (boxes[:, 1] <= y) & (y <= boxes[:, 3]))
+    return not any(point_in_convex(pieces[k], x, y) >= 0 for k in near.tolist())
+
+
+def piece_boxes(pieces: list) -> np.ndarray:
+    """The pieces' boxes, (len(pieces), 4): min x, min y, max x, max y (an empty piece's box
+    holds no point).
+
+    >>> piece_boxes([np.array([[1., 1], [2, 1], [2, 3]])]).tolist()
+    [[1.0, 1.0, 2.0, 3.0]]
+    """
+    out = np.empty((len(pieces), 4))
+    out[:, :2], out[:, 2:] = np.inf, -np.inf
+    sizes = np.array([len(p) for p in pieces], dtype=np.int64)
+    full = np.flatnonzero(sizes > 0)
+    if len(full):
+        pts = np.concatenate([np.asarray(pieces[k], dtype=np.float64).reshape(-1, 2) for k in full.tolist()])
+        starts = np.concatenate([[0], np.cumsum(sizes[full])[:-1]])
+        out[full, :2] = np.minimum.reduceat(pts, starts, axis=0)
+        out[full, 2:] = np.maximum.reduceat(pts, starts, axis=0)
+    return out
 
 
 def deep_point(geom, depth: float) -> tuple[float, float] | None:
