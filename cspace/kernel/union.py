@@ -89,7 +89,7 @@ def faithful(region, polys, slack: float = 0.0) -> bool:
     # The inputs in the union: their samples in it, or within tol of it (rounded nodes).
     shapely.prepare(region)
     out = pts[~shapely.intersects_xy(region, pts[:, 0], pts[:, 1])]
-    if len(out) and not (shapely.distance(region, shapely.points(out)) <= tol).all():
+    if len(out) and not shapely.dwithin(region, shapely.points(out), tol).all():  # (prepared: indexed)
         return False
     # The union's boundary along the inputs' edges: its vertices and edge midpoints each
     # on one, within tol (a true union's boundary is made of pieces of the inputs' edges).

@@ -70,9 +70,14 @@ def free_space(pieces: list, bounds) -> "object":
     box = shapely.box(xmin, ymin, xmax, ymax)
     # Zero-area pieces (points, segments) have no area to subtract: they are handled
     # by the search (cspace.spaces.pathcheck.Degenerate), not here.
-    polys = [shapely.Polygon(p) for p in split_pieces(pieces)[0]]
-    if not polys:
+    proper = split_pieces(pieces)[0]
+    if not proper:
         return box
+    # every piece at once: one array of rings (each closed by its first vertex), then polygons
+    closed = [np.vstack([p, p[:1]]) for p in proper]
+    rings = shapely.linearrings(np.concatenate(closed), indices=np.repeat(np.arange(len(closed)),
+                                                                            [len(c) for c in closed]))
+    polys = shapely.polygons(rings)
     taken = union(polys)  # checked (cspace.kernel.union): GEOS's float overlay can drop a piece
     return shapely.orient_polygons(box.difference(taken)) if hasattr(shapely, "orient_polygons") \
         else _orient(box.difference(taken))

@@ -56,8 +56,10 @@ def search(cspace, query, time_limit: float | None, *, possible_only: bool = Fal
 
 def prepare(cspace, exact: bool = False) -> float:
     """Build the POSSIBLE regions of the first slabs (what :func:`quick_proof` reads) for a C-space
-    that will serve many queries, and with ``exact`` also their FREE regions and the meshes their
-    translations search (what :func:`exact_se2` reads first); returns the seconds it took."""
+    that will serve many queries, and with ``exact`` also their FREE regions, the meshes their
+    translations search and the links between them (what :func:`exact_se2` reads first), and
+    FREE of their halves (a pair through a narrow door refines there first); returns the seconds
+    it took."""
     from cspace.spaces.se2_exact import initial_partition
     from cspace.spaces.shortest import warm
 
@@ -69,9 +71,12 @@ def prepare(cspace, exact: bool = False) -> float:
         if exact:
             free = regions.free(a, b)
             warm(free.pieces, regions.bounds, free.components)
-    if exact:  # the links between neighbouring slabs' FREE components
-        for (a, b), (c, d) in zip(part, part[1:] + part[:1]):
+    if exact:
+        for (a, b), (c, d) in zip(part, part[1:] + part[:1]):  # the links between neighbouring slabs
             regions.free_links(regions.free(a, b), regions.free(c, d))
+        for a, b in part:  # FREE of the halves the search's first refinement bisects a slab into
+            regions.free(a, 0.5 * (a + b))
+            regions.free(0.5 * (a + b), b)
     return time.perf_counter() - t
 
 
