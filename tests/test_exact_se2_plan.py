@@ -227,3 +227,23 @@ def test_bench_se2_exact_runs_and_counts_from_the_call(tmp_path, capsys):
     assert rows["wide_square"]["exact_path_cpu_s"] == math.inf  # (JSON's Infinity)
     text = capsys.readouterr().out
     assert "time to a path from plan()'s start" in text and "/1 solvable scenes" in text
+
+
+def test_a_prepared_cspace_answers_as_a_fresh_one_without_building_its_first_slabs():
+    # prepare(exact=True) builds what the first queries read (FREE of the first slabs and their
+    # halves, their meshes and links): the same certified path as a C-space built in the call,
+    # and no FREE region of a slab built again (at most the ends' own angles, zero-width slabs)
+    from cspace.spaces.se2_exact import initial_partition
+    from planners.core.exact_se2 import _regions_of, prepare
+    from planners.core.plan import build_cspace
+
+    sc = load_scenario(os.path.join(SCENARIOS, "se2", "bar_door.toml"))
+    fresh = planners.plan(sc, planner="exact", simplify=False)
+    cs = build_cspace(sc)
+    assert prepare(cs, exact=True) > 0
+    regions = _regions_of(cs)
+    built = regions.counts["free_built"]
+    assert built >= 3 * len(initial_partition())  # the 8 slabs and their 16 halves
+    again = planners.plan(sc, planner="exact", simplify=False, cspace=cs)
+    assert again.solved and fresh.solved and np.array_equal(again.path, fresh.path)
+    assert again.checks["refinements"] == 0 and regions.counts["free_built"] - built <= 2
