@@ -297,7 +297,8 @@ class _Search:
             # its own angle first): the FREE at its angle alone is built only when none holds it.
             direct = [] if same else [(k, c) for k in holding(self.part, th)
                                       for c in [self.R.containing(freg[k], x, y)]
-                                      if c is not None and point_free(freg[k].pieces, self.R.bounds, x, y, freg[k].piece_boxes)]
+                                      if c is not None
+                                      and point_free(freg[k].pieces, self.R.bounds, x, y, freg[k].piece_boxes)]
             for k, c in direct:
                 adj[virtual].append(((k, c), (x, y)))
                 adj[(k, c)].append((virtual, (x, y)))
