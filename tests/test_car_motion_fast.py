@@ -199,19 +199,19 @@ def test_a_real_plan_replayed_both_ways(scenes):
     sc, _, pure = scenes["parking.toml"]
     fresh = SE2CSpace.from_scenario(sc)
     asked = []
-    inner = fresh.curve_free
+    inner = fresh.car_motion_free
 
-    def logged(q0, segs, radius, q1=None):
-        r = inner(q0, segs, radius, q1=q1)
-        asked.append((tuple(q0), list(segs), radius, None if q1 is None else tuple(q1), r))
+    def logged(q0, q1, kind, radius):
+        r = inner(q0, q1, kind, radius)
+        asked.append((tuple(q0), tuple(q1), kind, radius, r))
         return r
 
-    fresh.curve_free = logged
+    fresh.car_motion_free = logged
     res = plan(sc, planner="RRTConnect", seed=1, time=10.0, cspace=fresh)
     assert res.solved and len(asked) > 50
     assert any(r for *_, r in asked) and not all(r for *_, r in asked)
-    for q0, segs, radius, q1, r in asked:
-        assert pure.curve_free(q0, segs, radius, q1=q1) == r
+    for q0, q1, kind, radius, r in asked:  # the pure path, from the Python segments
+        assert kind == "reeds-shepp" and pure.curve_free(q0, reeds_shepp_segments(q0, q1, radius), radius, q1=q1) == r
     path = np.asarray(res.path)
     j = oracle.car_sweep_check(sc, path, lambda a, b: reeds_shepp_segments(a, b, sc.turning_radius),
                                sc.turning_radius)
@@ -279,3 +279,78 @@ def test_pure_answers_are_sweep_checked(scenes):
             n += 1
             assert not judged_colliding(sc, a, b, segs), (a, b, segs)
     assert n > 0
+
+
+def compiled_motion(cs, q0, q1, kind, radius):
+    """The compiled motion alone (fastpath.car_motion): (r, chain's end), slabs built as asked."""
+    curve = fastpath.car_curve(cs, MAX_HULLS, FLOOR_REL, ARC_CHUNK)
+    motion = fastpath.car_motion(curve)
+    grids = [None] * cs.slabs
+    while True:
+        r, *end = motion(grids, *q0, *q1, float(radius), kind == "dubins", 1e6 * cs.extent, 64 * 2 * math.pi * radius)
+        if r >= -1:
+            return r, tuple(end)
+        grids[-2 - r] = cs.slab(-2 - r)._fast
+
+
+def _motion_pairs(sc, cs, seed):
+    pairs = random_curves(sc, cs, 300, seed=seed)
+    a = pairs[0][0]
+    # the same pose, a hair apart (Dubins' "nearly the same pose" rule), heading ±π, reversed
+    pairs += [(a, a), (a, (a[0] + 1e-9, a[1], a[2])), (a, (a[0], a[1] + 1e-7, a[2] + 1e-8)),
+              ((a[0], a[1], -math.pi), (a[0] + 0.5, a[1], math.pi - 1e-15)), (pairs[1][1], pairs[1][0])]
+    return pairs
+
+
+@compiled
+@pytest.mark.parametrize("name", [os.path.basename(f) for f in CAR_FILES])
+@pytest.mark.parametrize("kind", ["dubins", "reeds-shepp"])
+def test_compiled_motion_is_the_curve_of_the_python_segments(scenes, name, kind):
+    """fastpath.car_motion computes the segments in C: the same chain end, bit for bit, and the
+    same answer as the compiled curve check of the Python segments; the product's answer
+    (car_motion_free) is the pure path's on the Python segments."""
+    sc, cs, pure = scenes[name]
+    r = sc.turning_radius
+    seg = dubins_segments if kind == "dubins" else reeds_shepp_segments
+    decided = 0
+    for a, b in _motion_pairs(sc, cs, seed=11):
+        segs = seg(a, b, r)
+        got, end = compiled_motion(cs, a, b, kind, r)
+        want = compiled_answer(cs, a, segs, r)
+        assert got == want, (a, b, segs, got, want)
+        if got >= 0:
+            decided += 1
+            f = fastpath.car_curve(cs, MAX_HULLS, FLOOR_REL, ARC_CHUNK)
+            grids = [cs.slab(k)._fast for k in range(cs.slabs)]
+            assert end == tuple(f(grids, a[0], a[1], wrap_angle(a[2]), segs, r)[1:]), (a, b, segs)
+        full = pure.curve_free(a, segs, r, q1=b)
+        assert cs.car_motion_free(a, b, kind, r) == full == pure.car_motion_free(a, b, kind, r), (a, b, segs)
+    assert decided >= 0.97 * 305
+
+
+@compiled
+def test_compiled_motion_declines_what_python_decides(scenes):
+    """Headings past 2^20 (Python wraps them first), poses past 1e100 radii apart, segments past
+    the curve check's bounds and bad arguments: -1 or an error, never an answer of its own."""
+    sc, cs, pure = scenes["parking.toml"]
+    start = tuple(sc.all_queries()[0].start)
+    far = (start[0], start[1], start[2] + 2.0**21)
+    assert compiled_motion(cs, start, far, "reeds-shepp", 1.0)[0] == -1
+    assert compiled_motion(cs, start, (start[0] + 1.0, start[1], 0.0), "dubins", 1e-101)[0] == -1
+    motion = fastpath.car_motion(fastpath.car_curve(cs, MAX_HULLS, FLOOR_REL, ARC_CHUNK))
+    grids = [cs.slab(k)._fast for k in range(cs.slabs)]
+    # the straight 1.0 ahead exceeds a `longest` of 0.5: the Python check would refuse it
+    assert motion(grids, *start, start[0] + math.cos(start[2]), start[1] + math.sin(start[2]), start[2], 1.0,
+                  False, 0.5, 400.0)[0] == -1
+    assert motion(grids, float("nan"), 1.0, 0.0, 2.0, 1.0, 0.0, 1.0, False, 1e9, 400.0)[0] == -1
+    with pytest.raises(TypeError):
+        motion(grids, 1.0)
+    with pytest.raises(TypeError):
+        motion([None], *start, *start, 1.0, False, 1e9, 400.0)
+    with pytest.raises(ValueError):
+        cs.car_motion_free(start, start, "bicycle", 1.0)
+    with pytest.raises(ValueError):  # the full path words the error, as before
+        cs.car_motion_free(start, (1.0, float("inf"), 0.0), "reeds-shepp", 1.0)
+    # past the slab grid's headings the product still answers, by the Python path
+    assert cs.car_motion_free(start, far, "reeds-shepp", sc.turning_radius) == \
+        pure.curve_free(start, reeds_shepp_segments(start, far, sc.turning_radius), sc.turning_radius, q1=far)

@@ -193,3 +193,28 @@ def test_a_car_path_reports_the_clearance_of_its_curves(tmp_path):
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "objective" in r.stderr
     r = cli("plan", os.path.join(SCENARIOS, "car", "maze.toml"))
     assert r.returncode == 0 and "min clearance " in r.stdout and "(a certified lower bound)" in r.stdout
+
+
+def test_kept_curves_are_the_computed_curves():
+    """CarSpace keeps the curves of the motions it was asked about: a kept curve is the one
+    car_curves computes, for the same pose pair only (a zero coordinate, equal to -0.0, is
+    never a key), and a copy the caller may change."""
+    from planners.core.plan import build_cspace, make_adapter
+
+    for path in CARS:
+        sc = load_scenario(path)
+        adapter = make_adapter(sc, build_cspace(sc))
+        f = _segments_of(sc)
+        rng = np.random.default_rng(5)
+        xmin, xmax, ymin, ymax = sc.bounds
+        poses = [(float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax)), float(rng.uniform(-3, 3)))
+                 for _ in range(40)]
+        pairs = list(zip(poses[:-1], poses[1:]))
+        pairs += [((1.0, 2.0, 0.0), (3.0, 2.0, -0.0)), ((1.0, 2.0, -0.0), (3.0, 2.0, 0.0)), (poses[0], poses[0])]
+        for _ in range(2):  # the second time from the kept curves
+            for a, b in pairs:
+                got = adapter.segments(a, b)
+                assert got == f(a, b)
+                assert [math.copysign(1.0, v) for _, v in got] == [math.copysign(1.0, v) for _, v in f(a, b)]
+                got.append(("S", 1.0))  # the caller's copy
+        assert adapter.segments(np.array(poses[0]), np.array(poses[1])) == f(poses[0], poses[1])

@@ -475,72 +475,26 @@ static int64_t arc(Car *h, PyObject *grids, const Link *L, double radius, int64_
     return 1;
 }
 
-/* car_curve(handle, grids, x, y, th, segments, radius) -> (r, x, y, th): r 1 free, 0 not free,
-   -1 undecided, -2 - k slab k not built; (x, y, th) the chain's end (th wrapped). */
-PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* One segment appended to the chain from its end (px, py, pt): 1, or R_UNDECIDED where the
+   knot is not finite. A zero length adds nothing (as the Python path drops it). */
+static int64_t link_segment(Link *chain, int *nl, double *p, char kind, double length, double radius)
 {
-    if (nargs != 7) {
-        PyErr_SetString(PyExc_TypeError, "car_curve(handle, grids, x, y, th, segments, radius)");
-        return NULL;
-    }
-    Car *h = (Car *)PyCapsule_GetPointer(args[0], "cspace.spaces._fast.Car");
-    if (!h) return NULL;
-    PyObject *grids = args[1];
-    if (!PyList_Check(grids) || PyList_GET_SIZE(grids) != h->K) {
-        PyErr_SetString(PyExc_TypeError, "car_curve: grids must be a list of one entry per slab");
-        return NULL;
-    }
-    double q[3], radius;
-    for (int i = 0; i < 3; i++) {
-        q[i] = PyFloat_AsDouble(args[2 + i]);
-        if (q[i] == -1.0 && PyErr_Occurred()) return NULL;
-    }
-    radius = PyFloat_AsDouble(args[6]);
-    if (radius == -1.0 && PyErr_Occurred()) return NULL;
-    int64_t res = 1;
-    Link chain[MAX_SEGMENTS];
-    int nl = 0;
-    double px = q[0], py = q[1], pt = q[2];
-    PyObject *seq = PySequence_Fast(args[5], "car_curve: segments must be a sequence");
-    if (!seq) return NULL;
-    Py_ssize_t ns = PySequence_Fast_GET_SIZE(seq);
-    if (!(isfinite(px) && isfinite(py) && isfinite(pt) && isfinite(radius) && radius > 0.0) || ns > MAX_SEGMENTS)
-        res = R_UNDECIDED;
-    for (Py_ssize_t i = 0; i < ns && res == 1; i++) {
-        PyObject *it = PySequence_Fast_GET_ITEM(seq, i);
-        if (!PyTuple_Check(it) || PyTuple_GET_SIZE(it) != 2 || !PyUnicode_Check(PyTuple_GET_ITEM(it, 0))) {
-            res = R_UNDECIDED;
-            break;
-        }
-        Py_ssize_t klen;
-        const char *ks = PyUnicode_AsUTF8AndSize(PyTuple_GET_ITEM(it, 0), &klen);
-        if (!ks) {
-            Py_DECREF(seq);
-            return NULL;
-        }
-        double length = PyFloat_AsDouble(PyTuple_GET_ITEM(it, 1));
-        if (length == -1.0 && PyErr_Occurred()) {
-            PyErr_Clear();
-            res = R_UNDECIDED;
-            break;
-        }
-        if (klen != 1 || (ks[0] != 'L' && ks[0] != 'S' && ks[0] != 'R') || !isfinite(length)) {
-            res = R_UNDECIDED;
-            break;
-        }
-        if (length == 0.0) continue;
-        Link *L = chain + nl++;
-        double e[3];
-        advance(px, py, pt, ks[0], length, radius, e);
-        if (!(isfinite(e[0]) && isfinite(e[1]) && isfinite(e[2]))) {
-            res = R_UNDECIDED;
-            break;
-        }
-        L->sx = px, L->sy = py, L->st = pt, L->kind = ks[0], L->length = length;
-        L->ex = e[0], L->ey = e[1], L->et = wrap_angle(e[2]);
-        px = L->ex, py = L->ey, pt = L->et;
-    }
-    Py_DECREF(seq);
+    if (length == 0.0) return 1;
+    Link *L = chain + (*nl)++;
+    double e[3];
+    advance(p[0], p[1], p[2], kind, length, radius, e);
+    if (!(isfinite(e[0]) && isfinite(e[1]) && isfinite(e[2]))) return R_UNDECIDED;
+    L->sx = p[0], L->sy = p[1], L->st = p[2], L->kind = kind, L->length = length;
+    L->ex = e[0], L->ey = e[1], L->et = wrap_angle(e[2]);
+    p[0] = L->ex, p[1] = L->ey, p[2] = L->et;
+    return 1;
+}
+
+/* The chain from q (res 1 so far) certified: the probe, straight segments, then arcs, counted
+   as the Python path counts; (r, x, y, th) with (x, y, th) = p, the chain's end. */
+static PyObject *check_chain(Car *h, PyObject *grids, const double *q, const Link *chain, int nl, int64_t res,
+                             const double *p, double radius)
+{
     long n_arcs = 0, n_sweeps = 0, n_coll = 0;
     if (res == 1) {
         res = car_pose(h, grids, q[0], q[1], q[2]);
@@ -576,5 +530,116 @@ PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs
             return NULL;
     }
     long code = res >= 0 ? (long)res : (res == R_UNDECIDED ? -1 : (long)(-2 - (-3 - res)));
-    return Py_BuildValue("(lddd)", code, px, py, pt);
+    return Py_BuildValue("(lddd)", code, p[0], p[1], p[2]);
+}
+
+static Car *car_args(PyObject *const *args, const char *sig)
+{
+    Car *h = (Car *)PyCapsule_GetPointer(args[0], "cspace.spaces._fast.Car");
+    if (!h) return NULL;
+    if (!PyList_Check(args[1]) || PyList_GET_SIZE(args[1]) != h->K) {
+        PyErr_Format(PyExc_TypeError, "%s: grids must be a list of one entry per slab", sig);
+        return NULL;
+    }
+    return h;
+}
+
+static int doubles(PyObject *const *args, int n, double *out)
+{
+    for (int i = 0; i < n; i++) {
+        out[i] = PyFloat_AsDouble(args[i]);
+        if (out[i] == -1.0 && PyErr_Occurred()) return -1;
+    }
+    return 0;
+}
+
+/* car_curve(handle, grids, x, y, th, segments, radius) -> (r, x, y, th): r 1 free, 0 not free,
+   -1 undecided, -2 - k slab k not built; (x, y, th) the chain's end (th wrapped). */
+PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 7) {
+        PyErr_SetString(PyExc_TypeError, "car_curve(handle, grids, x, y, th, segments, radius)");
+        return NULL;
+    }
+    Car *h = car_args(args, "car_curve");
+    if (!h) return NULL;
+    double q[3], radius;
+    if (doubles(args + 2, 3, q) < 0 || doubles(args + 6, 1, &radius) < 0) return NULL;
+    int64_t res = 1;
+    Link chain[MAX_SEGMENTS];
+    int nl = 0;
+    double p[3] = {q[0], q[1], q[2]};
+    PyObject *seq = PySequence_Fast(args[5], "car_curve: segments must be a sequence");
+    if (!seq) return NULL;
+    Py_ssize_t ns = PySequence_Fast_GET_SIZE(seq);
+    if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]) && isfinite(radius) && radius > 0.0) || ns > MAX_SEGMENTS)
+        res = R_UNDECIDED;
+    for (Py_ssize_t i = 0; i < ns && res == 1; i++) {
+        PyObject *it = PySequence_Fast_GET_ITEM(seq, i);
+        if (!PyTuple_Check(it) || PyTuple_GET_SIZE(it) != 2 || !PyUnicode_Check(PyTuple_GET_ITEM(it, 0))) {
+            res = R_UNDECIDED;
+            break;
+        }
+        Py_ssize_t klen;
+        const char *ks = PyUnicode_AsUTF8AndSize(PyTuple_GET_ITEM(it, 0), &klen);
+        if (!ks) {
+            Py_DECREF(seq);
+            return NULL;
+        }
+        double length = PyFloat_AsDouble(PyTuple_GET_ITEM(it, 1));
+        if (length == -1.0 && PyErr_Occurred()) {
+            PyErr_Clear();
+            res = R_UNDECIDED;
+            break;
+        }
+        if (klen != 1 || (ks[0] != 'L' && ks[0] != 'S' && ks[0] != 'R') || !isfinite(length)) {
+            res = R_UNDECIDED;
+            break;
+        }
+        res = link_segment(chain, &nl, p, ks[0], length, radius);
+    }
+    Py_DECREF(seq);
+    return check_chain(h, args[1], q, chain, nl, res, p, radius);
+}
+
+/* car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns) -> (r, x, y, th):
+   the car's shortest curve from q0 to q1 (fast_car_segments: car_curves' segments, the same
+   doubles) checked as car_curve checks it from q0 with its angle wrapped. -1 (undecided) also
+   where the Python segments would differ in branch or fail pose_checks.curve_segments' bounds
+   (a length above `longest`, an arc above `turns`): the caller runs the Python path. */
+PyObject *fast_car_motion(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 12) {
+        PyErr_SetString(PyExc_TypeError,
+                        "car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns)");
+        return NULL;
+    }
+    Car *h = car_args(args, "car_motion");
+    if (!h) return NULL;
+    double v[9];
+    if (doubles(args + 2, 7, v) < 0 || doubles(args + 10, 2, v + 7) < 0) return NULL;
+    int dubins = PyObject_IsTrue(args[9]);
+    if (dubins < 0) return NULL;
+    const double *q0 = v, *q1 = v + 3;
+    double radius = v[6], longest = v[7], turns = v[8];
+    char kinds[5];
+    double lengths[5];
+    int64_t res = 1;
+    int ns = -1, nl = 0;
+    for (int i = 0; i < 6; i++)
+        if (!isfinite(v[i])) res = R_UNDECIDED;
+    if (!(isfinite(radius) && radius > 0.0)) res = R_UNDECIDED;
+    if (res == 1) ns = fast_car_segments(dubins, q0, q1, radius, kinds, lengths);
+    if (ns < 0) res = R_UNDECIDED;
+    double q[3] = {q0[0], q0[1], wrap_angle(q0[2])};
+    double p[3] = {q[0], q[1], q[2]};
+    Link chain[MAX_SEGMENTS];
+    for (int i = 0; i < ns && res == 1; i++) {
+        if (!(fabs(lengths[i]) <= longest) || (kinds[i] != 'S' && fabs(lengths[i]) > turns)) {
+            res = R_UNDECIDED;
+            break;
+        }
+        res = link_segment(chain, &nl, p, kinds[i], lengths[i], radius);
+    }
+    return check_chain(h, args[1], q, chain, nl, res, p, radius);
 }

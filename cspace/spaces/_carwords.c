@@ -351,30 +351,78 @@ static int d_lrl(double d, double a, double b, double *o)
     return 1;
 }
 
-/* dubins_word(d, alpha, beta) -> (word, (t, p, q)) or None (the Python function decides). */
-PyObject *fast_dubins_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* dubins_word_pure's choice: 1 with the word and (t, p, q) written, 0 where the Python
+   function must decide (huge or non-finite values). */
+static int dubins_best(double d, double alpha, double beta, const char **word, double *best)
 {
     static const char *words[6] = {"LSL", "RSR", "RSL", "LSR", "RLR", "LRL"};
     int (*solvers[6])(double, double, double, double *) = {d_lsl, d_rsr, d_rsl, d_lsr, d_rlr, d_lrl};
-    double q[3], best[3] = {0, 0, 0}, bsum = 0.0;
-    if (three_doubles(args, nargs, q, "dubins_word(d, alpha, beta)") < 0) return NULL;
-    double d = q[0], alpha = q[1], beta = q[2];
-    if (!(fabs(d) < 1e150 && fabs(alpha) < 1e150 && fabs(beta) < 1e150)) Py_RETURN_NONE;
+    double bsum = 0.0;
+    best[0] = best[1] = best[2] = 0.0;
+    if (!(fabs(d) < 1e150 && fabs(alpha) < 1e150 && fabs(beta) < 1e150)) return 0;
     if (d < DUBINS_NEAR && fabs(alpha - beta) < DUBINS_NEAR) {
         best[1] = d;
-        return word_result("LSL", best, 3);
+        *word = "LSL";
+        return 1;
     }
     int found = -1;
     for (int w = 0; w < 6; w++) {
         double o[3];
         if (!solvers[w](d, alpha, beta, o)) continue;
-        if (!(isfinite(o[0]) && isfinite(o[1]) && isfinite(o[2]))) Py_RETURN_NONE;
+        if (!(isfinite(o[0]) && isfinite(o[1]) && isfinite(o[2]))) return 0;
         double s = 0.0 + o[0] + o[1] + o[2];
         if (found < 0 || s < bsum) {
             found = w, bsum = s;
             best[0] = o[0], best[1] = o[1], best[2] = o[2];
         }
     }
-    if (found < 0) Py_RETURN_NONE;
-    return word_result(words[found], best, 3);
+    if (found < 0) return 0;
+    *word = words[found];
+    return 1;
+}
+
+/* dubins_word(d, alpha, beta) -> (word, (t, p, q)) or None (the Python function decides). */
+PyObject *fast_dubins_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    double q[3], best[3];
+    const char *word = NULL;
+    if (three_doubles(args, nargs, q, "dubins_word(d, alpha, beta)") < 0) return NULL;
+    if (!dubins_best(q[0], q[1], q[2], &word, best)) Py_RETURN_NONE;
+    return word_result(word, best, 3);
+}
+
+/* ------------------------------------------------------------------ segments */
+
+/* car_curves.dubins_segments / reeds_shepp_segments for poses of three finite floats and a
+   valid radius r, with the same doubles: the frame (dubins_frame / reeds_shepp_frame), the
+   word, then each nonzero length times r. Writes up to 5 segments (kinds 'L' 'S' 'R') and
+   returns their count, or -1 wherever the Python function would take another branch (a
+   heading beyond 2^20 that it wraps first, a frame past 1e100 radii, a word the compiled
+   one declines, a length that overflows): the caller then runs the Python function. */
+int fast_car_segments(int dubins, const double *q0, const double *q1, double r, char *kinds, double *lengths)
+{
+    if (!(fabs(q0[2]) <= 0x1p20 && fabs(q1[2]) <= 0x1p20)) return -1;
+    double dx = q1[0] - q0[0], dy = q1[1] - q0[1], best[5];
+    const char *word = NULL;
+    int n = 3;
+    if (dubins) {
+        double th = atan2(dy, dx);
+        double d = sqrt(dx * dx + dy * dy) / r, alpha = turn_angle(q0[2] - th), beta = turn_angle(q1[2] - th);
+        if (!(fabs(d) <= 1e100 && fabs(alpha) <= 1e100)) return -1;
+        if (!dubins_best(d, alpha, beta, &word, best)) return -1;
+    } else {
+        double c = cos(q0[2]), s = sin(q0[2]);
+        double x = (c * dx + s * dy) / r, y = (-s * dx + c * dy) / r, phi = q1[2] - q0[2];
+        if (!(fabs(x) <= 1e100 && fabs(y) <= 1e100)) return -1;
+        if (!(fabs(x) < 1e150 && fabs(y) < 1e150 && fabs(phi) < 1e150)) return -1;
+        if (rs_word(x, y, phi, &word, best, &n) != 1) return -1;
+    }
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        if (best[i] == 0.0) continue;
+        double v = best[i] * r;
+        if (!isfinite(v)) return -1;
+        kinds[m] = word[i], lengths[m++] = v;
+    }
+    return m;
 }

@@ -658,6 +658,9 @@ static PyMethodDef methods[] = {
      "car_handle(...): the data of the compiled car curve check (_carmotion.c)."},
     {"car_curve", (PyCFunction)(void (*)(void))fast_car_curve, METH_FASTCALL,
      "car_curve(handle, grids, x, y, th, segments, radius): (r, x, y, th), r 1 free, 0 not, -1 undecided, -2-k slab k (_carmotion.c)."},
+    {"car_motion", (PyCFunction)(void (*)(void))fast_car_motion, METH_FASTCALL,
+     "car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns): car_curve of the "
+     "shortest curve's segments, computed here with car_curves' doubles (_carmotion.c)."},
     {"reeds_shepp_word", (PyCFunction)(void (*)(void))fast_reeds_shepp_word, METH_FASTCALL,
      "reeds_shepp_word(x, y, phi): reeds_shepp.py's word and lengths, the same doubles, or None (_carwords.c)."},
     {"dubins_word", (PyCFunction)(void (*)(void))fast_dubins_word, METH_FASTCALL,

@@ -210,6 +210,8 @@ PyObject *fast_se2_motion_handle(PyObject *self, PyObject *args);              /
 PyObject *fast_se2_motion(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _se2motion.c */
 PyObject *fast_car_handle(PyObject *self, PyObject *args);                     /* _carmotion.c */
 PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carmotion.c */
+PyObject *fast_car_motion(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carmotion.c */
+int fast_car_segments(int dubins, const double *q0, const double *q1, double r, char *kinds, double *lengths); /* _carwords.c */
 PyObject *fast_reeds_shepp_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */
 PyObject *fast_dubins_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */
 PyObject *fast_disc_cost_handle(PyObject *self, PyObject *args);               /* _disccost.c */

@@ -38,8 +38,8 @@ import math
 import numpy as np
 
 from . import fastpath
-from .car_curves import advance, turning_centre
-from .pose_checks import curve_radius, curve_segments, se2_pose
+from .car_curves import advance, dubins_segments, reeds_shepp_segments, turning_centre
+from .pose_checks import MAX_ARC_TURNS, MAX_SEGMENT_EXTENTS, curve_radius, curve_segments, se2_pose
 from ..kernel.slab import rotate_piece, slab_pad, wrap_angle
 
 # Initial split of an arc: intervals of at most this angle (the bound's excess over
@@ -80,8 +80,61 @@ class CarMotions:
     """The car-like motion queries of :class:`cspace.spaces.se2.SE2CSpace` (a mixin)."""
 
     _car_planes = None
-    # The compiled curve check (fastpath.car_curve), made on the first curve; None: pure.
+    # The compiled curve check (fastpath.car_curve) and motion check (fastpath.car_motion) on
+    # one handle, made on the first curve; None: pure.
     _car_fast = False
+    _car_motion = None
+
+    def car_motion_free(self, q0, q1, kind: str, radius: float) -> bool:
+        """Is the car free along the shortest curve of ``kind`` ("dubins" or "reeds-shepp") from q0
+        to q1? :meth:`curve_free` of :mod:`cspace.spaces.car_curves`' segments, joined to q1.
+
+        On the compiled path the segments are computed and checked in one call, with the same
+        doubles (cspace/spaces/_carwords.c, _carmotion.c); anything it declines runs here.
+
+        >>> import numpy as np
+        >>> from cspace.spaces.se2 import SE2CSpace
+        >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+        >>> box = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
+        >>> cs = SE2CSpace((0, 10, 0, 10), [sq], [box], slabs=16)
+        >>> cs.car_motion_free((1.0, 1.0, 0.0), (8.0, 1.0, 0.0), "reeds-shepp", 1.0)  # along y = 1
+        True
+        >>> cs.car_motion_free((1.0, 5.0, 0.0), (8.0, 5.0, 0.0), "dubins", 1.0)  # through the square
+        False
+        """
+        dubins = kind == "dubins"
+        if not dubins and kind != "reeds-shepp":
+            raise ValueError(f"kind: 'dubins' or 'reeds-shepp', got {kind!r}")
+        if self._car_fast is not None and type(q0) is tuple and type(q1) is tuple:
+            got = self._car_motion_call(q0, q1, dubins, radius)
+            if got is not None:
+                return got
+        segments = (dubins_segments if dubins else reeds_shepp_segments)(q0, q1, radius)
+        return self.curve_free(q0, segments, radius, q1=q1)
+
+    def _car_motion_call(self, q0, q1, dubins: bool, radius):
+        """:meth:`car_motion_free` in one compiled call (fastpath.car_motion), or None when it
+        cannot decide (or the arguments are not the usual floats: the full path checks them)."""
+        q0, q1 = se2_pose(q0, "q0"), se2_pose(q1, "q1")
+        radius = curve_radius(radius, self.extent)
+        if self._car_fast is False and self._compile_car() is None:
+            return None
+        self.checks["curves"] += 1
+        grids = self._car_grids
+        turns = MAX_ARC_TURNS * 2.0 * math.pi * radius
+        motion = self._car_motion
+        while True:  # one call; a slab not built yet is built and the call repeated
+            r, x, y, th = motion(grids, *q0, *q1, radius, dubins, MAX_SEGMENT_EXTENTS * self.extent, turns)
+            if r == 0:
+                return False
+            if r == 1:
+                break
+            if r == -1 or (handle := self.slab(-2 - r)._fast) is None:
+                self.checks["curves"] -= 1  # the full path counts it
+                return None
+            grids[-2 - r] = handle
+        q1 = (q1[0], q1[1], wrap_angle(q1[2]))
+        return (x, y, th) == q1 or self.motion_free((x, y, th), q1)
 
     def curve_free(self, q0, segments, radius: float, q1=None) -> bool:
         """Is every pose of the segment chain from q0 free? Certified (see module doc).
@@ -109,14 +162,21 @@ class CarMotions:
         self.checks["curves"] += 1
         pose = (x, y, wrap_angle(th))
         fast = self._car_fast
-        if fast is False:  # first curve: the compiled check, or None on the pure path
-            fast = self._car_fast = fastpath.car_curve(self, MAX_HULLS, FLOOR_REL, ARC_CHUNK)
-            self._car_grids = [None] * self.slabs
+        if fast is False:
+            fast = self._compile_car()
         if fast is not None:
             got = self._curve_fast(fast, pose, segments, radius, q1)
             if got is not None:
                 return got
         return self._curve_pure(pose, segments, radius, q1)
+
+    def _compile_car(self):
+        """The first curve: the compiled checks on one handle, or None on the pure path."""
+        self._car_fast = fastpath.car_curve(self, MAX_HULLS, FLOOR_REL, ARC_CHUNK)
+        self._car_grids = [None] * self.slabs
+        if self._car_fast is not None:
+            self._car_motion = fastpath.car_motion(self._car_fast)
+        return self._car_fast
 
     def _curve_fast(self, fast, pose, segments, radius: float, q1):
         """:meth:`curve_free` by the compiled check (cspace/spaces/_carmotion.c: its "free" and

@@ -445,6 +445,30 @@ def car_curve(cs, max_hulls: int, floor_rel: float, arc_chunk: float):
     return functools.partial(_fast.car_curve, handle)
 
 
+def car_motion(curve):
+    """The compiled car motion on the handle of ``curve`` (a check :func:`car_curve` made):
+    ``(grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns) -> (r, x, y, th)``,
+    the segments of :func:`cspace.spaces.car_curves.dubins_segments` (``dubins`` true) or
+    ``reeds_shepp_segments`` computed in C with their doubles (cspace/spaces/_carwords.c),
+    then checked as ``curve`` checks them from q0 (its angle wrapped). r as ``curve``'s, and
+    -1 also where the Python segments would take another branch, or a segment would exceed
+    ``longest`` (an arc ``turns``): the caller runs the Python path.
+
+    >>> import math
+    >>> import numpy as np
+    >>> from cspace.spaces.se2 import SE2CSpace
+    >>> cs = SE2CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])],
+    ...                [np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])], slabs=16)
+    >>> c = car_curve(cs, 4096, 1e-9, math.pi / 8)
+    >>> grids = [cs.slab(k)._fast for k in range(16)]
+    >>> c is None or car_motion(c)(grids, 1.0, 1.0, 0.0, 8.0, 1.0, 0.0, 1.0, False, 1e7, 400.0)[0] == 1
+    True
+    """
+    import functools
+
+    return functools.partial(_fast.car_motion, curve.args[0])
+
+
 def reeds_shepp_word(x: float, y: float, phi: float):
     """:func:`cspace.spaces.reeds_shepp.reeds_shepp_word` compiled (cspace/spaces/_carwords.c: the
     same float operations, the same word and doubles), or None on the pure path or where the

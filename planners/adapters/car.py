@@ -12,6 +12,7 @@ hulls about the turning centre), never sampled.
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -21,6 +22,7 @@ from cspace.spaces.car_curves import curve_length, dubins_segments, knots, pose_
 from .se2 import SE2Space
 from .frame import scaled_bounds
 
+SEGMENTS_KEPT = 512
 SEGMENT_NAMES = {"L": "left", "S": "straight", "R": "right"}
 
 
@@ -40,7 +42,10 @@ class CarSpace(SE2Space):
             raise ValueError(f"CarSpace: kind must be 'dubins' or 'reeds-shepp', got {kind!r}")
         self.name = kind
         self.radius = float(radius)
-        self._segments = dubins_segments if kind == "dubins" else reeds_shepp_segments
+        curve, r = (dubins_segments if kind == "dubins" else reeds_shepp_segments), self.radius
+        # The curves of a path's motions are asked for again and again (its length when it is
+        # found, when it is returned, its JSON and picture): the last few hundred are kept.
+        self._curve = functools.lru_cache(maxsize=SEGMENTS_KEPT)(lambda q0, q1: curve(q0, q1, r))
 
     def state_space(self):
         from .glue import ompl
@@ -63,12 +68,15 @@ class CarSpace(SE2Space):
 
     def segments(self, q0, q1) -> list:
         """The motion q0 -> q1 as (kind, signed length) segments (the shortest curve)."""
-        return self._segments(q0, q1, self.radius)
+        if type(q0) is tuple and type(q1) is tuple and 0.0 not in q0 and 0.0 not in q1:
+            # the kept curves (a key with a zero is not: 0.0 == -0.0, and their curves may differ)
+            return list(self._curve(q0, q1))
+        return self._curve.__wrapped__(q0, q1)
 
     def motion_free(self, q0, q1) -> bool:
         """Whether the car, driven along the shortest curve from q0 to q1, touches nothing
-        (certified: :meth:`cspace.spaces.se2.SE2CSpace.curve_free`)."""
-        return self.cspace.curve_free(q0, self.segments(q0, q1), self.radius, q1=q1)
+        (certified: :meth:`cspace.spaces.se2.SE2CSpace.car_motion_free`)."""
+        return self.cspace.car_motion_free(q0, q1, self.name, self.radius)
 
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every curve between consecutive poses certified free, from the start pose to the goal pose.
