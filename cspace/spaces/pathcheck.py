@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernel.polygon import as_array, collinear_extent, orientation
+from ..kernel.polygon import as_array, collinear_extent, orientation, piece_boxes
 from ..kernel.predicates import orient2d_many, orient2d_xy
 
 
@@ -196,8 +196,7 @@ def path_violations(path, pieces: list, bounds=None) -> list[tuple[int, int]]:
     proper_idx = [k for k, f in enumerate(flat) if not f]
     deg_idx = [k for k, f in enumerate(flat) if f and len(pieces[k])]
     proper = [np.asarray(pieces[k], dtype=np.float64) for k in proper_idx]
-    plo = np.array([p.min(axis=0) for p in proper]).reshape(-1, 2)
-    phi = np.array([p.max(axis=0) for p in proper]).reshape(-1, 2)
+    plo, phi = piece_boxes(proper)  # every box in two reductions
     deg = Degenerate([collinear_extent(pieces[k]) for k in deg_idx])
     out = []
     for e in range(len(pts) - 1):

@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kernel.minkowski import minkowski_sum, reflect
-from ..kernel.polygon import point_in_convex
+from ..kernel.polygon import piece_boxes as box_pairs, point_in_convex
 from ..kernel.slab import ANGLE_SLACK, robot_radius, rotate_piece, slab_hull, slab_inner, slab_pad
 from .cspace_build import pair_sums
 from .shortest import free_space
@@ -296,16 +296,8 @@ def piece_boxes(pieces: list) -> np.ndarray:
     >>> piece_boxes([np.array([[1., 1], [2, 1], [2, 3]])]).tolist()
     [[1.0, 1.0, 2.0, 3.0]]
     """
-    out = np.empty((len(pieces), 4))
-    out[:, :2], out[:, 2:] = np.inf, -np.inf
-    sizes = np.array([len(p) for p in pieces], dtype=np.int64)
-    full = np.flatnonzero(sizes > 0)
-    if len(full):
-        pts = np.concatenate([np.asarray(pieces[k], dtype=np.float64).reshape(-1, 2) for k in full.tolist()])
-        starts = np.concatenate([[0], np.cumsum(sizes[full])[:-1]])
-        out[full, :2] = np.minimum.reduceat(pts, starts, axis=0)
-        out[full, 2:] = np.maximum.reduceat(pts, starts, axis=0)
-    return out
+    lo, hi = box_pairs(pieces)  # the kernel's (lo, hi), side by side
+    return np.hstack([lo, hi]).reshape(-1, 4)
 
 
 def deep_point(geom, depth: float) -> tuple[float, float] | None:
