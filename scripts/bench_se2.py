@@ -24,6 +24,14 @@
     those expected unsolvable, RRTConnect, 10 seeds, 10 s each, through
     ``planners.plan`` (the routine of ``cspace plan``); solved count, median solve time,
     median path length, and each path judged by the sweep oracle.
+(P) Side by side (``--peers shapely,coal``): ours (the proof before sampling, then the
+    planning routine stopped at its first certified path) against OMPL's planner with a
+    shapely or a coal state checker and its default discrete motion check, on SE(2) scenes,
+    generated ones and the car scenes; per seed every method once (interleaved), CPU time to
+    the first solution, paired median ratios. The sweep oracle judges every returned path
+    after the timed runs (a car's along its curves); "(sound)" is the paired ratio over the
+    seeds whose peer path it passes. A seed whose runs all take under 0.1 s is run three
+    times per method (interleaved) and the median taken (``--repeats``).
 
 Usage: python scripts/bench_se2.py [--quick] [--parts VMTP] [--peers shapely,coal] [--scenes WORDS] [--json FILE]
 """
@@ -276,8 +284,14 @@ def car_judge(sc):
     return collides
 
 
+# Part P: a seed whose runs all took less than this (CPU s) is run `repeats` times per method,
+# interleaved, and each method's median taken: at a millisecond, timer noise and the caches'
+# state move a single run's time by tens of percent.
+REPEAT_BELOW = 0.1
+
+
 def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RRTConnect",
-           only: tuple[str, ...] = ()) -> list[dict]:
+           only: tuple[str, ...] = (), repeats: int = 3) -> list[dict]:
     """Side by side: ours (certified) against OMPL with shapely and coal checkers (sampled motions),
     RRTConnect, time to the first solution, CPU, interleaved per seed; every path judged by the
     sweep oracle. ``only``: keep the scenes whose name contains one of these words."""
@@ -305,19 +319,31 @@ def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RR
         solved = {m: 0 for m in cpu}
         bad = {m: 0 for m in cpu}
         sound = {m: [] for m in cpu}  # per seed: the path passed the sweep oracle
-        for seed in range(seeds):  # interleaved: every method once per seed
+        found = []
+
+        def one_round(seed):
             runs = {"ours": se2_peers.ours_first(sc, cs, adapter, q, seed, budget, planner)}
             for name, chk in checkers.items():
                 runs[name] = se2_peers.peer_first(adapter, chk, adapter.pose(q.start), adapter.pose(q.goal), seed,
                                                   budget, planner)
-            for m, (path, c) in runs.items():
-                cpu[m].append(c if path is not None else None)
-                sound[m].append(False)
-                if path is not None:
-                    solved[m] += 1
-                    hit = collides(path)
-                    bad[m] += hit
-                    sound[m][-1] = not hit
+            return runs
+
+        for seed in range(seeds):  # interleaved: every method once per round
+            rounds = [one_round(seed)]
+            if max(c for _, c in rounds[0].values()) < REPEAT_BELOW:
+                rounds += [one_round(seed) for _ in range(repeats - 1)]
+            for m, (path, _) in rounds[0].items():  # the same seed: the same path in every round
+                cpu[m].append(statistics.median(r[m][1] for r in rounds) if path is not None else None)
+                found.append((m, path))
+        # The oracle judges the paths after the timed runs: its sweeps (shapely, ~0.1 s a path)
+        # between two runs would flush the caches of whichever method runs next.
+        for m, path in found:
+            sound[m].append(False)
+            if path is not None:
+                solved[m] += 1
+                hit = collides(path)
+                bad[m] += hit
+                sound[m][-1] = not hit
         row = {"scene": sc.name if sc.space == "se2" else f"{sc.name} ({sc.space})", "planner": planner, "vertices": sum(len(o.polygon) for o in sc.obstacles), "seeds": seeds,
                "solved": solved, "colliding": bad,
                "median_cpu_s": {m: (statistics.median([c for c in v if c is not None]) if any(c is not None for c in v)
@@ -340,6 +366,8 @@ def main(argv=None) -> int:
     ap.add_argument("--planners", default="RRTConnect,RRTstar", help="part P's planners")
     ap.add_argument("--scenes", default="", help="part P: only the scenes whose name contains one of these "
                                                  "comma-separated words (e.g. parking,loading_dock,u_turn)")
+    ap.add_argument("--repeats", type=int, default=3, help="part P: runs per method of a seed whose runs all take "
+                                                           f"under {REPEAT_BELOW} s (the median is taken)")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args(argv)
     out = {}
@@ -380,7 +408,7 @@ def main(argv=None) -> int:
         rows = []
         for name in a.planners.split(","):
             rows += part_p(seeds=3 if a.quick else 10, budget=10.0, peers=peers, planner=name,
-                           only=tuple(w for w in a.scenes.split(",") if w))
+                           only=tuple(w for w in a.scenes.split(",") if w), repeats=max(1, a.repeats))
         out["peers"] = rows
         print("(P) side by side, time to the first solution, CPU s (median over solved seeds), paired median ratio;")
         print("    colliding = returned paths the sweep oracle finds colliding (a car's along its curves);")
