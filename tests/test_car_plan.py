@@ -218,3 +218,17 @@ def test_kept_curves_are_the_computed_curves():
                 assert [math.copysign(1.0, v) for _, v in got] == [math.copysign(1.0, v) for _, v in f(a, b)]
                 got.append(("S", 1.0))  # the caller's copy
         assert adapter.segments(np.array(poses[0]), np.array(poses[1])) == f(poses[0], poses[1])
+
+
+def test_a_car_plan_counts_its_curves_as_motions():
+    """A car's motion check is a curve check: the plan's "motions" are the curves it asked about
+    (planning and the final verification), not the short SE(2) joins inside them."""
+    sc = load_scenario(os.path.join(SCENARIOS, "car", "loading_dock.toml"))
+    from planners.core.plan import build_cspace
+
+    cs = build_cspace(sc)
+    before = cs.report()["checks"].get("curves", 0)
+    res = planners.plan(sc, seed=2, time=10.0, cspace=cs)
+    assert res.solved
+    asked = cs.report()["checks"]["curves"] - before
+    assert res.checks["motions"] == asked >= len(res.path) - 1

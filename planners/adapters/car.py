@@ -78,6 +78,12 @@ class CarSpace(SE2Space):
         (certified: :meth:`cspace.spaces.se2.SE2CSpace.car_motion_free`)."""
         return self.cspace.car_motion_free(q0, q1, self.name, self.radius)
 
+    def counts(self) -> tuple[int, int]:
+        """Checks made so far: (state checks, motion checks), a car's motion being a curve (the
+        SE(2) motions joining a curve's end to its target pose are part of it, not counted)."""
+        c = self.cspace.report()["checks"]
+        return c.get("states", 0), c.get("curves", 0)
+
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every curve between consecutive poses certified free, from the start pose to the goal pose.
 
