@@ -392,9 +392,19 @@ class SE2CSpace(SE2Motions, CarMotions):
 
     # -- report ------------------------------------------------------------------------
 
+    def state_count(self) -> int:
+        """Pose tests made so far (the ``states`` counter of :meth:`report`, without the report).
+
+        >>> cs = SE2CSpace((0, 4, 0, 4), [], [np.array([[0., 0], [1, 0], [0, 1]])], slabs=4)
+        >>> n = cs.state_count(); _ = cs.is_free((2.0, 2.0, 0.0)); cs.state_count() - n
+        1
+        """
+        self.checks["states"] = int(self._states.__reduce__()[1][0])
+        return self.checks["states"]
+
     def report(self) -> dict:
         """K and its reason, the slabs built (seconds, piece counts) and the query counters."""
-        self.checks["states"] = int(self._states.__reduce__()[1][0])
+        self.state_count()
         return {
             "slabs": self.slabs,
             "slabs_reason": self.slabs_reason,

@@ -81,8 +81,7 @@ class CarSpace(SE2Space):
     def counts(self) -> tuple[int, int]:
         """Checks made so far: (state checks, motion checks), a car's motion being a curve (the
         SE(2) motions joining a curve's end to its target pose are part of it, not counted)."""
-        c = self.cspace.report()["checks"]
-        return c.get("states", 0), c.get("curves", 0)
+        return self.cspace.state_count(), self.cspace.checks.get("curves", 0)
 
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every curve between consecutive poses certified free, from the start pose to the goal pose.

@@ -151,5 +151,4 @@ class SE2Space:
 
     def counts(self) -> tuple[int, int]:
         """Checks made so far: (state checks, motion checks)."""
-        c = self.cspace.report()["checks"]
-        return c.get("states", 0), c.get("motions", 0)
+        return self.cspace.state_count(), self.cspace.checks.get("motions", 0)
