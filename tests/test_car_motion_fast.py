@@ -354,3 +354,35 @@ def test_compiled_motion_declines_what_python_decides(scenes):
     # past the slab grid's headings the product still answers, by the Python path
     assert cs.car_motion_free(start, far, "reeds-shepp", sc.turning_radius) == \
         pure.curve_free(start, reeds_shepp_segments(start, far, sc.turning_radius), sc.turning_radius, q1=far)
+
+
+_coord = st.one_of(st.floats(-20, 20), st.floats(-1e12, 1e12), st.sampled_from([0.0, -0.0, 6.0, 1e-300]))
+_angle = st.one_of(st.floats(-7, 7), st.floats(-3e6, 3e6), st.sampled_from([0.0, -0.0, math.pi, -math.pi, 2.0**20]))
+
+
+@compiled
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(st.tuples(_coord, _coord, _angle), st.tuples(_coord, _coord, _angle), st.sampled_from(["dubins", "reeds-shepp"]),
+       st.sampled_from([0.3, 1.0, 2.5, 1e-6]), st.booleans())
+def test_hypothesis_compiled_motion_never_differs(scenes, q0, q1, kind, radius, near):
+    """Any poses, near and absurd: where the compiled motion decides, it is the compiled curve
+    check of the Python segments (answer and chain end, bit for bit); where it declines, the
+    Python segments raise or the product runs the Python path. ``near``: q0 and q1 are the
+    scene's start and goal moved by a hundredth of the drawn values (free motions too)."""
+    sc, cs, pure = scenes["u_turn.toml"]
+    if near:
+        s0, s1 = tuple(sc.all_queries()[0].start), tuple(sc.all_queries()[0].goal)
+        q0 = tuple(float(v + 0.01 * math.tanh(w)) for v, w in zip(s0, q0))
+        q1 = tuple(float(v + 0.01 * math.tanh(w)) for v, w in zip(s0 if radius < 1 else s1, q1))
+    seg = dubins_segments if kind == "dubins" else reeds_shepp_segments
+    got, end = compiled_motion(cs, q0, q1, kind, radius)
+    try:
+        segs = seg(q0, q1, radius)
+    except ValueError:
+        assert got == -1  # Python refuses these poses: the compiled call never answers them
+        return
+    if got >= 0:
+        assert got == compiled_answer(cs, q0, segs, radius), (q0, q1, segs)
+        f = fastpath.car_curve(cs, MAX_HULLS, FLOOR_REL, ARC_CHUNK)
+        grids = [cs.slab(k)._fast for k in range(cs.slabs)]
+        assert end == tuple(f(grids, q0[0], q0[1], wrap_angle(q0[2]), segs, radius)[1:]), (q0, q1, segs)
