@@ -120,21 +120,12 @@ class CarMotions:
         if self._car_fast is False and self._compile_car() is None:
             return None
         self.checks["curves"] += 1
-        grids = self._car_grids
+        motion, longest = self._car_motion, MAX_SEGMENT_EXTENTS * self.extent
         turns = MAX_ARC_TURNS * 2.0 * math.pi * radius
-        motion = self._car_motion
-        while True:  # one call; a slab not built yet is built and the call repeated
-            r, x, y, th = motion(grids, *q0, *q1, radius, dubins, MAX_SEGMENT_EXTENTS * self.extent, turns)
-            if r == 0:
-                return False
-            if r == 1:
-                break
-            if r == -1 or (handle := self.slab(-2 - r)._fast) is None:
-                self.checks["curves"] -= 1  # the full path counts it
-                return None
-            grids[-2 - r] = handle
-        q1 = (q1[0], q1[1], wrap_angle(q1[2]))
-        return (x, y, th) == q1 or self.motion_free((x, y, th), q1)
+        got = self._compiled(lambda grids: motion(grids, *q0, *q1, radius, dubins, longest, turns), q1)
+        if got is None:
+            self.checks["curves"] -= 1  # the full path counts it
+        return got
 
     def curve_free(self, q0, segments, radius: float, q1=None) -> bool:
         """Is every pose of the segment chain from q0 free? Certified (see module doc).
@@ -181,17 +172,20 @@ class CarMotions:
     def _curve_fast(self, fast, pose, segments, radius: float, q1):
         """:meth:`curve_free` by the compiled check (cspace/spaces/_carmotion.c: its "free" and
         "not free" are the pure path's), or None when it cannot decide."""
+        return self._compiled(lambda grids: fast(grids, pose[0], pose[1], pose[2], segments, radius), q1)
+
+    def _compiled(self, call, q1):
+        """A compiled car call (``grids -> (r, x, y, th)``: 1 free, 0 not, -1 undecided, -2 - k slab
+        k not built) run to its answer, building the slabs it asks for; a free chain's end
+        (x, y, th) is then joined to q1 by a certified SE(2) motion. None: undecided."""
         grids = self._car_grids
         while True:  # one call; a slab not built yet is built and the call repeated
-            r, x, y, th = fast(grids, pose[0], pose[1], pose[2], segments, radius)
+            r, x, y, th = call(grids)
             if r == 0:
                 return False
             if r == 1:
                 break
-            if r == -1:
-                return None
-            handle = self.slab(-2 - r)._fast
-            if handle is None:
+            if r == -1 or (handle := self.slab(-2 - r)._fast) is None:
                 return None
             grids[-2 - r] = handle
         if q1 is not None:
