@@ -256,8 +256,8 @@ def test_ctrl_c_at_any_moment_of_our_code_is_interrupted_130(run):
 @pytest.mark.parametrize("entry", [["-m", "planners.cli"], ["-m", "planners"]])
 def test_ctrl_c_early_in_python_m_is_never_our_traceback(entry):
     """From the start of the interpreter: before our code runs Python itself may die of the
-    signal (no handler yet) or report it in its own start-up (site, runpy); never in a frame
-    of ours: once our code runs, exit 130 and "interrupted"."""
+    signal (no handler yet), report it in its own start-up (site, runpy) or lose it in a
+    callback there; never in a frame of ours: once our code runs, exit 130 and "interrupted"."""
     ours = 0
     for delay in (0.02, 0.05, 0.1, 0.15, 0.3):
         code, out, err = interrupt([sys.executable, *entry, *RUNS["basic"]], delay, ready=False)
@@ -266,6 +266,13 @@ def test_ctrl_c_early_in_python_m_is_never_our_traceback(entry):
         if code in (-signal.SIGINT, 1) and "/planners/" not in err and "/cspace/" not in err:
             # the interpreter's own start-up (no handler yet, site, runpy finding the package)
             assert err == "" or err.rstrip().endswith("KeyboardInterrupt"), err[-2000:]
+            continue
+        if code == 0 and err.startswith("Exception ignored in") and "/planners/" not in err \
+                and "/cspace/" not in err:
+            # Python's own handler (ours is not set yet) raised in a callback of its start-up
+            # (importlib's module locks, while site loads): Python prints this and goes on. Once
+            # our handler is set, a KeyboardInterrupt lost in a callback comes back, silently.
+            assert err.rstrip().endswith("KeyboardInterrupt:"), err[-2000:]
             continue
         assert code in (0, 130) and err in ("", "interrupted\n"), (delay, code, err[-2000:])
         ours += code == 130

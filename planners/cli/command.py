@@ -17,6 +17,8 @@ import sys
 import traceback
 import warnings
 
+from . import interrupt
+
 COMMANDS = {
     "plan": "planners.cli.plan",
     "show": "planners.cli.show",
@@ -166,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         code = 141  # 128 + SIGPIPE, as a shell reports a process killed by it
     except Exception as exc:  # a bug, not bad input: still one line unless --verbose
-        if _SIGINT:  # Ctrl-C, which a library turned into another error (numpy: an ImportError)
+        if interrupt.came():  # Ctrl-C, which a library turned into another error
             sys.stderr.write("interrupted\n")
             return 130
         if getattr(args, "verbose", False):  # the traceback, and still "internal error", not "not solved"
@@ -190,15 +192,6 @@ def _silence_stdout() -> None:
     os.close(devnull)
 
 
-_SIGINT: list = []  # Ctrl-C came (console's handler notes it; some libraries turn it into other errors)
-
-
-def _on_sigint(signum, frame):
-    """Python's own Ctrl-C handler (KeyboardInterrupt), which also notes that it came."""
-    _SIGINT.append(signum)
-    raise KeyboardInterrupt
-
-
 def console() -> None:
     """Entry point of the installed ``cspace`` script.
 
@@ -208,16 +201,13 @@ def console() -> None:
 
     Ctrl-C at any moment is ``interrupted`` and exit 130, also while the parser and the
     command's modules load (outside :func:`main`'s handler) and when a library turned it
-    into another error; once the exit code is known, a late Ctrl-C is ignored. An
+    into another error. A Ctrl-C that lands inside an import is held until the import
+    returns, and one lost in a callback comes back (:mod:`planners.cli.interrupt`); once
+    the exit code is known, a late Ctrl-C is ignored. An
     interrupted run also ends with ``os._exit``: Python would otherwise re-raise SIGINT at
     exit if a library's C code let the KeyboardInterrupt through (exit -2, not 130).
     """
-    import signal
-
-    try:
-        signal.signal(signal.SIGINT, _on_sigint)
-    except ValueError:  # not the main thread: no handler to install
-        pass
+    interrupt.install()  # KeyboardInterrupt, held while an import runs (planners.cli.interrupt)
     try:
         code = main()
         try:
@@ -226,22 +216,19 @@ def console() -> None:
             _silence_stdout()
             code = 141
     except Exception:
-        if not _SIGINT:
+        if not interrupt.came():
             raise
         code = _interrupted()
     except KeyboardInterrupt:
         code = _interrupted()
-    try:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    except ValueError:
-        pass
-    if _SIGINT:  # (a normal end flushed stdout above)
+    interrupt.release()
+    if interrupt.came():  # (a normal end flushed stdout above)
         try:
             sys.stdout.flush()
         except (BrokenPipeError, ValueError):
             _silence_stdout()
     sys.stderr.flush()
-    if _SIGINT or ("ompl" in sys.modules and "--verbose" not in sys.argv and "-v" not in sys.argv):
+    if interrupt.came() or ("ompl" in sys.modules and "--verbose" not in sys.argv and "-v" not in sys.argv):
         output = sys.modules.get("planners.output")
         if output is not None:  # what os._exit skips: the atexit removal of our temporaries
             output.clean_stale()
