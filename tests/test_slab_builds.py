@@ -225,6 +225,20 @@ def test_from_sums_checks_its_input():
         CSpace.from_sums((0, 4, 0, 4), [sq], [sq], [])
     with pytest.raises(ValueError):
         CSpace.from_sums((0, 4, 0, 4), [sq], [], [])
+    with pytest.raises(ValueError, match="2\\^400"):  # checked unless the caller says it checked
+        CSpace.from_sums((0, 4, 0, 4), [sq * 2.0**401], [-sq], pair_sums([sq * 2.0**401], [sq]))
+
+
+@needs_c
+def test_the_batched_slabs_check_the_range_once_for_all():
+    """build_slabs hands from_sums checked=True: its own one check must see what the
+    per-slab checks saw (here bounds past the supported range)."""
+    from cspace.spaces.slab_build import build_slabs
+
+    sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1]])
+    with pytest.raises(ValueError, match="2\\^400"):
+        build_slabs((0.0, 2.0**401, 0.0, 4.0), [sq + 2], [sq - 0.5], [0.0, 0.1], [0.1, 0.2], scale=1.0, pad=1e-9,
+                    grid_cells=64)
 
 
 # ---------------------------------------------------------------- whole C-spaces: batched against pure

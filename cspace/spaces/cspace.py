@@ -188,13 +188,15 @@ class CSpace(PointQueries, SegmentQueries):
 
     @classmethod
     def from_sums(cls, bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray], sums: list[np.ndarray],
-                  *, grid_cells: int | None = None, seconds: float = 0.0) -> "CSpace":
+                  *, grid_cells: int | None = None, seconds: float = 0.0, checked: bool = False) -> "CSpace":
         """The C-space ``CSpace(bounds, obstacle_pieces, robot_pieces, normalized=True)`` builds when
         every obstacle and robot piece is convex (kept as it is) and ``sums`` are their pair
         sums obstacle piece ⊕ −(robot piece), obstacle-major, as :func:`pair_sums` gives them
         (the caller computed them, for several C-spaces at once: the SE(2) slabs): the same
         pieces, pairs, grid and answers, the same stages in the report (``seconds``: the
-        sums' share of the caller's time).
+        sums' share of the caller's time). ``checked``: the caller has run
+        :func:`cspace.spaces.cspace_build.check_range` on these bounds and pieces (the SE(2)
+        slabs: once for the obstacles and every slab's hulls).
 
         >>> sq, tri = np.array([[4., 4], [6, 4], [6, 6], [4, 6]]), np.array([[-1., -1], [0, -1], [-1, 0]])
         >>> a = CSpace((0, 10, 0, 10), [sq], [-tri], normalized=True)
@@ -204,7 +206,8 @@ class CSpace(PointQueries, SegmentQueries):
         """
         self = cls.__new__(cls)
         self.bounds = tuple(float(v) for v in bounds)
-        check_range(self.bounds, list(obstacle_pieces) + list(robot_pieces))
+        if not checked:
+            check_range(self.bounds, list(obstacle_pieces) + list(robot_pieces))
         no, nr = len(obstacle_pieces), len(robot_pieces)
         self.stages = [Stage("decompose_obstacles", False, 0.0, {"obstacles": no, "decomposed": 0, "pieces": no},
                              "all obstacles convex: nothing to decompose")]
@@ -238,12 +241,17 @@ class CSpace(PointQueries, SegmentQueries):
         else:
             pts, sizes = pack(pieces)  # kept for the index's PieceSet
             lo, hi = piece_boxes(pieces, (pts, sizes))  # an empty piece: lo = inf, hi = -inf, dropped
-        keep = np.flatnonzero((lo[:, 0] <= xmax) & (hi[:, 0] >= xmin) & (lo[:, 1] <= ymax) & (hi[:, 1] >= ymin)).tolist()
+        meets = (lo[:, 0] <= xmax) & (hi[:, 0] >= xmin) & (lo[:, 1] <= ymax) & (hi[:, 1] >= ymin)
+        if meets.all():  # (mostly) every piece meets the bounds: nothing to copy
+            keep = range(before)
+            pieces, pairs = list(pieces), [[pr] for pr in self._raw_pairs]
+        else:
+            keep = np.flatnonzero(meets).tolist()
+            pieces = [pieces[k] for k in keep]
+            pairs = [[self._raw_pairs[k]] for k in keep]
+            owner = owner[keep] if len(owner) else owner
+            lo, hi = lo[keep], hi[keep]  # the kept pieces' boxes, for the containment test and the index
         outside = before - len(keep)
-        pieces = [pieces[k] for k in keep]
-        pairs = [[self._raw_pairs[k]] for k in keep]
-        owner = owner[keep] if len(owner) else owner
-        lo, hi = lo[keep], hi[keep]  # the kept pieces' boxes, for the containment test and the index
         contained = contained_pieces(pieces, (lo, hi))
         if contained:
             for p in sorted(contained):

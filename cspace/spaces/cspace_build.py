@@ -136,8 +136,10 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
         # Few pieces: every pair whose boxes nest, by one comparison of all the boxes (at
         # most n^2 pairs for the exact test; building the trees and polygons for the
         # point-in-polygon filter below costs more than the exact test of what it drops).
-        qs, ps = np.nonzero((lo[None, :, 0] >= lo[:, None, 0]) & (hi[None, :, 0] <= hi[:, None, 0]) &
-                            (lo[None, :, 1] >= lo[:, None, 1]) & (hi[None, :, 1] <= hi[:, None, 1]))
+        nest = (lo[None, :, 0] >= lo[:, None, 0]) & (hi[None, :, 0] <= hi[:, None, 0]) & \
+            (lo[None, :, 1] >= lo[:, None, 1]) & (hi[None, :, 1] <= hi[:, None, 1])
+        np.fill_diagonal(nest, False)
+        qs, ps = np.nonzero(nest)  # exactly the pairs the filter below keeps
     elif (sizes := np.fromiter((len(p) for p in pieces), np.int64, n)).min() >= 3:
         flat = np.concatenate(pieces)
         owner = np.repeat(np.arange(n), sizes)
@@ -156,9 +158,10 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
     else:
         boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
         qs, ps = shapely.STRtree(boxes).query(boxes, predicate="covers")
-    inside = (ps != qs) & (lo[ps, 0] >= lo[qs, 0]) & (hi[ps, 0] <= hi[qs, 0]) & (lo[ps, 1] >= lo[qs, 1]) & \
-        (hi[ps, 1] <= hi[qs, 1])
-    qs, ps = qs[inside], ps[inside]
+    if n > BOX_PROPOSALS:
+        inside = (ps != qs) & (lo[ps, 0] >= lo[qs, 0]) & (hi[ps, 0] <= hi[qs, 0]) & (lo[ps, 1] >= lo[qs, 1]) & \
+            (hi[ps, 1] <= hi[qs, 1])
+        qs, ps = qs[inside], ps[inside]
     if not len(qs):  # no box inside another (the common case): nothing to test
         return removed
     order = np.argsort(lo[:, 0], kind="stable")

@@ -34,7 +34,7 @@ import numpy as np
 from . import fastpath
 from .broadphase import GridIndex
 from .cspace import CSpace
-from .cspace_build import pair_sums
+from .cspace_build import check_range, pair_sums
 from ..kernel.hull import convex_hull, ring_hulls
 from ..kernel.minkowski import reflect
 from ..kernel.pieces import PieceSet
@@ -264,19 +264,21 @@ def build_slabs(bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np
     sums = pair_sums(obstacle_pieces, negs) if obstacle_pieces and negs else []
     t_sums = time.perf_counter() - t
     nb, no = len(negs), len(obstacle_pieces)
+    check_range(tuple(float(v) for v in bounds), list(obstacle_pieces) + [h for hs in hulls for h in hs])  # once, not per slab
     out = []
     for k in range(K):
         t = time.perf_counter()
-        outer = CSpace.from_sums(bounds, obstacle_pieces, hulls[k],
-                                 [sums[i * nb + k * nr + j] for i in range(no) for j in range(nr)],
-                                 grid_cells=grid_cells, seconds=t_sums / K)
+        # slab k's sums, obstacle-major: for each obstacle piece i, sums[i * nb + k * nr + j]
+        mine = sums[k::nb][:no] if nr == 1 else [sums[i * nb + k * nr + j] for i in range(no) for j in range(nr)]
+        outer = CSpace.from_sums(bounds, obstacle_pieces, hulls[k], mine, grid_cells=grid_cells, seconds=t_sums / K,
+                                 checked=True)
         t_outer = time.perf_counter() - t
         inner = False
         ni = len(inners[k])
         if ni and obstacle_pieces:
             g = outer.index
             at = inner_at[k]
-            pieces = [sums[i * nb + at + j] for i in range(no) for j in range(ni)]
+            pieces = sums[at::nb][:no] if ni == 1 else [sums[i * nb + at + j] for i in range(no) for j in range(ni)]
             inner = GridIndex.blocked_cells(pieces, bounds, (g.nx, g.ny), packed=_packed(pieces))
         out.append((outer, inner, ni, time.perf_counter() - t + (t_sets + t_sums) / K, t_outer + t_sets / K))
     return out
