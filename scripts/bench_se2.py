@@ -31,9 +31,11 @@
     the first solution, paired median ratios. The sweep oracle judges every returned path
     after the timed runs (a car's along its curves); "(sound)" is the paired ratio over the
     seeds whose peer path it passes. A seed whose runs all take under 0.1 s is run three
-    times per method (interleaved) and the median taken (``--repeats``).
+    times per method (interleaved) and the median taken (``--repeats``). ``--peer-resolution``
+    sets the peers' motion-check step (a finer one tunnels less, and costs more).
 
-Usage: python scripts/bench_se2.py [--quick] [--parts VMTP] [--peers shapely,coal] [--scenes WORDS] [--json FILE]
+Usage: python scripts/bench_se2.py [--quick] [--parts VMTP] [--peers shapely,coal] [--scenes WORDS]
+                                   [--peer-resolution STEP] [--json FILE]
 """
 from __future__ import annotations
 
@@ -291,7 +293,7 @@ REPEAT_BELOW = 0.1
 
 
 def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RRTConnect",
-           only: tuple[str, ...] = (), repeats: int = 3) -> list[dict]:
+           only: tuple[str, ...] = (), repeats: int = 3, resolution: float | None = None) -> list[dict]:
     """Side by side: ours (certified) against OMPL with shapely and coal checkers (sampled motions),
     RRTConnect, time to the first solution, CPU, interleaved per seed; every path judged by the
     sweep oracle. ``only``: keep the scenes whose name contains one of these words."""
@@ -325,7 +327,7 @@ def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RR
             runs = {"ours": se2_peers.ours_first(sc, cs, adapter, q, seed, budget, planner)}
             for name, chk in checkers.items():
                 runs[name] = se2_peers.peer_first(adapter, chk, adapter.pose(q.start), adapter.pose(q.goal), seed,
-                                                  budget, planner)
+                                                  budget, planner, resolution)
             return runs
 
         for seed in range(seeds):  # interleaved: every method once per round
@@ -368,6 +370,9 @@ def main(argv=None) -> int:
                                                  "comma-separated words (e.g. parking,loading_dock,u_turn)")
     ap.add_argument("--repeats", type=int, default=3, help="part P: runs per method of a seed whose runs all take "
                                                            f"under {REPEAT_BELOW} s (the median is taken)")
+    ap.add_argument("--peer-resolution", type=float, default=None,
+                    help="part P: the peers' motion-check step as a fraction of the space's extent "
+                         "(default: OMPL's, 0.01); finer steps make a peer tunnel less and cost more")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args(argv)
     out = {}
@@ -408,11 +413,14 @@ def main(argv=None) -> int:
         rows = []
         for name in a.planners.split(","):
             rows += part_p(seeds=3 if a.quick else 10, budget=10.0, peers=peers, planner=name,
-                           only=tuple(w for w in a.scenes.split(",") if w), repeats=max(1, a.repeats))
+                           only=tuple(w for w in a.scenes.split(",") if w), repeats=max(1, a.repeats),
+                           resolution=a.peer_resolution)
         out["peers"] = rows
         print("(P) side by side, time to the first solution, CPU s (median over solved seeds), paired median ratio;")
         print("    colliding = returned paths the sweep oracle finds colliding (a car's along its curves);")
-        print("    (sound) = the paired ratio over the seeds whose peer path the oracle passes")
+        print("    (sound) = the paired ratio over the seeds whose peer path the oracle passes;")
+        print("    peers' motion-check step: " + ("OMPL's default (1 % of the extent)" if a.peer_resolution is None
+                                                   else f"{a.peer_resolution:g} of the extent"))
         print(f"  {'scene':24} {'planner':10} {'verts':>5}" + "".join(f" {m + ' solved':>14} {m + ' s':>10} {m + ' coll.':>11}"
                                                        for m in ("ours", *peers))
               + "".join(f" {'ours/' + m:>13} {'(sound)':>8}" for m in peers))

@@ -98,10 +98,12 @@ def coal_checker(obstacle_pieces, robot_pieces, bounds):
     return is_valid
 
 
-def peer_first(adapter, checker, start, goal, seed: int, limit: float, planner: str = "RRTConnect"):
+def peer_first(adapter, checker, start, goal, seed: int, limit: float, planner: str = "RRTConnect",
+               resolution: float | None = None):
     """OMPL's ``planner`` on the adapter's state space with ``checker`` and OMPL's default discrete
     motion check, seeded as ours, stopped at its first solution (an anytime planner by OMPL's own
-    rule, as ours): ``(path or None, CPU seconds of the set-up and solve)``."""
+    rule, as ours): ``(path or None, CPU seconds of the set-up and solve)``. ``resolution``: the
+    motion check's step as a fraction of the space's extent (None: OMPL's default, 0.01)."""
     from planners.adapters.glue import ANYTIME, ompl, ompl_seed, stop_at_first
 
     ob, og, ou = ompl()
@@ -114,6 +116,8 @@ def peer_first(adapter, checker, start, goal, seed: int, limit: float, planner: 
     adapter.set_state(s, start)
     adapter.set_state(g, goal)
     ss.setStartAndGoalStates(s, g, 1e-9)
+    if resolution is not None:
+        ss.getSpaceInformation().setStateValidityCheckingResolution(resolution)
     ss.setPlanner(getattr(og, planner)(ss.getSpaceInformation()))
     if planner.lower() in ANYTIME:
         stop_at_first(ss)
