@@ -98,29 +98,25 @@ def test_a_held_ctrl_c_goes_to_the_handler_current_when_the_import_returns(tmp_p
     assert out.stdout == "planner's handler\nnot interrupted\n"
 
 
+# A finaliser that sends SIGINT and runs Python code after it: Python's handler runs inside it.
+FINALISED = """
+    class Finalised:
+        def __del__(self):
+            signal.raise_signal(signal.SIGINT)
+            for _ in range(20):
+                time.sleep(0.001)
+"""
+
+
 def test_a_ctrl_c_lost_in_a_callback_comes_back_silently(tmp_path):
     """A KeyboardInterrupt raised inside __del__ is 'Exception ignored' in Python, and the run
     would go on; here it is re-delivered, with nothing on stderr."""
-    body = """
-        class Finalised:
-            def __del__(self):
-                signal.raise_signal(signal.SIGINT)
-                for _ in range(20):  # Python's handler runs here, inside the finaliser
-                    time.sleep(0.001)
-    """
-    out = run(tmp_path, body, "x = Finalised(); del x")
+    out = run(tmp_path, FINALISED, "x = Finalised(); del x")
     assert out.returncode == 0 and out.stderr == "", out.stderr
     assert out.stdout == "interrupted True None\n"
 
 
 def test_a_ctrl_c_lost_in_a_callback_during_an_import_waits_for_the_import(tmp_path):
-    body = """
-        class Finalised:
-            def __del__(self):
-                signal.raise_signal(signal.SIGINT)
-                for _ in range(20):
-                    time.sleep(0.001)
-    """
     module = """
         import __main__, time
         x = __main__.Finalised()
@@ -129,7 +125,7 @@ def test_a_ctrl_c_lost_in_a_callback_during_an_import_waits_for_the_import(tmp_p
             time.sleep(0.001)
         DONE = True
     """
-    out = run(tmp_path, body, "import slow_module", module)
+    out = run(tmp_path, FINALISED, "import slow_module", module)
     assert out.returncode == 0 and out.stderr == "", out.stderr
     assert out.stdout == "interrupted True True\n"
 
