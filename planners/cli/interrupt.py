@@ -64,9 +64,12 @@ def release() -> None:
 
 def _on_sigint(signum, frame):
     _state["came"] = True
-    if not _state["held"] and _importing(frame) and _hold():
+    if _state["held"]:  # a second Ctrl-C while one is held: now, and the hold is over
+        sys.setprofile(None)
+        _state["held"] = False
+    elif _importing(frame) and _hold():
         return
-    raise KeyboardInterrupt  # (a second Ctrl-C while one is held, too)
+    raise KeyboardInterrupt
 
 
 def _on_unraisable(unraisable) -> None:
