@@ -85,7 +85,8 @@ def test_help_imports_no_command_module():
             "print(sorted(m for m in sys.modules if m.startswith(('planners.', 'cspace', 'numpy'))))")
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
-    assert r.stdout.strip() == "['planners.cli', 'planners.cli.command']"  # the dispatcher, no command
+    # the dispatcher and its Ctrl-C handling (signal and sys only), no command
+    assert r.stdout.strip() == "['planners.cli', 'planners.cli.command', 'planners.cli.interrupt']"
     m = subprocess.run([sys.executable, "-m", "planners", "--help"], cwd=ROOT, capture_output=True, text=True,
                        timeout=60)
     assert m.returncode == 0 and m.stdout.startswith("usage: cspace") and "plan a collision-free path" in m.stdout
