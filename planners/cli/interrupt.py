@@ -57,16 +57,13 @@ def release() -> None:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     except ValueError:
         return
-    if _state["held"]:
-        sys.setprofile(None)
-        _state["held"] = False
+    _end_hold()
 
 
 def _on_sigint(signum, frame):
     _state["came"] = True
     if _state["held"]:  # a second Ctrl-C while one is held: now, and the hold is over
-        sys.setprofile(None)
-        _state["held"] = False
+        _end_hold()
     elif _importing(frame) and _hold():
         return
     raise KeyboardInterrupt
@@ -87,6 +84,13 @@ def _hold() -> bool:
     return True
 
 
+def _end_hold() -> None:
+    """Take the profile hook off (if a Ctrl-C is held): nothing is held any more."""
+    if _state["held"]:
+        sys.setprofile(None)
+        _state["held"] = False
+
+
 def _watch(frame, event, arg) -> None:
     """Profile hook while a Ctrl-C is held: deliver it at the first call or return outside
     the unraisable hook and outside any import, or as the outermost import returns."""
@@ -94,8 +98,7 @@ def _watch(frame, event, arg) -> None:
         return
     if _importing(frame) and not (event == "return" and _is_importlib(frame) and not _importing(frame.f_back)):
         return
-    sys.setprofile(None)
-    _state["held"] = False
+    _end_hold()
     _deliver()  # raised here, it comes out of the returning import (or the called function)
 
 
