@@ -242,6 +242,19 @@ def _packed(pieces: list[np.ndarray]) -> PieceSet | None:
     return PieceSet(pieces, (lo, hi), (pts, np.diff(off)))
 
 
+def _operand_sums(sums: list, nb: int, no: int, at: int, n: int) -> list:
+    """Of the pair sums of ``no`` obstacle pieces with ``nb`` operands (obstacle-major, as
+    :func:`pair_sums` gives them), those with operands ``at .. at + n - 1``, obstacle-major:
+    ``[sums[i * nb + at + j] for i in range(no) for j in range(n)]`` (one operand: a slice).
+
+    >>> _operand_sums(list("abcdefgh"), 4, 2, 1, 2), _operand_sums(list("abcdefgh"), 4, 2, 3, 1)
+    (['b', 'c', 'f', 'g'], ['d', 'h'])
+    """
+    if n == 1:
+        return sums[at::nb][:no]
+    return [sums[i * nb + at + j] for i in range(no) for j in range(n)]
+
+
 def build_slabs(bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray], lo: list[float],
                 hi: list[float], *, scale: float, pad: float, grid_cells: int) -> list[tuple]:
     """Slabs ``[lo[k], hi[k]]`` at once: per slab ``(outer, inner, inner_pieces, seconds,
@@ -268,17 +281,14 @@ def build_slabs(bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np
     out = []
     for k in range(K):
         t = time.perf_counter()
-        # slab k's sums, obstacle-major: for each obstacle piece i, sums[i * nb + k * nr + j]
-        mine = sums[k::nb][:no] if nr == 1 else [sums[i * nb + k * nr + j] for i in range(no) for j in range(nr)]
-        outer = CSpace.from_sums(bounds, obstacle_pieces, hulls[k], mine, grid_cells=grid_cells, seconds=t_sums / K,
-                                 checked=True)
+        outer = CSpace.from_sums(bounds, obstacle_pieces, hulls[k], _operand_sums(sums, nb, no, k * nr, nr),
+                                 grid_cells=grid_cells, seconds=t_sums / K, checked=True)
         t_outer = time.perf_counter() - t
         inner = False
         ni = len(inners[k])
         if ni and obstacle_pieces:
             g = outer.index
-            at = inner_at[k]
-            pieces = sums[at::nb][:no] if ni == 1 else [sums[i * nb + at + j] for i in range(no) for j in range(ni)]
+            pieces = _operand_sums(sums, nb, no, inner_at[k], ni)
             inner = GridIndex.blocked_cells(pieces, bounds, (g.nx, g.ny), packed=_packed(pieces))
         out.append((outer, inner, ni, time.perf_counter() - t + (t_sets + t_sums) / K, t_outer + t_sets / K))
     return out
