@@ -1,4 +1,4 @@
-"""Build hook for the optional compiled fast path (cspace/spaces/_fast.c, _build.c, _cells.c,
+"""Build hook for the optional compiled fast path (cspace/compiled/_fast.c, _build.c, _cells.c,
 _chords.c, _gjk.c, _nearest.c, _se2motion.c, _carmotion.c, _carwords.c, _disccost.c and their header
 _fast.h); everything else is in pyproject.toml.
 
@@ -11,6 +11,6 @@ from setuptools import Extension, setup
 
 # Each product rounded once, as the float filter's error bound assumes: no FMA contraction.
 args = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off"]
-sources = [f"cspace/spaces/{name}.c" for name in ("_fast", "_build", "_cells", "_chords", "_gjk", "_nearest", "_se2motion", "_carmotion", "_carwords", "_disccost")]
-setup(ext_modules=[Extension("cspace.spaces._fast", sources, depends=["cspace/spaces/_fast.h"], optional=True,
+sources = [f"cspace/compiled/{name}.c" for name in ("_fast", "_build", "_cells", "_chords", "_gjk", "_nearest", "_se2motion", "_carmotion", "_carwords", "_disccost")]
+setup(ext_modules=[Extension("cspace.compiled._fast", sources, depends=["cspace/compiled/_fast.h"], optional=True,
                              extra_compile_args=args)])

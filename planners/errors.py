@@ -1,7 +1,7 @@
 """Errors the command line reports as one line: ``error: FILE: FIELD: what is wrong``."""
 from __future__ import annotations
 
-from cspace.io.scenario import ScenarioError
+from cspace.io.load import ScenarioError
 
 
 class InputError(ScenarioError):

@@ -197,7 +197,7 @@ def track(items: Iterable[T], desc: str, total: int | None = None, enabled: bool
 
 
 def search_reporter(bar: Progress, desc: str | None = None) -> Callable[[int, int, float], None]:
-    """A callback for :func:`cspace.spaces.shortest.shortest_path`'s ``on_progress``.
+    """A callback for :func:`cspace.paths.shortest.shortest_path`'s ``on_progress``.
 
     The search calls it with (nodes settled, nodes in the graph, lower bound on the
     length): A* settles nodes in order of f = g + h, and with a consistent heuristic

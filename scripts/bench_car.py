@@ -42,8 +42,8 @@ sys.path.insert(0, ROOT)
 from bench_se2 import _si, shapely_se2_checker, solve_runs  # noqa: E402
 from sweep_oracle import car_sweep_check  # noqa: E402
 
-from cspace.spaces.car_curves import dubins_segments, reeds_shepp_segments  # noqa: E402
-from cspace.io.scenario import load_scenario  # noqa: E402
+from cspace.car.curves import dubins_segments, reeds_shepp_segments  # noqa: E402
+from cspace.io.load import load_scenario  # noqa: E402
 
 CAR_DIR = os.path.join(ROOT, "scenarios", "car")
 

@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from cspace.spaces.cspace import CSpace
-from cspace.spaces.direct import DirectChecker
+from cspace.translation.cspace import CSpace
+from cspace.translation.direct import DirectChecker
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT = ["combs.toml", "office.toml", "disks_cluttered.toml"]

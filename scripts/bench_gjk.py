@@ -12,10 +12,10 @@ import time
 
 import numpy as np
 
-from cspace.kernel.epa import epa_penetration
-from cspace.kernel.gjk import exact_relation, gjk_distance
-from cspace.kernel.hull import convex_hull
-from cspace.kernel.minkowski import minkowski_sum, reflect
+from cspace.kernel.distance.epa import epa_penetration
+from cspace.kernel.distance.gjk import exact_relation, gjk_distance
+from cspace.kernel.polygons.hull import convex_hull
+from cspace.kernel.minkowski.merge import minkowski_sum, reflect
 
 
 def rand_convex(rng, n, c):

@@ -21,9 +21,9 @@ import time
 
 import numpy as np
 
-from cspace.spaces.cspace import CSpace
-from cspace.io.imported import ImportOptions, import_file
-from cspace.io.scenario import scenario_from_dict
+from cspace.translation.cspace import CSpace
+from cspace.io.importers.imported import ImportOptions, import_file
+from cspace.io.load import scenario_from_dict
 
 FREE, OCC, UNK = 254, 0, 205
 

@@ -29,8 +29,8 @@ def child(yaml_path: str, size: int, reps: int) -> dict:
     sys.path.insert(0, HERE)
     from noisy_map import start_goal
 
-    from cspace.io.imported import ImportOptions, import_file
-    from cspace.io.validate import scenario_from_dict
+    from cspace.io.importers.imported import ImportOptions, import_file
+    from cspace.io.scenario.validate import scenario_from_dict
 
     start, goal = start_goal(size)
     opts = ImportOptions(robot={"radius": 0.2}, start=start, goal=goal)

@@ -13,8 +13,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchutil import median_time  # noqa: E402
-from cspace.kernel.minkowski import minkowski_sum
-from cspace.spaces import fastpath  # registers the compiled pair sum (when built) in minkowski_sum
+from cspace.kernel.minkowski.merge import minkowski_sum
+from cspace.compiled import fastpath  # registers the compiled pair sum (when built) in minkowski_sum
 
 
 def random_convex(n, rng, span=2**20):
@@ -81,7 +81,7 @@ def main():
     print(f"k-way: {k} polygons x {n} vertices: {kway * 1e3:.2f} ms, one argsort of all edges "
           f"{srt * 1e3:.2f} ms, ratio {kway / srt:.2f}; pairwise folding {folded * 1e3:.2f} ms "
           f"({folded / kway:.1f}x the single merge)")
-    # Small pairs: the compiled pair sum (cspace.spaces.fastpath) against the pure scalar merge.
+    # Small pairs: the compiled pair sum (cspace.compiled.fastpath) against the pure scalar merge.
     for n in (8, 32):
         P, Q = random_convex(n, rng), random_convex(n, rng)
         fast = median_time(lambda: minkowski_sum(P, Q), 2000)

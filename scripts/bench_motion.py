@@ -6,7 +6,7 @@ validator recording every state and every motion OMPL asks about. Those checks a
 then replayed, in interleaved rounds timed in process CPU time: the state test
 (``CSpace.point_test(state=True)``, what the validity callback is), the motion test
 (``CSpace.segment_test()``, what the motion validator calls: the compiled routine
-when built, see cspace/spaces/fastpath.py) and the pure-Python motion test (the exact path,
+when built, see cspace/compiled/fastpath.py) and the pure-Python motion test (the exact path,
 the compiled one's oracle; with CSPACE_PURE=1 both motion columns are pure). Figures:
 mean cost per check of each round, medians over rounds, and the median over rounds of
 the ratio motion / state. The replayed motion answers are checked equal on both paths.
@@ -26,7 +26,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 
 from cspace import CSpace, load_scenario  # noqa: E402
-from cspace.spaces import fastpath  # noqa: E402
+from cspace.compiled import fastpath  # noqa: E402
 
 DEFAULT = ("maze.toml", "random_polygons.toml")
 

@@ -66,8 +66,8 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 sys.path.insert(0, HERE)  # se2_peers
 
-from cspace.spaces.cspace import CSpace, decompose_obstacles, decompose_robot  # noqa: E402
-from cspace.io.scenario import load_scenario  # noqa: E402
+from cspace.translation.cspace import CSpace, decompose_obstacles, decompose_robot  # noqa: E402
+from cspace.io.load import load_scenario  # noqa: E402
 from planners.core.routine import run_planner  # noqa: E402
 from planners.adapters.translation import TranslationSpace  # noqa: E402
 from se2_peers import prism  # noqa: E402  (coal's prisms, shared with the SE(2) benches)
@@ -268,7 +268,7 @@ def scenes(names=None) -> list[str]:
 
 def unsolvable(sc, cs) -> bool:
     """Proven unsolvable by the exact planner (2 s; undecided counts as solvable)."""
-    from cspace.spaces.shortest import shortest_path
+    from cspace.paths.shortest import shortest_path
 
     return bool(shortest_path(cs.pieces, cs.bounds, sc.start[:2], sc.goal[:2], time_limit=2.0).proven_unsolvable)
 

@@ -57,9 +57,9 @@ sys.path.insert(0, ROOT)
 
 from sweep_oracle import sweep_check  # noqa: E402
 
-from cspace.spaces.cspace import CSpace  # noqa: E402
-from cspace.io.scenario import load_scenario  # noqa: E402
-from cspace.spaces.se2 import SE2CSpace  # noqa: E402
+from cspace.translation.cspace import CSpace  # noqa: E402
+from cspace.io.load import load_scenario  # noqa: E402
+from cspace.se2.cspace import SE2CSpace  # noqa: E402
 
 SE2_DIR = os.path.join(ROOT, "scenarios", "se2")
 VALIDITY_SCENES = ("car_maze.toml", "bug_trap.toml", "piano_corridor.toml")
@@ -256,7 +256,7 @@ def generated(kind: str, size: int, robot: list, scale: float, seed: int = 0):
     first seed from ``seed`` whose start and goal are free for it."""
     import tomllib
 
-    from cspace.io.scenario import ScenarioError, scenario_from_dict
+    from cspace.io.load import ScenarioError, scenario_from_dict
     from planners.cli.generate import generate
 
     for s in range(seed, seed + 50):
@@ -275,7 +275,7 @@ def car_judge(sc):
     """``path -> bool``: a car's path swept along its own curves by the oracle."""
     from sweep_oracle import car_sweep_check
 
-    from cspace.spaces.car_curves import dubins_segments, reeds_shepp_segments
+    from cspace.car.curves import dubins_segments, reeds_shepp_segments
 
     f = dubins_segments if sc.space == "dubins" else reeds_shepp_segments
 

@@ -50,7 +50,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import planners  # noqa: E402
 import sweep_oracle  # noqa: E402
-from cspace.io.scenario import load_scenario  # noqa: E402
+from cspace.io.load import load_scenario  # noqa: E402
 
 TARGETS = {"plank_corner_tight": 1.0, "wide_square": 0.1, "bug_trap_l": 0.2}
 

@@ -8,7 +8,7 @@ and their vertex count is the input size N), start and goal at opposite corners:
 (b) grid mazes: a random occupancy grid of unit cells (35 % full, like OMPL's env2),
     merged into polygons, with a free corridor around it; side ~ sqrt(N).
 
-For each scene, ``cspace.spaces.shortest.shortest_path`` (the mesh search, with its
+For each scene, ``cspace.paths.shortest.shortest_path`` (the mesh search, with its
 preparation: F, the triangulation, its checks) and ``method="lazy"`` (the old search,
 time-limited) run interleaved, ``--reps`` times each, the scene cache cleared before
 every call; the table shows medians of CPU seconds (the machine is shared), the old/new ratio where the old search
@@ -41,7 +41,7 @@ import time
 import numpy as np
 
 from cspace import CSpace, scenario_from_dict
-from cspace.spaces.shortest import clear_cache, shortest_path
+from cspace.paths.shortest import clear_cache, shortest_path
 
 FULL = [500, 1000, 2000, 5000, 10000, 20000]
 QUICK = [500, 2000, 5000]

@@ -2,7 +2,7 @@
 
 For each scene, one round builds all K slabs of a fresh ``SE2CSpace`` twice, interleaved:
 ``new`` with ``cs.slab(k)`` for every k (on the compiled path, runs of slabs built
-together by cspace.spaces.slab_build), ``legacy`` with the previous route, one slab at a
+together by cspace.se2.slab_build), ``legacy`` with the previous route, one slab at a
 time (its code kept below as it was: a ``CSpace`` per slab from the obstacles and the slab
 hulls, the inner sums by ``minkowski_sum`` pair by pair, the inner grid). The C-space's
 own setup (decomposition, pair grid) is outside the timing. Medians over the rounds,
@@ -23,11 +23,11 @@ import time
 import numpy as np
 
 from cspace import CSpace, SE2CSpace, load_scenario
-from cspace.kernel.minkowski import minkowski_sum, reflect
-from cspace.kernel.slab import slab_hull, slab_inner
-from cspace.spaces import fastpath
-from cspace.spaces.broadphase import BLOCKED, FREE, GridIndex
-from cspace.spaces.se2 import SLAB_GRID_CELLS
+from cspace.kernel.minkowski.merge import minkowski_sum, reflect
+from cspace.kernel.slabs.slab import slab_hull, slab_inner
+from cspace.compiled import fastpath
+from cspace.translation.broadphase import BLOCKED, FREE, GridIndex
+from cspace.se2.cspace import SLAB_GRID_CELLS
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CAR = np.array([[-0.6, -0.25], [0.5, -0.25], [0.7, -0.1], [0.7, 0.1], [0.5, 0.25], [-0.6, 0.25]])

@@ -62,6 +62,15 @@ def tree_commands() -> dict[str, list[str]]:
     }
 
 
+def fast_dir(tree: str) -> str:
+    """The folder of a tree's compiled fast path (its C sources and the built extension):
+    cspace/compiled, or cspace/spaces before the geometry was laid out by robot kind."""
+    for sub in ("compiled", "spaces"):
+        if os.path.exists(os.path.join(tree, "cspace", sub, "_fast.c")):
+            return os.path.join(tree, "cspace", sub)
+    return os.path.join(tree, "cspace", "compiled")
+
+
 @contextlib.contextmanager
 def checkout(rev: str):
     """A worktree of ``rev`` in a temporary folder (removed afterwards), with this tree's
@@ -71,8 +80,7 @@ def checkout(rev: str):
     subprocess.run(["git", "-C", ROOT, "worktree", "add", "--detach", path, rev], check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        here = os.path.join(ROOT, "cspace", "spaces")
-        there = os.path.join(path, "cspace", "spaces")
+        here, there = fast_dir(ROOT), fast_dir(path)
         sources = sorted(os.path.basename(f) for f in glob.glob(os.path.join(here, "_*.[ch]")))
         if all(os.path.exists(os.path.join(there, f)) and filecmp.cmp(os.path.join(here, f), os.path.join(there, f),
                                                                       shallow=False) for f in sources):

@@ -4,7 +4,7 @@ The map and the pairs come from scripts/make_warehouse_map.py (2000 x 2000 cells
 offices, racks and aisles, docks; a 0.62 x 0.9 m rectangular footprint; seeded start/goal poses
 free with a margin), written to a temporary folder.
 
-- preparation: the map imported (``cspace.io.imported``, the default tolerance), the SE(2)
+- preparation: the map imported (``cspace.io.importers.imported``, the default tolerance), the SE(2)
   C-space built (``planners.core.plan.build_cspace``) with all its slabs, the POSSIBLE regions
   that the proof before sampling reads, and the first slabs' FREE regions, meshes and links that
   the exact planner reads first (``planners.core.exact_se2.prepare``).
@@ -110,9 +110,9 @@ def main(argv=None) -> int:
     if not mine or set(mine) - {"RRTConnect", "exact"}:
         ap.error(f"--planners: RRTConnect and/or exact, got {args.planners!r}")
 
-    from cspace.io.imported import ImportOptions, import_file
-    from cspace.io.scenario import read_toml, scenario_from_dict
-    from cspace.io.validate import with_queries
+    from cspace.io.importers.imported import ImportOptions, import_file
+    from cspace.io.load import read_toml, scenario_from_dict
+    from cspace.io.scenario.validate import with_queries
     from planners.core.exact_se2 import prepare
     from planners.core.plan import build_cspace
 

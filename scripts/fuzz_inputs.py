@@ -1,8 +1,10 @@
-"""The large fuzz campaign of issue 36: scenario files (tests/test_fuzz_cli.py) and imported
-maps and meshes (tests/test_fuzz_imports.py) under the exit-code contract (0/1/2, never 3;
-exit 2 one line; inputs never written over; no temporaries; valid JSON).
+"""The large fuzz campaign of issue 36: scenario files (tests/cli/test_fuzz_cli.py) and imported
+maps and meshes (tests/io/test_fuzz_maps.py, tests/io/test_fuzz_meshes.py) under the exit-code
+contract of tests/helpers/fuzzing.py (0/1/2, never 3; exit 2 one line; inputs never written over;
+no temporaries; valid JSON).
 
-Runs the two fuzz files as two pytest processes (in parallel with ``--jobs 2``), each with
+Runs the scenario fuzz and the import fuzz (its two files in one process: the last test of
+test_fuzz_meshes.py reports both) as two pytest processes (in parallel with ``--jobs 2``), each with
 ``CSPACE_FUZZ_EXAMPLES`` examples per test, and prints one JSON summary: cases and files per
 input kind, the exit-code histogram, exit 3 and modified-input counts, the slowest case. A case
 that breaks the contract is kept (its files and the reason) under ``OUT/kept`` and counted; the
@@ -23,35 +25,38 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The test files of each campaign, run in one pytest process (relative to ROOT): the imports'
+# report is the last test of test_fuzz_meshes.py, after test_fuzz_maps.py's cases.
+FILES = {"scenario": (os.path.join("tests", "cli", "test_fuzz_cli.py"),),
+         "imports": (os.path.join("tests", "io", "test_fuzz_maps.py"), os.path.join("tests", "io", "test_fuzz_meshes.py"))}
 
 
-def run_file(test_file: str, examples: int, out: str, tag: str) -> tuple[subprocess.Popen, str]:
+def run_files(test_files: tuple, examples: int, out: str, tag: str) -> tuple[subprocess.Popen, str]:
     report = os.path.join(out, f"report-{tag}.json")
     env = dict(os.environ, CSPACE_FUZZ_EXAMPLES=str(examples), CSPACE_FUZZ_REPORT=report,
                CSPACE_FUZZ_KEEP=os.path.join(out, "kept", tag))
     log = open(os.path.join(out, f"pytest-{tag}.log"), "w")
-    proc = subprocess.Popen([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-                             os.path.join("tests", test_file)], cwd=ROOT, env=env, stdout=log,
-                            stderr=subprocess.STDOUT)
+    proc = subprocess.Popen([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *test_files],
+                            cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
     return proc, report
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", type=int, default=1000, help="examples per test of test_fuzz_cli.py (4 tests)")
-    ap.add_argument("--imports", type=int, default=2000, help="examples per test of test_fuzz_imports.py (4 tests)")
+    ap.add_argument("--imports", type=int, default=2000,
+                    help="examples per test of test_fuzz_maps.py and test_fuzz_meshes.py (4 tests)")
     ap.add_argument("--out", default="fuzz_out", help="folder for the reports, logs and kept cases")
     ap.add_argument("--jobs", type=int, choices=(1, 2), default=2)
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     out = os.path.abspath(args.out)
     t0 = time.time()
-    plan = [(f, n, tag) for f, n, tag in (("test_fuzz_cli.py", args.scenario, "scenario"),
-                                          ("test_fuzz_imports.py", args.imports, "imports")) if n > 0]
+    plan = [(FILES[tag], n, tag) for n, tag in ((args.scenario, "scenario"), (args.imports, "imports")) if n > 0]
     reports, codes = {}, {}
     running = []
     for f, n, tag in plan:
-        proc, rep = run_file(f, n, out, tag)
+        proc, rep = run_files(f, n, out, tag)
         running.append((tag, proc))
         reports[tag] = rep
         if args.jobs == 1:

@@ -17,7 +17,7 @@ Deterministic output: the pictures of :mod:`planners.pictures.plot` are saved he
 figure size and a fixed dpi, without ``bbox_inches="tight"`` (which sized each PNG by its title's
 and legend's text, so a changed label changed the PNG's pixel size); every plan has a fixed seed.
 Each such PNG records its legend entries in its metadata (the PNG text key ``Legend``, one
-label a line: :func:`legend_labels` reads it back), so tests/test_docs_drift.py can compare a fresh
+label a line: :func:`legend_labels` reads it back), so tests/project/test_docs_drift.py can compare a fresh
 drawing with the committed one. The whole set takes
 well under two minutes on a laptop core; the acceptance sweep behind
 ``error_vs_time.png`` takes about ten and runs only when named (``--only acceptance``).
@@ -185,7 +185,7 @@ def slab_pair_figure(scenario: str, a: float, b: float, c: float) -> Callable[[s
     """The exact SE(2) planner's slab graph for the two slabs [a, b] and [b, c]."""
 
     def draw(out: str) -> str:
-        from cspace.io.scenario import load_scenario
+        from cspace.io.load import load_scenario
         from planners.pictures.slab_pair import plot_slab_pair
 
         plot_slab_pair(load_scenario(os.path.join(SCENARIOS, "se2", f"{scenario}.toml")), a, b, c, out)
@@ -198,8 +198,8 @@ def cspace_figure(scenario: str) -> Callable[[str], str]:
     """Workspace, C-obstacles and their convex pieces, as ``cspace show --plot``."""
 
     def draw(out: str) -> str:
-        from cspace.spaces.cspace import CSpace
-        from cspace.io.scenario import load_scenario
+        from cspace.translation.cspace import CSpace
+        from cspace.io.load import load_scenario
         from planners.pictures.plot import plot_scene
 
         sc = load_scenario(_scenario(scenario))
@@ -236,7 +236,7 @@ def map_figure(seed: int = SEED) -> Callable[[str], str]:
     """The ROS map imported and planned, as ``cspace plan office.yaml --robot robot.toml --plot``."""
 
     def draw(out: str) -> str:
-        from cspace.io.imported import ImportOptions, load_imported
+        from cspace.io.importers.imported import ImportOptions, load_imported
         from planners.cli.imports import read_robot
         from planners import plan
         from planners.pictures.plot import plot_result

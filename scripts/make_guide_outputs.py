@@ -16,7 +16,7 @@ the same text once every number is replaced by ``#``. Numbers followed by ``ms``
 :data:`TIME_FLOOR_MS`. Other numbers (lengths, waypoints, counts, bytes) are deterministic with
 the commands' seeds and must equal the fresh ones to the printed digits, unless the block is
 marked ``loose`` (a time-limited anytime planner, a timed benchmark: only the shape is checked).
-``slow`` blocks run only with ``--slow`` (tests/test_docs_drift.py: ``CSPACE_DOCS_SLOW=1``).
+``slow`` blocks run only with ``--slow`` (tests/project/test_docs_drift.py: ``CSPACE_DOCS_SLOW=1``).
 
 ``--write`` replaces each quoted line by its fresh match (numbers, times included, and wording
 of the same shape); a quoted line whose shape no fresh line has is reported, to edit by hand.

@@ -1,4 +1,11 @@
-"""Shared fixtures: scenario files written from TOML text, paths to bundled data."""
+"""Shared fixtures: scenario files written from TOML text, paths to bundled data.
+
+The test modules sit in folders by concern (tests/kernel/, tests/io/, ...); pytest puts each
+test file's own folder on sys.path, and this file's folder, so ``from conftest import ROOT``
+works from every one of them. What tests of different folders share (independent oracles, the
+fuzzing contract) lives in tests/helpers/, plain modules put on sys.path here: a test imports
+``from oracles import swept_clearance``, never another test module of another folder.
+"""
 from __future__ import annotations
 
 import importlib.util
@@ -9,6 +16,9 @@ import textwrap
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+HELPERS = os.path.join(ROOT, "tests", "helpers")
+if HELPERS not in sys.path:
+    sys.path.insert(0, HELPERS)
 SCENARIOS = os.path.join(ROOT, "scenarios")
 # OMPL's planning-benchmark scenes, bundled (converted copies; see scenarios/ompl/README.md).
 # Tests read only files inside the repository: a user's clone has nothing beside it.

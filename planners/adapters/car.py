@@ -1,13 +1,13 @@
 """Car-like state spaces: OMPL's Dubins and Reeds–Shepp spaces over the sliced SE(2) C-space.
 
-A car is a rotating robot (poses (x, y, theta), the C-space of :mod:`cspace.spaces.se2`)
+A car is a rotating robot (poses (x, y, theta), the C-space of :mod:`cspace.se2.cspace`)
 whose motions are not straight lines in SE(2) but the shortest Dubins curves
 (forward only) or Reeds–Shepp curves (forward and reverse) of a minimum turning
 radius. OMPL's ``DubinsStateSpace`` / ``ReedsSheppStateSpace`` give the planners
 their metric and interpolation; every motion the planners ask about is recomputed
-here as its segments (:mod:`cspace.spaces.car_curves`, checked against OMPL's own
+here as its segments (:mod:`cspace.car.curves`, checked against OMPL's own
 ``distance`` and ``interpolate`` by the tests) and certified segment by segment
-(:meth:`cspace.spaces.se2.SE2CSpace.curve_free`: exact straight segments, arcs bounded by
+(:meth:`cspace.car.motion.CarCSpace.curve_free`: exact straight segments, arcs bounded by
 hulls about the turning centre), never sampled.
 """
 from __future__ import annotations
@@ -17,7 +17,8 @@ import math
 
 import numpy as np
 
-from cspace.spaces.car_curves import curve_length, dubins_segments, knots, pose_along, reeds_shepp_segments
+from cspace.car.motion import as_car
+from cspace.car.curves import curve_length, dubins_segments, knots, pose_along, reeds_shepp_segments
 
 from .se2 import SE2Space
 from .frame import scaled_bounds
@@ -37,7 +38,7 @@ class CarSpace(SE2Space):
     clearance_functions = None
 
     def __init__(self, cspace, kind: str, radius: float, k: int | None = None):
-        super().__init__(cspace, k)
+        super().__init__(as_car(cspace), k)
         if kind not in ("dubins", "reeds-shepp"):
             raise ValueError(f"CarSpace: kind must be 'dubins' or 'reeds-shepp', got {kind!r}")
         self.name = kind
@@ -58,8 +59,8 @@ class CarSpace(SE2Space):
 
     def path_clearance(self, path: np.ndarray):
         """A certified lower bound of the clearance of the ROBOT (body pieces, not inflated)
-        driven along the curves of ``path`` (:func:`cspace.spaces.car_clearance.car_path_clearance`)."""
-        from cspace.spaces.car_clearance import car_path_clearance
+        driven along the curves of ``path`` (:func:`cspace.car.clearance.car_path_clearance`)."""
+        from cspace.car.clearance import car_path_clearance
 
         return car_path_clearance(path, self.segments, self.radius, self.cspace.body_pieces,
                                   self.cspace.obstacle_pieces)
@@ -75,7 +76,7 @@ class CarSpace(SE2Space):
 
     def motion_free(self, q0, q1) -> bool:
         """Whether the car, driven along the shortest curve from q0 to q1, touches nothing
-        (certified: :meth:`cspace.spaces.se2.SE2CSpace.car_motion_free`)."""
+        (certified: :meth:`cspace.car.motion.CarCSpace.car_motion_free`)."""
         return self.cspace.car_motion_free(q0, q1, self.name, self.radius)
 
     def counts(self) -> tuple[int, int]:

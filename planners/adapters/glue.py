@@ -11,7 +11,7 @@ import contextlib
 import os
 import sys
 
-from cspace.io.scenario import ScenarioError
+from cspace.io.load import ScenarioError
 
 
 _ompl = None

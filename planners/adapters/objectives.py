@@ -5,8 +5,8 @@ OMPL 2.0's Python bindings bind ``PathLengthOptimizationObjective`` but not
 subclasses of OMPL's classes (checked to run inside RRTstar and the other optimising
 planners), fed by :func:`clearance_functions` (in translation: a state's clearance is the
 exact float distance from the reference point to the nearest C-obstacle piece, through the
-grid of :class:`cspace.spaces.point_clearance.PointClearance`, computed once per state; a
-motion's is :func:`cspace.spaces.point_clearance.disc_bound` of its ends' clearances and
+grid of :class:`cspace.translation.point_clearance.PointClearance`, computed once per state; a
+motion's is :func:`cspace.translation.point_clearance.disc_bound` of its ends' clearances and
 its length, a certified lower bound of the segment's exact clearance that costs no
 geometry; in SE(2), the adapter's ``clearance_functions``):
 
@@ -20,7 +20,7 @@ geometry; in SE(2), the adapter's ``clearance_functions``):
   OMPL's MaximizeMinClearanceObjective combines by max instead: written in Python it cost
   three calls into Python per neighbour (8x the length objective per iteration on bug_trap,
   and a median clearance of 0.08 there against this one's 0.31, 3 seeds of 3000 iterations). In translation the motion's cost is compiled
-  (:func:`cspace.spaces.fastpath.disc_cost`, the same doubles; this Python one is its oracle and
+  (:func:`cspace.compiled.fastpath.disc_cost`, the same doubles; this Python one is its oracle and
   the pure path): ~3-4x the length objective per RRTstar iteration (the Python motion
   cost over a compiled C-space: 4-7x; all pure: 1.4-1.8x; ``scripts/bench_objective.py``);
 - ``balanced``: the integral along the path of ``1 + w · ρ / (c + ρ)`` (c the clearance,
@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import math
 
-from cspace.spaces import fastpath
+from cspace.compiled import fastpath
 
 OBJECTIVES = ("length", "clearance", "balanced")
 BALANCED_WEIGHT = 1.0  # w: extra cost of a unit of length at zero clearance
@@ -97,7 +97,7 @@ def clearance_functions(adapter):
     """``(state -> clearance, (state, state) -> clearance)`` on OMPL states, as the
     clearance objectives read them (C-space units). Translation: a state's exact float
     clearance (0 for a state that is not free), remembered per state; a motion's
-    :func:`cspace.spaces.point_clearance.disc_bound` of its ends (a lower bound of its
+    :func:`cspace.translation.point_clearance.disc_bound` of its ends (a lower bound of its
     exact clearance). Other spaces: the adapter's ``clearance_functions``."""
     if getattr(adapter, "name", None) != "translation":
         return adapter.clearance_functions()
@@ -109,7 +109,7 @@ def _translation_functions(adapter, box):
     ``box(-clearance)`` (``ob.Cost`` inside the objective: one Python call per motion), and
     the state's clearance at raw OMPL coordinates, not remembered (what the compiled motion
     cost calls on a state it has not met)."""
-    from cspace.spaces.point_clearance import PointClearance
+    from cspace.translation.point_clearance import PointClearance
 
     cs, k = adapter.cspace, -adapter.k
     near = PointClearance(cs.pieces, cs.bounds)
@@ -171,9 +171,9 @@ def _translation_functions(adapter, box):
 
 def path_clearance_bound(adapter, path) -> float:
     """The clearance the ``clearance`` objective gives a translation path of reference
-    points (rows x, y, C-space units): the least :func:`cspace.spaces.point_clearance.disc_bound`
+    points (rows x, y, C-space units): the least :func:`cspace.translation.point_clearance.disc_bound`
     over its motions (inf without obstacles), never more than the path's exact clearance."""
-    from cspace.spaces.point_clearance import PointClearance, disc_bound
+    from cspace.translation.point_clearance import PointClearance, disc_bound
 
     cs = adapter.cspace
     near = PointClearance(cs.pieces, cs.bounds)

@@ -3,9 +3,9 @@
 The planning routine talks to a state-space adapter (see :mod:`planners.adapters`, whose
 methods this one has); this is the one for robots that translate *and* rotate. OMPL interpolates x, y linearly and
 theta along the shorter arc; the validity checker asks the sliced C-space
-(:meth:`cspace.spaces.se2.SE2CSpace.pose_test`: a slab's certified FREE answer, else the exact
+(:meth:`cspace.se2.cspace.SE2CSpace.pose_test`: a slab's certified FREE answer, else the exact
 test of the robot turned to theta) and the motion validator asks
-:meth:`cspace.spaces.se2.SE2CSpace.motion_free`, a certificate along the whole motion (never a
+:meth:`cspace.se2.cspace.SE2CSpace.motion_free`, a certificate along the whole motion (never a
 sample). Weights as OMPL.app: R^2 x 1, SO(2) x 0.5.
 """
 from __future__ import annotations
@@ -40,9 +40,9 @@ class SE2Space:
         distance from the (inflated) robot at the pose to the nearest obstacle piece; a
         motion takes the least of its two ends and its middle pose (a sample: this feeds
         the optimisation objective only; the reported clearance is certified)."""
-        from cspace.spaces.clearance import Nearest
-        from cspace.spaces.se2_motion import interpolate
-        from cspace.kernel.slab import rotate_piece
+        from cspace.translation.clearance import Nearest
+        from cspace.se2.motion import interpolate
+        from cspace.kernel.polygons.rotation import rotate_piece
 
         near, k = Nearest(self.cspace.obstacle_pieces), -self.k
         pieces = self.cspace.robot_pieces or [np.zeros((1, 2))]
@@ -63,8 +63,8 @@ class SE2Space:
 
     def path_clearance(self, path: np.ndarray):
         """A certified lower bound of the clearance of the ROBOT (body pieces, not inflated)
-        along ``path`` (:func:`cspace.spaces.clearance.se2_path_clearance`)."""
-        from cspace.spaces.clearance import se2_path_clearance
+        along ``path`` (:func:`cspace.se2.clearance.se2_path_clearance`)."""
+        from cspace.se2.clearance import se2_path_clearance
 
         return se2_path_clearance(path, self.cspace.body_pieces, self.cspace.obstacle_pieces)
 
@@ -125,7 +125,7 @@ class SE2Space:
 
     def motion_free(self, q0, q1) -> bool:
         """Whether the robot, moved along OMPL's SE(2) interpolation from q0 to q1, touches
-        nothing (certified: :meth:`cspace.spaces.se2.SE2CSpace.motion_free`)."""
+        nothing (certified: :meth:`cspace.se2.cspace.SE2CSpace.motion_free`)."""
         return self.cspace.motion_free(q0, q1)
 
     def pose(self, p) -> tuple:

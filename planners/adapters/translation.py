@@ -130,8 +130,8 @@ class TranslationSpace:
         C-space's units: the distance from the reference point (from the segment, for a
         motion) to the nearest C-obstacle edge, that is, for a free state or motion, how far
         the robot (inflated by the margin, if any) is from touching an obstacle (floats, all
-        edges at once: :class:`cspace.spaces.clearance.EdgeDistance`)."""
-        from cspace.spaces.clearance import EdgeDistance
+        edges at once: :class:`cspace.translation.clearance.EdgeDistance`)."""
+        from cspace.translation.clearance import EdgeDistance
 
         ed, k = EdgeDistance(self.cspace.pieces), -self.k
         point, segment = ed.point, ed.segment
@@ -146,8 +146,8 @@ class TranslationSpace:
 
     def path_clearance(self, path: np.ndarray):
         """The exact clearance of the ROBOT (not inflated) swept along ``path``
-        (:func:`cspace.spaces.clearance.path_clearance`)."""
-        from cspace.spaces.clearance import path_clearance
+        (:func:`cspace.translation.clearance.path_clearance`)."""
+        from cspace.translation.clearance import path_clearance
 
         return path_clearance(path, self.cspace.robot_pieces, self.cspace.obstacle_pieces)
 

@@ -2,8 +2,8 @@
 column of the summary.
 
 Every solved run's ``min_clearance`` is the one :func:`planners.core.plan.plan` measures
-(:mod:`cspace.spaces.clearance`: exact in translation, a certified lower bound in SE(2)
-and, along the curves, for cars: :mod:`cspace.spaces.car_clearance`), after the run's timed solve. ``--objective`` is handed to the
+(:mod:`cspace.translation.clearance`: exact in translation, a certified lower bound in SE(2)
+and, along the curves, for cars: :mod:`cspace.car.clearance`), after the run's timed solve. ``--objective`` is handed to the
 one planning routine (:func:`planners.core.routine.run_planner`) through ``plan()``; it is
 checked here once, before any run, so that a planner or a scenario that cannot take it
 is one line and exit 2, not a sweep of crashed rows.

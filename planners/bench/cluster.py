@@ -59,7 +59,7 @@ def held_scenario(file: str, sha: str, space: str | None, slabs: int | None) -> 
     """``(scenario, cspace)`` of a scenario file, built once per process (the worker's cache)."""
     key = (sha, space, slabs)
     if key not in _held:
-        from cspace.io.scenario import load_scenario
+        from cspace.io.load import load_scenario
 
         from .arena_db import file_hash
         from .reference import warmed

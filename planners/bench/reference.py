@@ -2,7 +2,7 @@
 the tasks, one per (scenario, planner, budget, seed) in a deterministic order.
 
 The reference of a translation scenario is its exact shortest path
-(:mod:`cspace.spaces.shortest` through ``plan(planner="exact")``); a rotating robot's is
+(:mod:`cspace.paths.shortest` through ``plan(planner="exact")``); a rotating robot's is
 the inscribed-disk lower bound (:mod:`planners.core.bounds`), so its error is an upper
 bound; in SE(2) the exact planner's certified path (the slab graph, shortened) is also
 computed once, an upper bound on the optimum, with the exact planner's own time. The sweep
@@ -48,7 +48,7 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
     apart. With ``held``, ``held[file] = (scenario, cspace)`` keeps each built C-space
     for the runs. A missing or malformed file is a ScenarioError (exit 2).
     """
-    from cspace.io.scenario import load_scenario
+    from cspace.io.load import load_scenario
 
     out = []
     for f in files:

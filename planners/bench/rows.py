@@ -49,7 +49,7 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
     ``min_clearance`` is the one ``plan()`` measures on the solved path, after the solve
     (so outside ``solve_s``; its time is ``clearance_s``).
     """
-    from cspace.io.scenario import load_scenario
+    from cspace.io.load import load_scenario
 
     from ..core.plan import plan
 

@@ -18,7 +18,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from cspace.io.scenario import load_scenario
+    from cspace.io.load import load_scenario
 
     from ..core.proof_check import check_proof, load_proof
 

@@ -31,7 +31,7 @@ COMMANDS = {
 }
 # Each command's one-line help, for the listing of ``cspace --help`` (and a bare
 # ``cspace``), which then imports no command module, nor numpy: start-up stays short.
-# tests/test_cli.py checks these are the help strings the modules register.
+# tests/cli/test_cli.py checks these are the help strings the modules register.
 HELP = {
     "plan": "plan a collision-free path for a scenario",
     "show": "draw the workspace, the C-obstacles and their convex pieces",
@@ -45,12 +45,12 @@ HELP = {
 
 
 def clip(text: str, limit: int) -> str:
-    """:func:`cspace.io.messages.clip`, imported when needed (it pulls in numpy).
+    """:func:`cspace.io.scenario.messages.clip`, imported when needed (it pulls in numpy).
 
     >>> clip("abc", 10)
     'abc'
     """
-    from cspace.io.messages import clip as _clip
+    from cspace.io.scenario.messages import clip as _clip
 
     return _clip(text, limit)
 
@@ -96,12 +96,12 @@ def version_line() -> str:
 
 
 def fast_path() -> str:
-    """Whether the compiled routines of :mod:`cspace.spaces.fastpath` are in use, and why not.
+    """Whether the compiled routines of :mod:`cspace.compiled.fastpath` are in use, and why not.
 
     >>> fast_path().startswith(("compiled fast path: on", "pure Python path"))
     True
     """
-    from cspace.spaces import fastpath
+    from cspace.compiled import fastpath
 
     if fastpath.compiled():
         return "compiled fast path: on"
@@ -151,7 +151,7 @@ def main(argv: list[str] | None = None) -> int:
     first = next((a for a in argv if not a.startswith("-")), None)
     parser = build_parser(first if first in COMMANDS else None)
     args = parser.parse_args(argv)
-    from cspace.io.scenario import ScenarioError
+    from cspace.io.load import ScenarioError
 
     try:
         with warnings.catch_warnings():

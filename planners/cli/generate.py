@@ -254,12 +254,12 @@ def _solvable(scene: dict, bar=None) -> str | None:
     (stages shown on ``bar``).
 
     Connected means in one polygon of the free space F (the exact planner's own test
-    of solvability, :func:`cspace.spaces.shortest.shortest_path`): one polygon union, not a
+    of solvability, :func:`cspace.paths.shortest.shortest_path`): one polygon union, not a
     search, so it is bounded (seconds for thousands of obstacles) where the shortest
     path itself may search for minutes.
     """
-    from cspace.spaces.cspace import CSpace
-    from cspace.io.scenario import ScenarioError, scenario_from_dict
+    from cspace.translation.cspace import CSpace
+    from cspace.io.load import ScenarioError, scenario_from_dict
 
     from ..progress import Progress
 
@@ -281,7 +281,7 @@ def _connected(cs, start, goal) -> bool:
     """Start and goal in one polygon of the free space (as the exact planner decides it)."""
     import shapely
 
-    from cspace.spaces.shortest import free_space
+    from cspace.paths.shortest import free_space
 
     s, g = shapely.Point(start), shapely.Point(goal)
     return any(part.covers(s) and part.covers(g) for part in shapely.get_parts(free_space(cs.pieces, cs.bounds)))

@@ -43,9 +43,9 @@ IMPORT_FLAGS = ("robot", "radius", "polygon", "start", "goal", "unknown", "toler
 
 
 def import_options(args, src: str):
-    """The :class:`cspace.io.imported.ImportOptions` of the parsed options; for a file that
+    """The :class:`cspace.io.importers.imported.ImportOptions` of the parsed options; for a file that
     is not imported (a scenario TOML) any of them is an error."""
-    from cspace.io.imported import ImportOptions, is_import
+    from cspace.io.importers.imported import ImportOptions, is_import
 
     given = [f for f in IMPORT_FLAGS if getattr(args, f, None) is not None]
     if not is_import(src):
@@ -90,18 +90,18 @@ def input_files(src: str, robot: str | None = None, queries: str | None = None) 
     the image it names, or the cfg and its meshes, resolved as the import resolves them),
     the ``--robot`` file and the ``--queries`` file. Listed without importing; a file that
     cannot be listed (a broken YAML or cfg) is reported by the import itself."""
-    from cspace.io.imported import CFG_SUFFIXES, is_import
-    from cspace.io.messages import ScenarioError
+    from cspace.io.importers.imported import CFG_SUFFIXES, is_import
+    from cspace.io.scenario.messages import ScenarioError
 
     files = [src]
     if is_import(src):
         try:
             if src.lower().endswith(CFG_SUFFIXES):
-                from cspace.io.omplapp import mesh_files
+                from cspace.io.importers.omplapp import mesh_files
 
                 files += mesh_files(src)
             else:
-                from cspace.io.occupancy import read_map_yaml
+                from cspace.io.importers.occupancy import read_map_yaml
 
                 files.append(read_map_yaml(src).image)
         except (ScenarioError, OSError, ValueError):
@@ -111,7 +111,7 @@ def input_files(src: str, robot: str | None = None, queries: str | None = None) 
 
 def read_robot(path: str) -> dict:
     """The ``[robot]`` table of a TOML file (a robot file, or any scenario)."""
-    from cspace.io.files import read_input, toml_reader
+    from cspace.io.scenario.files import read_input, toml_reader
 
     tomllib = toml_reader()
     raw = read_input(path)
@@ -126,9 +126,9 @@ def read_robot(path: str) -> dict:
 
 
 def run(args) -> int:
-    from cspace.io.files import check_input
-    from cspace.io.imported import import_file, is_import, to_toml
-    from cspace.io.validate import scenario_from_dict
+    from cspace.io.scenario.files import check_input
+    from cspace.io.importers.imported import import_file, is_import, to_toml
+    from cspace.io.scenario.validate import scenario_from_dict
 
     from ..output import check_output, write_text
 

@@ -69,7 +69,7 @@ def integer(s: str) -> int:
 
 
 def run(args) -> int:
-    from cspace.io.files import check_input
+    from cspace.io.scenario.files import check_input
 
     from ..errors import InputError
 
@@ -81,7 +81,7 @@ def run(args) -> int:
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
     if args.clearance is not None:
-        from cspace.io.fields import clearance_fault
+        from cspace.io.scenario.fields import clearance_fault
 
         if fault := clearance_fault(args.clearance):
             raise InputError(src, "--clearance", fault)
@@ -116,7 +116,7 @@ def run(args) -> int:
     options = import_options(args, src)
     queries = None
     if args.queries is not None:
-        from cspace.io.scenario import read_toml
+        from cspace.io.load import read_toml
 
         check_input(args.queries)
         queries = read_toml(args.queries)
@@ -153,13 +153,13 @@ def run(args) -> int:
         from ..adapters.glue import ompl
 
         ompl()[2].setLogLevel(ompl()[2].LOG_INFO)
-    from cspace.io.scenario import ScenarioError
+    from cspace.io.load import ScenarioError
 
     scenario = src
     t_import = time.perf_counter()  # a load done here (an import, a queries file) is this run's load
     if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
-        from cspace.io.imported import import_file
-        from cspace.io.scenario import scenario_from_dict
+        from cspace.io.importers.imported import import_file
+        from cspace.io.load import scenario_from_dict
 
         imp = import_file(src, options)
         for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"),
@@ -175,8 +175,8 @@ def run(args) -> int:
                 raise InputError(args.queries, f"queries[0].{exc.field}", exc.message) from None
             raise
     if queries is not None:
-        from cspace.io.scenario import load_scenario
-        from cspace.io.validate import with_queries
+        from cspace.io.load import load_scenario
+        from cspace.io.scenario.validate import with_queries
 
         if options is None:
             scenario = load_scenario(src, space=args.space, turning_radius=args.turning_radius)

@@ -26,13 +26,13 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from cspace.io.files import check_input
-    from cspace.io.scenario import load_scenario
+    from cspace.io.scenario.files import check_input
+    from cspace.io.load import load_scenario
 
     from ..errors import InputError
 
     if args.clearance is not None:
-        from cspace.io.fields import clearance_fault
+        from cspace.io.scenario.fields import clearance_fault
 
         if fault := clearance_fault(args.clearance):
             raise InputError(args.scenario, "--clearance", fault)
@@ -44,7 +44,7 @@ def run(args) -> int:
     if args.json is not None:
         check_output(args.json, "--json", inputs=inputs)
     check_distinct([(args.json, "--json"), (args.plot, "--plot")])
-    from cspace.spaces.cspace import CSpace
+    from cspace.translation.cspace import CSpace
 
     from .imports import import_options
 
@@ -84,8 +84,9 @@ def _show_se2(sc, args, fmt) -> int:
     slab hulls, free there means free at every angle of the slab) and the report."""
     import math
 
-    from cspace.spaces.se2 import SE2CSpace
-    from cspace.kernel.slab import slab_range, wrap_angle
+    from cspace.se2.cspace import SE2CSpace
+    from cspace.kernel.slabs.slab import slab_range
+    from cspace.kernel.polygons.rotation import wrap_angle
 
     from ..errors import InputError
 

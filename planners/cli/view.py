@@ -36,7 +36,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from cspace.io.files import check_input
+    from cspace.io.scenario.files import check_input
 
     from ..adapters.glue import MAX_TIME, OMPL_HINT, SEED_LIMIT, ompl_available, planner_name
     from ..errors import InputError

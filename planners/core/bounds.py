@@ -28,9 +28,9 @@ class DiskBound:
 
 def disk_bound(sc, query, time_limit: float = 10.0, sides: int = 32) -> DiskBound:
     """The inscribed-disk lower bound and unsolvability proof for ``query`` of an SE(2) scenario."""
-    from cspace.spaces.cspace import CSpace
-    from cspace.spaces.shortest import shortest_path
-    from cspace.kernel.slab import inscribed_polygon, inscribed_radius
+    from cspace.translation.cspace import CSpace
+    from cspace.paths.shortest import shortest_path
+    from cspace.kernel.slabs.slab import inscribed_polygon, inscribed_radius
 
     t0 = time.perf_counter()
     rho = inscribed_radius([s.polygon for s in sc.robot]) if sc.robot else 0.0

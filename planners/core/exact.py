@@ -1,6 +1,6 @@
 """The ``exact`` planner: the true shortest path over the C-space, as a PlanResult.
 
-The geometry lives in :mod:`cspace.spaces.shortest` (a reduced visibility graph over the
+The geometry lives in :mod:`cspace.paths.shortest` (a reduced visibility graph over the
 C-obstacle corners, searched lazily with A*). Here it is only wrapped so that it
 answers like any other planner: ``cspace plan --planner exact`` or
 ``planners.shortest_path(scenario)``.
@@ -29,7 +29,7 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
     (nodes settled, and a lower bound on the length that rises towards the answer);
     ``progress=False`` silences it, ``None`` draws it only when stderr is a terminal.
     """
-    from cspace.spaces.shortest import shortest_path as geometric_shortest
+    from cspace.paths.shortest import shortest_path as geometric_shortest
 
     from .. import progress as pg
 

@@ -1,5 +1,5 @@
 """``exact`` for a rotating robot: the slab graph's certified path, its proof that no path
-exists, or the resolution it reached (:mod:`cspace.spaces.se2_exact`), as a PlanResult.
+exists, or the resolution it reached (:mod:`cspace.se2.exact`), as a PlanResult.
 
 - *solved*: the slab graph's path (translations at fixed angles, each the exact shortest path
   inside its component, and rotations in place) is re-verified motion by motion by the
@@ -45,7 +45,7 @@ def search(cspace, query, time_limit: float | None, *, possible_only: bool = Fal
     """The slab-graph search on an SE(2) C-space's pieces (body frame; its margin, if any,
     inflates the robot for the path, while a proof is made for the body itself). The slab
     regions are kept with the C-space, so the queries of one scene share them."""
-    from cspace.spaces.se2_exact import exact_se2_search
+    from cspace.se2.exact import exact_se2_search
 
     regions = _regions_of(cspace)
     return exact_se2_search(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, tuple(query.start),
@@ -60,8 +60,8 @@ def prepare(cspace, exact: bool = False) -> float:
     translations search and the links between them (what :func:`exact_se2` reads first), and
     FREE of their halves (a pair through a narrow door refines there first); returns the seconds
     it took."""
-    from cspace.spaces.se2_exact import initial_partition
-    from cspace.spaces.shortest import warm
+    from cspace.se2.exact import initial_partition
+    from cspace.paths.shortest import warm
 
     t = time.perf_counter()
     regions = _regions_of(cspace)
@@ -81,8 +81,8 @@ def prepare(cspace, exact: bool = False) -> float:
 
 
 def _regions_of(cspace):
-    """The C-space's :class:`cspace.spaces.slab_graph.SlabRegions`, made on first use and kept."""
-    from cspace.spaces.se2_exact import slab_regions
+    """The C-space's :class:`cspace.se2.slab_graph.SlabRegions`, made on first use and kept."""
+    from cspace.se2.exact import slab_regions
 
     regions = _REGIONS.get(cspace)
     if regions is None:
@@ -94,7 +94,7 @@ def _regions_of(cspace):
 def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None = None,
               simplify: bool = True) -> PlanResult:
     """``planner = "exact"`` for a rotating robot (``space = "se2"``) or a car (a proof or nothing)."""
-    from cspace.io.scenario import ScenarioError
+    from cspace.io.load import ScenarioError
 
     car = sc.space != "se2"
     t0 = time.perf_counter()
@@ -180,7 +180,7 @@ def quick_proof(sc, cspace, query, time_limit: float) -> PlanResult | None:
     once (:data:`QUICK_WIDTH`), within a small share of the time limit. A result (not solved, proven unsolvable) when it separates
     start and goal, else None (the planner runs). A query whose search ran to its end without a
     proof is remembered with the C-space (:data:`_NO_PROOF`): the next seed skips the search."""
-    from cspace.spaces.se2_exact import NO_PROOF_FOUND
+    from cspace.se2.exact import NO_PROOF_FOUND
 
     key = (tuple(map(float, query.start)), tuple(map(float, query.goal)))
     tried = _NO_PROOF.setdefault(cspace, set())

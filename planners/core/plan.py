@@ -17,8 +17,8 @@ import warnings
 
 import numpy as np
 
-from cspace.spaces.cspace import CSpace
-from cspace.io.scenario import Scenario, ScenarioError, load_scenario
+from cspace.translation.cspace import CSpace
+from cspace.io.load import Scenario, ScenarioError, load_scenario
 
 from ..adapters.frame import path_length  # noqa: F401  (planners.path_length, the API's name)
 from .result import PlanResult
@@ -91,7 +91,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
 
     ``space="se2"`` (or ``space = "se2"`` in the file) lets the robot rotate: poses and
     the path's rows are (x, y, theta), the C-space is the sliced
-    :class:`cspace.spaces.se2.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
+    :class:`cspace.se2.cspace.SE2CSpace` (``slabs`` angle slabs; default: the file's, else
     derived from the scene) and every motion is certified along OMPL's SE(2)
     interpolation. ``planner="exact"`` there searches the slab graph
     (:mod:`planners.core.exact_se2`): a certified path, a proof that none exists, or the
@@ -104,7 +104,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     answers a car only with a proof that no path exists.
 
     ``clearance=D`` (over the file's ``clearance``) inflates the robot by a polygon
-    containing the disk of radius D (:mod:`cspace.kernel.margin`): every path then keeps the
+    containing the disk of radius D (:mod:`cspace.kernel.minkowski.margin`): every path then keeps the
     robot at least D from every obstacle (``exact``: the shortest such path). Each solved
     result carries ``min_clearance`` (exact in translation, a certified lower bound in
     SE(2)), where it occurs, and ``touches``. ``objective`` is ``length`` (default),
@@ -235,7 +235,7 @@ def _with_clearance(sc: Scenario, clearance) -> Scenario:
     """The scenario with the margin D of ``plan(clearance=D)`` (the file's when None)."""
     if clearance is None:
         return sc
-    from cspace.io.fields import clearance_fault
+    from cspace.io.scenario.fields import clearance_fault
 
     fault = clearance_fault(clearance)
     if fault:
@@ -282,9 +282,12 @@ def _stage_names(report: dict) -> list[str]:
 
 
 def build_cspace(sc: Scenario, slabs: int | None = None):
-    """The C-space a scenario's state space needs: translation, or sliced SE(2)."""
+    """The C-space a scenario's state space needs: translation, sliced SE(2), or a car's."""
     if sc.rotates:
-        from cspace.spaces.se2 import SE2CSpace
+        if sc.turning_radius is not None:
+            from cspace.car.motion import CarCSpace as SE2CSpace
+        else:
+            from cspace.se2.cspace import SE2CSpace
 
         try:
             return SE2CSpace.from_scenario(sc, slabs=slabs if slabs is not None else sc.slabs)

@@ -46,8 +46,8 @@ from fractions import Fraction
 import numpy as np
 import shapely
 
-from cspace.io.files import read_input, utf8_text
-from cspace.io.scenario import ScenarioError, load_scenario
+from cspace.io.scenario.files import read_input, utf8_text
+from cspace.io.load import ScenarioError, load_scenario
 from ..errors import InputError
 
 FORMAT = "cspace-se2-proof/1"
@@ -340,7 +340,7 @@ def regions(scenario, p):
 
 def check_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
     """Check a proof that no path joins query ``query_index`` of ``scenario`` (a loaded
-    :class:`cspace.io.scenario.Scenario`): the first failing step, or ``valid`` (step ``"ok"``)."""
+    :class:`cspace.io.load.Scenario`): the first failing step, or ``valid`` (step ``"ok"``)."""
     step = "format"
     try:
         p = parse(proof)

@@ -9,8 +9,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:  # annotations only (this module imports no geometry)
-    from cspace.io.schema import Scenario
-    from cspace.spaces.cspace import CSpace
+    from cspace.io.scenario.schema import Scenario
+    from cspace.translation.cspace import CSpace
 
 
 @dataclass
@@ -43,7 +43,7 @@ class PlanResult:
     # run without the bench's slices, whose first solution is not timed). The planners stamp
     # time.process_time() here and plan() makes it relative.
     first_path_cpu: float | None = None
-    # Clearance (filled by plan() on solved paths; cspace.spaces.clearance): the smallest distance
+    # Clearance (filled by plan() on solved paths; cspace.translation.clearance): the smallest distance
     # between the ROBOT (not inflated) swept along the path and any obstacle, the reference
     # pose where it occurs, the obstacle's closest point, "exact" (translation) or "lower"
     # (SE(2): a certified lower bound); ``touches``: the path touches an obstacle (distance 0,
@@ -59,7 +59,7 @@ class PlanResult:
     # A car's path: per motion its start and end poses and its segments (type, length,
     # direction), see planners.adapters.car.CarSpace.curves; None for other spaces.
     curves: list | None = None
-    # A rotating robot's proof that no path exists (cspace.spaces.se2_exact's JSON form; written
+    # A rotating robot's proof that no path exists (cspace.se2.exact's JSON form; written
     # by ``cspace plan --proof FILE``, re-checked by ``cspace check-proof``); None otherwise.
     proof: dict | None = field(default=None, repr=False, compare=False)
     # The objects behind the result, for plots and further queries (not serialised).

@@ -2,8 +2,8 @@
 
 The Minkowski sum of the convex kernel only takes convex operands, and a robot part may
 not be convex (a U, a T). The sum distributes over a union, R ⊕ M = ∪ (Rᵢ ⊕ M) for the
-convex pieces Rᵢ of R (:func:`cspace.spaces.cspace_build.decompose_robot`), so each piece
-is summed with the margin (:func:`cspace.kernel.margin.inflated_pieces`, as the C-space
+convex pieces Rᵢ of R (:func:`cspace.translation.build.decompose_robot`), so each piece
+is summed with the margin (:func:`cspace.kernel.minkowski.margin.inflated_pieces`, as the C-space
 build does) and the outline drawn is their union's (shapely), not every piece's.
 """
 from __future__ import annotations
@@ -28,9 +28,9 @@ def grown_robot(scenario, x: float, y: float, theta: float = 0.0) -> list[tuple[
         return []
     import shapely
 
-    from cspace.kernel.margin import inflated_pieces
-    from cspace.kernel.slab import rotate
-    from cspace.spaces.cspace_build import decompose_robot
+    from cspace.kernel.minkowski.margin import inflated_pieces
+    from cspace.kernel.polygons.rotation import rotate
+    from cspace.translation.build import decompose_robot
 
     body, _ = decompose_robot([s.polygon for s in scenario.robot], getattr(scenario, "robot_kind", "") == "disk")
     if theta:

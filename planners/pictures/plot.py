@@ -29,7 +29,7 @@ GAP = "#7b2cbf"
 CLOSEST = "#e67e00"  # the closest approach: orange, apart from every other colour
 
 # A passage narrower than this fraction of the scene's size gets an inset zoom.
-from cspace.spaces.gap import GAP_FRACTION  # noqa: E402  (the pictures' threshold)
+from cspace.paths.gap import GAP_FRACTION  # noqa: E402  (the pictures' threshold)
 
 
 def mpl():
@@ -168,7 +168,7 @@ def draw_closest(ax, scenario, res) -> list[str]:
     robot's, and the clearance written beside it. Returns the legend keys drawn."""
     if not res.solved or not res.min_clearance_obstacle or not res.min_clearance_at:
         return []
-    from cspace.kernel.gjk import gjk_distance
+    from cspace.kernel.distance.gjk import gjk_distance
 
     pose = tuple(res.min_clearance_at) + (0.0,) * (3 - len(res.min_clearance_at))
     x, y, th = pose[:3]
@@ -300,8 +300,8 @@ def _new_figure(sc, wide: bool = False):
 
 def narrow_gap(sc, cspace, results: list):
     """The narrowest gap along the solved paths when under :data:`GAP_FRACTION` of the scene, else None
-    (:func:`cspace.spaces.gap.narrowest_gap_of_paths`)."""
-    from cspace.spaces.gap import narrowest_gap_of_paths
+    (:func:`cspace.paths.gap.narrowest_gap_of_paths`)."""
+    from cspace.paths.gap import narrowest_gap_of_paths
 
     if cspace is None:
         return None
@@ -341,7 +341,7 @@ def draw_inset(ax, sc, cspace, results: list, gap) -> object:
 
 def figure_result(res, scenario=None, cspace=None, poses: int = 4):
     """The Figure of a plan result (one query, or every query of ``--all-queries``)."""
-    from cspace.spaces.cspace import CSpace
+    from cspace.translation.cspace import CSpace
 
     sc = scenario or res.scenario_data
     if sc is None:

@@ -20,7 +20,7 @@ def poses_along(path: np.ndarray, count: int, weight: float = 0.5) -> np.ndarray
     >>> round(float(p[1, 2]), 6)
     3.141593
     """
-    from cspace.spaces.se2 import interpolate
+    from cspace.se2.cspace import interpolate
 
     path = np.asarray(path, dtype=np.float64)
     if len(path) == 1 or count < 2:

@@ -17,8 +17,8 @@ def figure_slab_pair(scenario, a: float, b: float, c: float):
     """The Figure of slabs [a, b] and [b, c] of a rotating robot's scenario (two panels)."""
     import numpy as np
 
-    from cspace.spaces.cspace_build import decompose_obstacles, decompose_robot
-    from cspace.spaces.slab_graph import SlabRegions
+    from cspace.translation.build import decompose_obstacles, decompose_robot
+    from cspace.se2.slab_graph import SlabRegions
 
     sc = scenario
     obstacles, _, _ = decompose_obstacles([o.polygon for o in sc.obstacles], [o.holes for o in sc.obstacles],

@@ -41,7 +41,7 @@ def _finite(a) -> bool:
 
 def pred_case(triples: list):
     def run():
-        from cspace.kernel.predicates import orient2d
+        from cspace.kernel.polygons.predicates import orient2d
 
         signs, dt = _timed(lambda: [orient2d(a, b, c) for a, b, c in triples])
         ref = [orient_exact(a, b, c) for a, b, c in triples]
@@ -75,7 +75,7 @@ def hull_case(points, limit_s: float | None = None):
 
 
 def _strictly_convex(out: np.ndarray) -> bool:
-    from cspace.kernel.predicates import orient2d_many
+    from cspace.kernel.polygons.predicates import orient2d_many
 
     if len(out) < 3:
         return True
@@ -107,7 +107,7 @@ def sum_case(P, Q, exact: bool, limit_s: float | None = None):
 def erode_case(A, B):
     def run():
         from cspace import erode
-        from cspace.kernel.halfplane import erode_exact
+        from cspace.kernel.polygons.halfplane import erode_exact
 
         a, b = np.asarray(A, dtype=np.float64), np.asarray(B, dtype=np.float64)
         out, dt = _timed(erode, a, b)
@@ -179,7 +179,7 @@ def gjk_case(A, B, expect: str | None = None):
 def epa_case(A, B, expect: str | None = None):
     def run():
         from cspace import epa_penetration
-        from cspace.kernel.epa import EPA_TOL
+        from cspace.kernel.distance.epa import EPA_TOL
 
         a, b = np.asarray(A, dtype=np.float64), np.asarray(B, dtype=np.float64)
         p, dt = _timed(epa_penetration, a, b)

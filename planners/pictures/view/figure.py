@@ -42,7 +42,7 @@ def figure_dict(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DE
     else:
         cs = res.cspace
         if cs is None:
-            from cspace.spaces.cspace import CSpace
+            from cspace.translation.cspace import CSpace
 
             cs = CSpace.from_scenario(sc)
         if not sc.is_point_robot:
@@ -55,7 +55,7 @@ def figure_dict(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DE
     data += tr.start_goal_traces(sc, res, nd)
     data += tr.closest_traces(sc, res, nd)
     if not sc.rotates:  # a passage narrower than 1 % of the scene, crossed by a path (as the plot's zoom)
-        from cspace.spaces.gap import narrowest_gap_of_paths
+        from cspace.paths.gap import narrowest_gap_of_paths
 
         data += tr.gap_traces(narrowest_gap_of_paths(cs.pieces, cs.bounds,
                                                      [r.path for r in (res.queries or [res]) if r.solved]), nd)
@@ -114,11 +114,11 @@ def angle_frames(sc, res, nd: int, angles: int, index: int) -> tuple[list, dict 
     >>> len(slider["steps"]), first[0]["name"].startswith("C-obstacle")
     (8, True)
     """
-    from cspace.kernel.slab import slab_of, slab_range
+    from cspace.kernel.slabs.slab import slab_of, slab_range
 
     se2 = res.cspace
     if se2 is None or not hasattr(se2, "slabs"):
-        from cspace.spaces.se2 import SE2CSpace
+        from cspace.se2.cspace import SE2CSpace
 
         se2 = SE2CSpace.from_scenario(sc, slabs=sc.slabs)
     K = se2.slabs
@@ -152,7 +152,7 @@ def angle_frames(sc, res, nd: int, angles: int, index: int) -> tuple[list, dict 
 def slab_traces(se2, k: int, proof: list, th: float, nd: int) -> list[dict]:
     """Slab ``k``'s C-obstacles and the components of the proof slab holding ``th`` (empty without a proof).
 
-    >>> from cspace.spaces.se2 import SE2CSpace
+    >>> from cspace.se2.cspace import SE2CSpace
     >>> se2 = SE2CSpace.from_scenario(tr.example_scene(), slabs=8)
     >>> [len(t["x"]) > 0 for t in slab_traces(se2, 0, [], 0.0, 3)]
     [True, False]

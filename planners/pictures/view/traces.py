@@ -20,7 +20,7 @@ def example_scene():
     >>> example_scene().bounds
     (0.0, 10.0, 0.0, 10.0)
     """
-    from cspace.io.scenario import scenario_from_dict
+    from cspace.io.load import scenario_from_dict
 
     return scenario_from_dict({"name": "example", "bounds": {"xmin": 0, "xmax": 10, "ymin": 0, "ymax": 10},
                                "robot": {"polygon": [[-0.4, -0.3], [0.4, -0.3], [0.0, 0.5]]},
@@ -183,7 +183,7 @@ def closest_traces(scenario, res, nd: int) -> list[dict]:
     """
     if not res.solved or not res.min_clearance_obstacle or not res.min_clearance_at:
         return []
-    from cspace.kernel.gjk import gjk_distance
+    from cspace.kernel.distance.gjk import gjk_distance
 
     pose = tuple(res.min_clearance_at) + (0.0,) * (3 - len(res.min_clearance_at))
     ob = np.array(res.min_clearance_obstacle, dtype=np.float64)
@@ -254,7 +254,7 @@ def proof_trace(rings, nd: int) -> dict:
 
 
 def gap_traces(gap, nd: int) -> list[dict]:
-    """The narrowest gap the path crosses (:func:`cspace.spaces.gap.narrowest_gap_of_paths`), as a
+    """The narrowest gap the path crosses (:func:`cspace.paths.gap.narrowest_gap_of_paths`), as a
     segment from wall to wall, its width in the legend; none without such a gap.
 
     >>> gap_traces(None, 3)

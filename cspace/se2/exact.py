@@ -1,0 +1,403 @@
+"""A deterministic exact SE(2) planner: the slab graph (note se2-exact.md, sections 2-4).
+
+The circle of angles [−π, π] is cut into slabs (8 equal ones first). For each slab,
+:class:`cspace.se2.slab_graph.SlabRegions` gives FREE (reference points free at every
+angle of the slab) and POSSIBLE (every free pose of the slab has its (x, y) there), as
+polygons with holes, and their connected components.
+
+- FREE graph: nodes (slab, component); components of adjacent slabs are linked when they
+  overlap with an interior (the robot turns in place at a point deep inside the overlap,
+  through the shared boundary angle). The start pose joins the FREE component of a slab
+  holding θs that contains its (x, y) (free at every angle of the slab); where none does,
+  it joins through the FREE region at its own angle (a zero-width slab): its component
+  there is linked to the FREE components of the slab(s) holding θs that overlap it. The
+  goal likewise. A walk from start to goal is a
+  certified path: translations at a fixed angle (short paths inside one component, checked
+  exactly: :mod:`cspace.se2.exact_path`)
+  and rotations in place.
+- POSSIBLE graph: nodes (slab, component); components of adjacent slabs are linked when their
+  closures meet (within a tolerance, toward more links); start and goal belong to every
+  POSSIBLE component of their slab(s) whose closure is within the tolerance of their (x, y).
+  If no walk joins them, no collision-free path exists at any resolution: the proof.
+- Each round builds FREE first and stops at its walk; POSSIBLE is built, and the proof
+  looked for, only when FREE does not join start and goal.
+- Otherwise slabs are bisected: those on a cheapest POSSIBLE walk from start to goal whose
+  nodes or links FREE does not yet reproduce ("FREE breaks there"), else those anywhere in
+  the start's POSSIBLE component where it breaks, else all. The search stops at ``min_width``
+  (no slab is cut below it) or at ``time_limit`` (checked before every region is built):
+  "undecided", with the resolution D = r·Δmax (no path with clearance above D exists, since
+  such a path would lie in FREE; note section 4).
+
+Angles are OMPL's, wrapped to [−π, π); a pose on the boundary ±π belongs to the first and
+the last slab. Nothing depends on randomness or on the iteration order of a set.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..kernel.slabs.slab import slab_range
+from ..kernel.polygons.rotation import TWO_PI, wrap_angle
+from .slab_graph import SlabRegions, point_free
+from .exact_path import AssemblyError, assemble, holding
+from .walks import G_NODE, S_NODE, cheapest_walk, labels, reach, shortest_walk
+
+PROOF_FORMAT = "cspace-se2-proof/1"
+# A proof's start and goal join the POSSIBLE components of every slab within this many radians of
+# their angle (more nodes: a weaker claim), 10 x the independent checker's angle tolerance.
+ANGLE_NEAR = 1e-8
+NO_PROOF_FOUND = "POSSIBLE graph only: no proof found"  # the reason a proof-only search ends without one
+
+
+@dataclass
+class SE2ExactResult:
+    """What :func:`exact_se2_search` found. ``status``: "solved" (``path``, an (N, 3) array of
+    poses; consecutive poses differ only in position or only in angle), "unsolvable"
+    (``proof``) or "undecided" (``resolution``: no path with clearance above it exists).
+    ``length``: the path's length in (x, y); ``rotation``: its total turning (radians)."""
+
+    status: str
+    path: np.ndarray | None = None
+    length: float = math.inf
+    rotation: float = math.inf
+    resolution: float = math.inf
+    stats: dict = field(default_factory=dict)
+    proof: dict | None = None
+
+
+class _Timeout(Exception):
+    pass
+
+
+def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, goal, *,
+                     time_limit: float | None = None, min_width: float = TWO_PI / 2048, initial_slabs: int = 8,
+                     margin: list | None = None, possible_only: bool = False, refine: bool = True,
+                     regions: SlabRegions | None = None) -> SE2ExactResult:
+    """Plan for a robot of convex ``robot_pieces`` (body frame) among convex ``obstacle_pieces``:
+    a certified path, a proof that none exists, or "undecided" at the resolution reached.
+
+    ``bounds`` = (xmin, xmax, ymin, ymax) of the reference point; ``start``, ``goal`` = (x, y, θ).
+    ``margin``: convex operands the robot is inflated by for the path (a clearance); the proof
+    is made for the body itself (a stronger statement). ``possible_only``: look for a proof
+    only (no FREE regions, no path: a car, or the check before sampling); its refinement
+    bisects every slab; ``refine=False`` stops after the first partition ("undecided").
+    ``regions``: a :class:`SlabRegions` of the same pieces, bounds and margin from an earlier
+    search (its regions and links are cached: queries on one scene share them).
+
+    >>> wall = [np.array([[4., 0], [5, 0], [5, 4], [4, 4]]), np.array([[4., 6], [5, 6], [5, 10], [4, 10]])]
+    >>> bar = [np.array([[-1.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-1.5, 0.2]])]
+    >>> r = exact_se2_search(wall, bar, (0, 10, 0, 10), (2, 5, math.pi / 2), (8, 5, math.pi / 2))
+    >>> r.status, r.path[0].tolist(), r.path[-1].tolist()
+    ('solved', [2.0, 5.0, 1.5707963267948966], [8.0, 5.0, 1.5707963267948966])
+    >>> exact_se2_search(wall, [np.array([[-1.2, -1.2], [1.2, -1.2], [1.2, 1.2], [-1.2, 1.2]])], (0, 10, 0, 10),
+    ...                  (2, 5, 0.0), (8, 5, 0.0)).status
+    'unsolvable'
+    """
+    if isinstance(initial_slabs, bool) or not isinstance(initial_slabs, int) or initial_slabs < 8:
+        raise ValueError(f"exact_se2_search: initial_slabs must be an integer >= 8 (slabs of at most pi/4), "
+                         f"got {initial_slabs!r}")
+    robot = [np.asarray(p, dtype=np.float64) for p in robot_pieces]
+    if not robot:
+        raise ValueError("exact_se2_search: needs a robot of at least one convex piece (a point robot does not turn)")
+    if regions is None:
+        regions = slab_regions(obstacle_pieces, robot, bounds, margin)
+    search = _Search(regions, start, goal, time_limit, float(min_width), initial_slabs)
+    search.possible_only, search.refine = bool(possible_only), bool(refine)
+    return search.run()
+
+
+def initial_partition(n: int = 8) -> list[tuple[float, float]]:
+    """The search's first slabs: ``n`` equal ones from −π, the last ending one ulp above the float
+    π (which is below the true π), so that they cover the circle in exact arithmetic (last b −
+    first a > 2π), as a proof needs.
+
+    >>> p = initial_partition(8)
+    >>> len(p), p[0][0] == -math.pi, p[-1][1] > math.pi, all(p[k][1] == p[k + 1][0] for k in range(7))
+    (8, True, True, True)
+    """
+    part = [slab_range(k, n) for k in range(n)]
+    part[-1] = (part[-1][0], math.nextafter(math.pi, math.inf))
+    return part
+
+
+def slab_regions(obstacle_pieces: list, robot_pieces: list, bounds, margin: list | None = None) -> SlabRegions:
+    """The :class:`SlabRegions` :func:`exact_se2_search` works on (FREE with the robot inflated by
+    ``margin``, POSSIBLE with the body), to keep and pass to several searches."""
+    robot = [np.asarray(p, dtype=np.float64) for p in robot_pieces]
+    hull = None
+    if margin:
+        from ..translation.build import inflated
+
+        hull = inflated(robot, [np.asarray(m, dtype=np.float64) for m in margin])
+    return SlabRegions(obstacle_pieces, robot, bounds, hull_pieces=hull)
+
+
+def from_scenario(scenario, query_index: int = 0, **kwargs) -> SE2ExactResult:
+    """:func:`exact_se2_search` on a loaded scenario (or a file path), query ``query_index``
+    of ``scenario.all_queries()``; keyword arguments are passed on.
+
+    >>> import os, tempfile
+    >>> f = os.path.join(tempfile.mkdtemp(), "s.toml")
+    >>> _ = open(f, "w").write('space = "se2"\\n[bounds]\\nxmin=0\\nxmax=4\\nymin=0\\nymax=4\\n'
+    ...     "[start]\\nx=0.5\\ny=0.5\\n[goal]\\nx=3.5\\ny=3.5\\n[robot]\\npolygon=[[0,0],[0.2,0],[0,0.2]]\\n"
+    ...     "[[obstacles]]\\npolygon=[[1,1],[3,1],[3,3],[1,3]]\\n")
+    >>> from_scenario(f).status
+    'solved'
+    """
+    from ..io.load import load_scenario
+    from ..io.scenario.schema import Scenario
+    from ..translation.build import decompose_obstacles, decompose_robot
+
+    sc = scenario if isinstance(scenario, Scenario) else load_scenario(str(scenario))
+    if not sc.rotates:
+        raise ValueError(f"from_scenario: the scenario's space is {sc.space!r}, not a rotating one")
+    obstacles, _, _ = decompose_obstacles([o.polygon for o in sc.obstacles], [o.holes for o in sc.obstacles],
+                                          convex=[o.convex for o in sc.obstacles])
+    robot, _ = decompose_robot([r.polygon for r in sc.robot], sc.robot_kind == "disk")
+    q = sc.all_queries()[query_index]
+    kwargs.setdefault("margin", sc.margins() or None)
+    return exact_se2_search(obstacles, robot, sc.bounds, q.start, q.goal, **kwargs)
+
+
+class _Search:
+    """One run of the refinement loop (state kept for the stats)."""
+
+    def __init__(self, regions: SlabRegions, start, goal, time_limit, min_width, initial_slabs):
+        self.R = regions
+        self.start = (float(start[0]), float(start[1]), wrap_angle(float(start[2])))
+        self.goal = (float(goal[0]), float(goal[1]), wrap_angle(float(goal[2])))
+        self.t0, self.c0 = time.perf_counter(), time.process_time()
+        self.deadline = None if time_limit is None else self.t0 + float(time_limit)
+        self.min_width = min_width
+        self.part = initial_partition(initial_slabs)
+        self.times = {"regions": 0.0, "graphs": 0.0, "path": 0.0}
+        self.possible_only, self.refine = False, True
+        self.refinements = 0
+        self.graph_sizes: dict = {}
+
+    # -- the loop ------------------------------------------------------------------------
+
+    def run(self) -> SE2ExactResult:
+        for name, (x, y, t) in (("start", self.start), ("goal", self.goal)):
+            if not self.R.pose_free(x, y, t):
+                raise ValueError(f"exact_se2_search: the {name} pose {(x, y, t)} is not free")
+        try:
+            while True:
+                # FREE first: where its graph already joins start and goal (most solvable scenes, at
+                # the first slabs) the POSSIBLE regions are never built; they are built, and the
+                # proof looked for, only when it does not.
+                freg = None if self.possible_only else self._regions("free")
+                if freg is not None:
+                    t = time.perf_counter()
+                    fadj = self._free_graph(freg)
+                    walk = shortest_walk(fadj, S_NODE, G_NODE, self.start[:2], self.goal[:2], self._turn_cost)
+                    self.times["graphs"] += time.perf_counter() - t
+                    if walk is not None:
+                        t = time.perf_counter()
+                        try:
+                            path = assemble(walk, self.part, freg, self.R, self.start, self.goal)
+                        except AssemblyError as exc:  # a certified walk whose exact re-check failed
+                            self.times["path"] += time.perf_counter() - t
+                            return self._result("undecided", error=str(exc))
+                        self.times["path"] += time.perf_counter() - t
+                        return self._result("solved", path=path)
+                preg = self._regions("possible")
+                t = time.perf_counter()
+                padj, s_p, g_p, p_edges = self._possible_graph(preg)
+                reached = reach(padj, [S_NODE])
+                self.times["graphs"] += time.perf_counter() - t
+                if G_NODE not in reached:
+                    return self._result("unsolvable", proof=self._proof(preg, s_p, g_p, p_edges))
+                if freg is None:
+                    if not self._split(self._wide()):
+                        return self._result("undecided", reason=NO_PROOF_FOUND)
+                    continue
+                t = time.perf_counter()
+                split = self._select(preg, freg, padj, fadj, reached)
+                self.times["graphs"] += time.perf_counter() - t
+                if not self._split(split):
+                    return self._result("undecided", reason="minimum slab width reached")
+        except _Timeout:
+            return self._result("undecided", reason="time limit")
+
+    def _wide(self) -> set:
+        """The slabs that may still be bisected (half as wide stays above the floor)."""
+        return {k for k, (a, b) in enumerate(self.part) if 0.5 * (b - a) >= self.min_width}
+
+    def _split(self, split: set) -> bool:
+        """Bisect the slabs ``split``; False (nothing done) if there are none or refining is off."""
+        if not split or not self.refine:
+            return False
+        self.refinements += 1
+        new = []
+        for k, (a, b) in enumerate(self.part):
+            new += [(a, 0.5 * (a + b)), (0.5 * (a + b), b)] if k in split else [(a, b)]
+        self.part = new
+        return True
+
+    def _regions(self, kind: str) -> list:
+        t = time.perf_counter()
+        out = []
+        build = self.R.possible if kind == "possible" else self.R.free
+        for a, b in self.part:
+            if self.deadline is not None and time.perf_counter() > self.deadline:
+                raise _Timeout
+            out.append(build(a, b))
+        self.times["regions"] += time.perf_counter() - t
+        return out
+
+    # -- graphs --------------------------------------------------------------------------
+
+    def _possible_graph(self, preg: list):
+        K = len(self.part)
+        adj: dict = {S_NODE: set(), G_NODE: set()}
+        edges = []
+        for k in range(K):
+            for c in range(len(preg[k].components)):
+                adj[(k, c)] = set()
+        for k in range(K):
+            k2 = (k + 1) % K
+            for i, j in self.R.possible_links(preg[k], preg[k2]):
+                edges.append([k, i, k2, j])
+                adj[(k, i)].add((k2, j))
+                adj[(k2, j)].add((k, i))
+        ends = []
+        for virtual, (x, y, th) in ((S_NODE, self.start), (G_NODE, self.goal)):
+            nodes = [(k, c) for k in holding(self.part, th, ANGLE_NEAR) for c in self.R.near(preg[k], x, y)]
+            for n in nodes:
+                adj[virtual].add(n)
+                adj[n].add(virtual)
+            ends.append(nodes)
+        self.graph_sizes["possible"] = {"nodes": len(adj) - 2, "edges": len(edges)}
+        return adj, ends[0], ends[1], edges
+
+    def _free_graph(self, freg: list) -> dict:
+        """Adjacency: node -> sorted list of (neighbour, link point); S_NODE / G_NODE stand
+        for the start's / goal's component of FREE at their own angle."""
+        K = len(self.part)
+        adj: dict = {S_NODE: [], G_NODE: []}
+        n_edges = 0
+        for k in range(K):
+            for c in range(len(freg[k].components)):
+                adj[(k, c)] = []
+        for k in range(K):
+            k2 = (k + 1) % K
+            for i, j, pt in self.R.free_links(freg[k], freg[k2]):
+                adj[(k, i)].append(((k2, j), pt))
+                adj[(k2, j)].append(((k, i), pt))
+                n_edges += 1
+        same = self.start[2] == self.goal[2]
+        ends = {}
+        for virtual, (x, y, th) in ((S_NODE, self.start), (G_NODE, self.goal)):
+            # An end whose (x, y) is free at every angle of a slab holding its angle joins that
+            # slab's component there, with the end itself as the link point (no translation at
+            # its own angle first): the FREE at its angle alone is built only when none holds it.
+            direct = [] if same else [(k, c) for k in holding(self.part, th)
+                                      for c in [self.R.containing(freg[k], x, y)]
+                                      if c is not None
+                                      and point_free(freg[k].pieces, self.R.bounds, x, y, freg[k].piece_boxes)]
+            for k, c in direct:
+                adj[virtual].append(((k, c), (x, y)))
+                adj[(k, c)].append((virtual, (x, y)))
+                n_edges += 1
+            if direct:
+                continue
+            zero = self.R.free_at(th)
+            c0 = self.R.containing(zero, x, y)
+            ends[virtual] = c0
+            if c0 is None:
+                continue
+            for k in holding(self.part, th):
+                for i, j, pt in self.R.free_links(zero, freg[k]):
+                    if i == c0:
+                        adj[virtual].append(((k, j), pt))
+                        adj[(k, j)].append((virtual, pt))
+                        n_edges += 1
+        if same and ends[S_NODE] is not None and ends[S_NODE] == ends[G_NODE]:
+            adj[S_NODE].append((G_NODE, None))  # one translation at the common angle
+        for n in adj:
+            adj[n].sort(key=lambda e: e[0])
+        self.graph_sizes["free"] = {"nodes": len(adj) - 2, "edges": n_edges}
+        return adj
+
+    def _turn_cost(self, n, m) -> float:
+        """The robot radius times the turn from node n's angle to node m's (middles; 0 at S, G)."""
+        w = [0.0 if k < 0 else self.part[k][1] - self.part[k][0] for k in (n[0], m[0])]
+        return self.R.radius * 0.5 * (w[0] + w[1])
+
+    # -- refinement ----------------------------------------------------------------------
+
+    def _select(self, preg, freg, padj, fadj, reached) -> set:
+        """The slabs to bisect (see the module docstring)."""
+        K = len(self.part)
+        label = labels(fadj)
+        owner = {k: self.R.owner(freg[k], preg[k]) for k in range(K)}
+        seen: dict = {}
+        for (k, f), lab in label.items():
+            if k >= 0:
+                seen.setdefault((k, owner[k][f]), set()).add(lab)
+        bad_node = {n for n in padj if n[0] >= 0 and len(seen.get(n, ())) != 1}
+        good_edge = set()
+        for n, nbrs in fadj.items():
+            for m, _ in nbrs:
+                pn = n if n[0] < 0 else (n[0], owner[n[0]][n[1]])
+                pm = m if m[0] < 0 else (m[0], owner[m[0]][m[1]])
+                good_edge.add((pn, pm))
+        # Virtual nodes: FREE's start node stands for the POSSIBLE start node.
+        walk = cheapest_walk(padj, bad_node, good_edge)
+        wide = self._wide()
+        pick = set()
+        for u, v in zip(walk, walk[1:]):
+            for n in (u, v):
+                if n in bad_node:
+                    pick.add(n[0])
+            if (u, v) not in good_edge:
+                pick |= {n[0] for n in (u, v) if n[0] >= 0}
+        pick &= wide
+        if not pick:
+            pick = {n[0] for n in bad_node if n in reached} & wide
+        if not pick:
+            pick = wide
+        return pick
+
+    # -- results -------------------------------------------------------------------------
+
+    def _proof(self, preg, s_p, g_p, edges) -> dict:
+        slabs = []
+        for (a, b), reg in zip(self.part, preg):
+            slabs.append({"a": float(a), "b": float(b), "cores": [c.tolist() if len(c) else [] for c in reg.cores],
+                          "components": [_component_json(c) for c in reg.components]})
+        xmin, xmax, ymin, ymax = self.R.bounds
+        return {"format": PROOF_FORMAT, "start": list(self.start), "goal": list(self.goal),
+                "bounds": [xmin, xmax, ymin, ymax], "robot_pieces": [p.tolist() for p in self.R.robot],
+                "slabs": slabs, "start_nodes": [list(n) for n in sorted(s_p)],
+                "goal_nodes": [list(n) for n in sorted(g_p)], "edges": sorted(edges)}
+
+    def _result(self, status: str, path=None, proof=None, **extra) -> SE2ExactResult:
+        widest = max(b - a for a, b in self.part)
+        D = self.R.radius * widest
+        stats = {"slabs": len(self.part), "refinements": self.refinements, "regions_built": dict(self.R.counts),
+                 "graphs": dict(self.graph_sizes), "seconds": dict(self.times),
+                 "wall_seconds": time.perf_counter() - self.t0, "cpu_seconds": time.process_time() - self.c0,
+                 "partition": [[float(a), float(b)] for a, b in self.part], "widest_slab": widest, "resolution": D,
+                 **extra}
+        out = SE2ExactResult(status, resolution=D, stats=stats, proof=proof)
+        if status == "undecided":
+            stats["statement"] = (f"no path with clearance above {D:.6g} (robot radius {self.R.radius:.6g} x widest "
+                                  f"slab {widest:.6g} rad) exists; a tighter one was not decided")
+        if path is not None:
+            out.path = path
+            d = np.diff(path, axis=0)
+            out.length = float(np.hypot(d[:, 0], d[:, 1]).sum())
+            turn = np.abs((d[:, 2] + math.pi) % TWO_PI - math.pi)
+            out.rotation = float(turn.sum())
+        return out
+
+
+def _component_json(poly) -> dict:
+    """A component as the proof stores it: shell CCW, holes CW, no closing repeat."""
+    return {"shell": [list(p) for p in poly.exterior.coords[:-1]],
+            "holes": [[list(p) for p in r.coords[:-1]] for r in poly.interiors]}

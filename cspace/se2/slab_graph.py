@@ -1,0 +1,336 @@
+"""Per-slab FREE and POSSIBLE regions of a rotating robot, their components and links.
+
+The geometry of note se2-exact.md, sections 1-3, for one angle slab S = [a, b] (any width
+up to π/4; slabs need not come from a uniform partition). P_i are the convex robot pieces
+in the body frame, O_j the convex obstacle pieces, B the reference point's bounds.
+
+- FREE(S) = B − ⋃ O_j ⊕ (−H_i), H_i = :func:`slab_hull` of P_i over [a − s, b + s]
+  (s = ``ANGLE_SLACK``, as :class:`cspace.se2.cspace.SE2CSpace` builds its slabs): H_i holds
+  R_θ P_i for every θ of S, so a reference point in FREE(S) is free at every angle of S.
+  For a zero-width slab (a single angle θ, the start's or the goal's) H_i is
+  ``rotate_piece(P_i, θ)`` summed with the square [−δ, δ]² (δ = the slab pad): the exact
+  translation C-space of the turned robot, shrunk by δ, so that a shortest path, which may
+  run along the boundary, still keeps the robot off the obstacles (touching is collision).
+- POSSIBLE(S) = B − ⋃ O_j ⊕ (−C_i), C_i = :func:`slab_inner` of P_i over [a − c, b + c]
+  (c = ``CORE_SLACK``; the *core*: inside R_θ P_i for every θ of S); a piece whose core is
+  empty contributes nothing. A
+  pose (x, y, θ), θ in S, whose (x, y) is outside POSSIBLE(S) collides.
+
+Reflection: O ⊕ (−R) is the set of reference points q where R + q meets O (q ∈ O − R), so the
+robot-side operand is always reflected (``reflect``) before :func:`pair_sums`, as
+:class:`cspace.translation.cspace.CSpace` does internally.
+
+Erring toward MORE possible space (what a proof of "no path" needs). The core C_i is
+already padded inward by ``slab_inner`` (4 pads per edge, for the float rotation and
+clipping). POSSIBLE is then computed with the core shrunk by a further ε (every edge moved
+inward by ε: the erosion of C_i by the disk of radius ε, up to rounding far below ε):
+ε = 2^-34 · S', S' = max coordinate magnitude of the bounds and obstacles + r√2 (r the robot
+radius), i.e. 64 × the checked tolerance of the GEOS union (:mod:`cspace.kernel.minkowski.union`,
+2^-40 of the coordinates, or the snap-rounding grid 2^-42). The union of O ⊕ (−(C ⊖ ε))
+grown by ε lies inside the union of O ⊕ (−C), so as long as GEOS moves no boundary by
+more than ε (its checked tolerance is 64 × smaller) the computed obstacle union lies
+inside the true one and the computed POSSIBLE contains the true POSSIBLE of the cores C_i.
+The proof stores the un-shrunk cores C_i (the checker's cores), so its components cover
+the POSSIBLE the checker derives from them. Links between POSSIBLE components err
+toward more links: closures within ``tol`` = 2^-30 · S' count as meeting.
+
+FREE only needs to be a subset up to rounding: every point the planner uses is certified
+again exactly (:func:`point_free`; translations by :func:`cspace.paths.shortest.shortest_path`,
+which checks its path against the pieces with exact predicates).
+
+Regions are built on first use and cached by their (a, b); links between the components
+of two slabs are cached by the two slabs' keys. Everything is deterministic.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..kernel.minkowski.merge import minkowski_sum, reflect
+from ..kernel.polygons.polygon import piece_boxes as box_pairs, point_in_convex
+from ..kernel.slabs.slab import ANGLE_SLACK, robot_radius, slab_hull, slab_inner, slab_pad
+from ..kernel.polygons.rotation import rotate_piece
+from ..translation.build import pair_sums
+from ..paths.shortest import free_space
+
+EPS_REL = 2.0**-34  # POSSIBLE's extra shrink of the cores, relative to S'
+# A core is computed over [a - CORE_SLACK, b + CORE_SLACK]: inside the robot at every angle of the
+# wider interval, so inside it on the slab (a smaller core: more POSSIBLE, the proof's side), and
+# still inside where an independent check unsure of an angle's last bits looks just past a slab's
+# end (planners.core.proof_check counts a sinusoid's peak within 1e-9 rad of the slab: a core
+# vertex touching the robot's edge at the slab's end, inside by the pads only, failed it there).
+CORE_SLACK = 1e-8
+# ... and with its edges moved in by ε / 16 more than the slab pad (2^-38 S', a 64th of ε at
+# 4 pads per edge): far above the independent check's margin (1e-12 relative to the edge's and
+# the vertex's magnitudes), which a core at its pads alone met only just (a short end edge).
+CORE_PAD = 1.0 / 16.0
+TOL_REL = 2.0**-30  # link / membership tolerance, and the depth of a certified link point
+
+
+@dataclass
+class Region:
+    """FREE or POSSIBLE of one slab: its C-obstacle pieces and its components (shapely
+    Polygons, deterministic order), with their boxes (n, 4: minx, miny, maxx, maxy).
+    ``cores``: POSSIBLE only, the un-shrunk cores (one per robot piece, (0, 2) if empty)."""
+
+    a: float
+    b: float
+    kind: str
+    pieces: list
+    components: list
+    boxes: np.ndarray
+    cores: list = field(default_factory=list)
+    seconds: float = 0.0
+    piece_boxes: np.ndarray | None = None  # (len(pieces), 4) boxes of the pieces, for point_free
+
+
+class SlabRegions:
+    """Builds and caches FREE / POSSIBLE regions of slabs and the links between them.
+
+    >>> wall = np.array([[4., 0], [5, 0], [5, 10], [4, 10]])
+    >>> bar = np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])
+    >>> sr = SlabRegions([wall], [bar], (0, 10, 0, 10))
+    >>> f, p = sr.free(0.0, 0.5), sr.possible(0.0, 0.5)
+    >>> len(f.components), len(p.components), p.components[0].area > f.components[0].area
+    (2, 2, True)
+    """
+
+    def __init__(self, obstacle_pieces: list, robot_pieces: list, bounds, *, hull_pieces: list | None = None):
+        self.obstacles = [np.asarray(o, dtype=np.float64) for o in obstacle_pieces]
+        self.robot = [np.asarray(r, dtype=np.float64) for r in robot_pieces]
+        # The pieces FREE's hulls are built from (the robot inflated by a margin, if any):
+        # FREE shrinks and POSSIBLE, built from the body itself, only grows: FREE ⊆ POSSIBLE.
+        self.hull_robot = self.robot if hull_pieces is None else [np.asarray(r, dtype=np.float64) for r in hull_pieces]
+        self.bounds = tuple(float(v) for v in bounds)
+        self.radius = max(robot_radius(self.robot), robot_radius(self.hull_robot))
+        self.scale = max([abs(v) for v in self.bounds] + [float(np.abs(o).max()) for o in self.obstacles if len(o)])
+        s2 = self.scale + self.radius * math.sqrt(2.0)
+        self.pad = slab_pad(s2)  # slab_inner's pad, as SE2CSpace's
+        self.hull_pad = slab_pad(max(self.radius * math.sqrt(2.0), self.scale))
+        self.eps = EPS_REL * s2
+        self.tol = TOL_REL * s2
+        self._free: dict = {}
+        self._possible: dict = {}
+        self._links: dict = {}
+        self.counts = {"free_built": 0, "possible_built": 0, "links_built": 0}
+
+    # -- regions -----------------------------------------------------------------------
+
+    def free(self, a: float, b: float) -> Region:
+        """FREE of the slab [a, b] (``a == b``: the single angle a, shrunk by δ)."""
+        key = (float(a), float(b))
+        if key not in self._free:
+            t = time.perf_counter()
+            a, b = key
+            if a == b:
+                d = self.hull_pad
+                square = np.array([[-d, -d], [d, -d], [d, d], [-d, d]])
+                hulls = [minkowski_sum(rotate_piece(p, a), square) for p in self.hull_robot]
+            else:
+                hulls = [slab_hull(p, a - ANGLE_SLACK, b + ANGLE_SLACK, scale=self.scale) for p in self.hull_robot]
+            self._free[key] = self._region(a, b, "free", hulls, [], t)
+            self.counts["free_built"] += 1
+        return self._free[key]
+
+    def free_at(self, theta: float) -> Region:
+        """FREE at one angle (the zero-width slab [θ, θ]).
+
+        >>> sr = SlabRegions([np.array([[4., 0], [5, 0], [5, 10], [4, 10]])], [np.array([[0., 0], [1, 0], [0, 1]])],
+        ...                  (0, 10, 0, 10))
+        >>> round(sr.free_at(0.0).components[0].bounds[2], 9)  # the triangle's tip touches x = 4 at x = 3
+        3.0
+        """
+        return self.free(theta, theta)
+
+    def pose_free(self, x: float, y: float, theta: float) -> bool:
+        """The exact pose test: (x, y) in the bounds and outside every O_j ⊕ −rotate_piece(P_i, θ)
+        (the hull pieces: the robot with its margin, if any).
+
+        >>> sr = SlabRegions([np.array([[4., 0], [5, 0], [5, 10], [4, 10]])], [np.array([[0., 0], [1, 0], [0, 1]])],
+        ...                  (0, 10, 0, 10))
+        >>> sr.pose_free(3.0, 1.0, 0.0), sr.pose_free(2.9, 1.0, 0.0), sr.pose_free(3.5, 1.0, math.pi)
+        (False, True, True)
+        """
+        turned = [reflect(rotate_piece(p, float(theta))) for p in self.hull_robot]
+        pieces = pair_sums(self.obstacles, turned) if self.obstacles else []
+        return point_free(pieces, self.bounds, float(x), float(y))
+
+    def possible(self, a: float, b: float) -> Region:
+        """POSSIBLE of the slab [a, b] (cores shrunk by ε more: see the module docstring)."""
+        key = (float(a), float(b))
+        if key not in self._possible:
+            t = time.perf_counter()
+            a, b = key
+            cores, used = [], []
+            lo, hi, pad = a - CORE_SLACK, b + CORE_SLACK, self.pad + CORE_PAD * self.eps
+            for p in self.robot:
+                c = slab_inner(p, lo, hi, pad)
+                cores.append(c if len(c) >= 3 else np.zeros((0, 2)))
+                if len(c) >= 3:
+                    # slab_inner lowers every offset by 4·pad·|n|: pad + ε/4 moves each edge ε further in.
+                    s = slab_inner(p, lo, hi, pad + 0.25 * self.eps)
+                    if len(s) >= 3:
+                        used.append(s)
+            self._possible[key] = self._region(a, b, "possible", used, cores, t)
+            self.counts["possible_built"] += 1
+        return self._possible[key]
+
+    def _region(self, a: float, b: float, kind: str, robot_side: list, cores: list, t: float) -> Region:
+        import shapely
+
+        pieces = pair_sums(self.obstacles, [reflect(h) for h in robot_side]) if robot_side and self.obstacles else []
+        F = free_space(pieces, self.bounds)
+        comps = [p for p in shapely.get_parts(F) if p.geom_type == "Polygon" and not p.is_empty]
+        boxes = np.array([p.bounds for p in comps], dtype=np.float64).reshape(-1, 4)
+        order = sorted(range(len(comps)), key=lambda i: (tuple(boxes[i]), -comps[i].area))
+        comps = [comps[i] for i in order]
+        for c in comps:
+            shapely.prepare(c)
+        return Region(a, b, kind, pieces, comps, boxes[order].reshape(-1, 4), cores, time.perf_counter() - t,
+                      piece_boxes(pieces))
+
+    # -- links ---------------------------------------------------------------------------
+
+    def free_links(self, r1: Region, r2: Region) -> list[tuple[int, int, tuple[float, float]]]:
+        """(i, j, point): FREE components i of r1 and j of r2 whose intersection has an
+        interior, with a point deep inside it (more than ``tol`` from its boundary)."""
+        key = ("free", r1.a, r1.b, r2.a, r2.b)
+        if key not in self._links:
+            import shapely
+
+            out = []
+            for i, j in _box_pairs(r1.boxes, r2.boxes, 0.0):
+                inter = shapely.intersection(r1.components[i], r2.components[j])
+                pt = deep_point(inter, self.tol)
+                if pt is not None:
+                    out.append((i, j, pt))
+            self._links[key] = out
+            self.counts["links_built"] += 1
+        return self._links[key]
+
+    def possible_links(self, r1: Region, r2: Region) -> list[tuple[int, int]]:
+        """(i, j): POSSIBLE components of r1 and r2 whose closures meet or come within ``tol``."""
+        key = ("possible", r1.a, r1.b, r2.a, r2.b)
+        if key not in self._links:
+            import shapely
+
+            # (components that overlap, the usual case between neighbouring slabs, are at distance
+            # 0: the prepared intersects test answers them without measuring)
+            out = [(i, j) for i, j in _box_pairs(r1.boxes, r2.boxes, self.tol)
+                   if shapely.intersects(r1.components[i], r2.components[j])
+                   or shapely.distance(r1.components[i], r2.components[j]) <= self.tol]
+            self._links[key] = out
+            self.counts["links_built"] += 1
+        return self._links[key]
+
+    def near(self, region: Region, x: float, y: float) -> list[int]:
+        """Components of ``region`` whose closure is within ``tol`` of (x, y).
+
+        >>> sr = SlabRegions([np.array([[4., 0], [5, 0], [5, 10], [4, 10]])], [np.array([[0., 0], [1, 0], [0, 1]])],
+        ...                  (0, 10, 0, 10))
+        >>> sr.near(sr.possible(0.0, 0.1), 1.0, 1.0), sr.near(sr.possible(0.0, 0.1), 4.5, 1.0)
+        ([0], [])
+        """
+        import shapely
+
+        pt = shapely.Point(float(x), float(y))
+        return [i for i in range(len(region.components))
+                if _box_near(region.boxes[i], x, y, self.tol)
+                and (shapely.intersects_xy(region.components[i], float(x), float(y))
+                     or shapely.distance(region.components[i], pt) <= self.tol)]
+
+    def containing(self, region: Region, x: float, y: float) -> int | None:
+        """The component of ``region`` that covers (x, y), or None.
+
+        >>> sr = SlabRegions([], [np.array([[0., 0], [1, 0], [0, 1]])], (0, 10, 0, 10))
+        >>> sr.containing(sr.free_at(0.0), 5.0, 5.0), sr.containing(sr.free_at(0.0), 11.0, 5.0)
+        (0, None)
+        """
+        import shapely
+
+        for i, c in enumerate(region.components):
+            if _box_near(region.boxes[i], x, y, 0.0) and shapely.intersects_xy(c, float(x), float(y)):
+                return i
+        return None
+
+    def owner(self, free: Region, possible: Region) -> list[int]:
+        """For each FREE component of a slab, the POSSIBLE component of the same slab that
+        holds it (FREE ⊆ POSSIBLE: the one nearest to an inner point of it)."""
+        key = ("owner", free.a, free.b)
+        if key not in self._links:
+            import shapely
+
+            out = []
+            for c in free.components:
+                pt = c.representative_point()
+                d = [shapely.distance(p, pt) for p in possible.components]
+                out.append(int(np.argmin(d)) if d else -1)
+            self._links[key] = out
+        return self._links[key]
+
+
+def point_free(pieces: list, bounds, x: float, y: float, boxes: np.ndarray | None = None) -> bool:
+    """Is (x, y) in the bounds and outside every closed piece (exact predicates)? ``boxes``:
+    the pieces' :func:`piece_boxes`, when the caller keeps them (a region's ``piece_boxes``).
+
+    >>> point_free([np.array([[1., 1], [2, 1], [2, 2], [1, 2]])], (0, 3, 0, 3), 1.0, 1.5)
+    False
+    >>> point_free([np.array([[1., 1], [2, 1], [2, 2], [1, 2]])], (0, 3, 0, 3), 0.5, 1.5)
+    True
+    """
+    xmin, xmax, ymin, ymax = bounds
+    if not (xmin <= x <= xmax and ymin <= y <= ymax):
+        return False
+    if boxes is None:
+        boxes = piece_boxes(pieces)
+    near = np.flatnonzero((boxes[:, 0] <= x) & (x <= boxes[:, 2]) & (boxes[:, 1] <= y) & (y <= boxes[:, 3]))
+    return not any(point_in_convex(pieces[k], x, y) >= 0 for k in near.tolist())
+
+
+def piece_boxes(pieces: list) -> np.ndarray:
+    """The pieces' boxes, (len(pieces), 4): min x, min y, max x, max y (an empty piece's box
+    holds no point).
+
+    >>> piece_boxes([np.array([[1., 1], [2, 1], [2, 3]])]).tolist()
+    [[1.0, 1.0, 2.0, 3.0]]
+    """
+    lo, hi = box_pairs(pieces)  # the kernel's (lo, hi), side by side
+    return np.hstack([lo, hi]).reshape(-1, 4)
+
+
+def deep_point(geom, depth: float) -> tuple[float, float] | None:
+    """A point of ``geom`` (shapely, polygonal) farther than ``depth`` from its boundary, or None:
+    the centre of the largest inscribed circle of its largest part.
+
+    >>> import shapely
+    >>> x, y = deep_point(shapely.box(0, 0, 2, 1), 0.1)
+    >>> bool(0.4 < x < 1.6 and abs(y - 0.5) < 1e-9), deep_point(shapely.box(0, 0, 2, 1e-9), 0.1)
+    (True, None)
+    """
+    import shapely
+
+    parts = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and p.area > 0.0]
+    for p in sorted(parts, key=lambda q: -q.area):
+        x0, y0, x1, y1 = p.bounds  # a coarse circle is enough: any point deep inside will do
+        mic = shapely.maximum_inscribed_circle(p, tolerance=0.02 * max(x1 - x0, y1 - y0))
+        (cx, cy), _ = shapely.get_coordinates(mic).tolist()
+        if p.boundary.distance(shapely.Point(cx, cy)) > depth and shapely.intersects_xy(p, cx, cy):
+            return float(cx), float(cy)
+    return None
+
+
+def _box_pairs(b1: np.ndarray, b2: np.ndarray, grow: float) -> list[tuple[int, int]]:
+    """Index pairs (i, j), in order, whose boxes (grown by ``grow``) overlap."""
+    if not len(b1) or not len(b2):
+        return []
+    m = ((b1[:, None, 0] <= b2[None, :, 2] + grow) & (b2[None, :, 0] <= b1[:, None, 2] + grow)
+         & (b1[:, None, 1] <= b2[None, :, 3] + grow) & (b2[None, :, 1] <= b1[:, None, 3] + grow))
+    i, j = np.nonzero(m)
+    return list(zip(i.tolist(), j.tolist()))
+
+
+def _box_near(box: np.ndarray, x: float, y: float, grow: float) -> bool:
+    return box[0] - grow <= x <= box[2] + grow and box[1] - grow <= y <= box[3] + grow

@@ -1,0 +1,193 @@
+"""Bad input is exit 2 with one short line, never exit 3 (issue 24 items 5, 8).
+
+Huge integers and hex literals, deep nesting, out-of-range seeds, long names,
+byte-order marks and UTF-16, giant echoed values, numpy warnings.
+"""
+from __future__ import annotations
+
+import os
+import re
+import warnings
+
+import pytest
+
+from conftest import ROOT
+from cspace.io.scenario.messages import clip, show
+from cspace.io.load import ScenarioError, load_scenario
+from planners.cli import main
+
+BASIC = open(os.path.join(ROOT, "scenarios", "basic.toml"), encoding="utf-8").read()
+
+
+def run(capsys, *argv):
+    try:
+        code = main([str(a) for a in argv])
+    except SystemExit as exc:  # argparse's errors end here (our one-line parser error)
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def bad(capsys, tmp_path, text: str | bytes, *extra, field=None, limit=400):
+    """The scenario ``text`` through ``cspace show``: exit 2 and one short line naming ``field``."""
+    f = tmp_path / "s.toml"
+    f.write_bytes(text if isinstance(text, bytes) else text.encode("utf-8"))
+    code, out, err = run(capsys, "show", f, *extra)
+    lines = err.strip().splitlines()
+    assert code == 2, (code, err[:300])
+    assert len(lines) == 1 and lines[0].startswith(f"error: {f}: "), err[:300]
+    assert len(lines[0]) < limit, len(lines[0])
+    if field is not None:
+        assert f": {field}: " in lines[0], lines[0]
+    return lines[0]
+
+
+def with_start_x(value: str) -> str:
+    return BASIC.replace("[start]\nx = 1.0", f"[start]\nx = {value}", 1)
+
+
+def test_the_fixture_edit_applies():
+    assert with_start_x("7") != BASIC
+
+
+# ------------------------------------------------------------------ item 5: internal errors for bad input
+
+
+def test_an_integer_of_5000_digits_is_bad_toml_not_an_internal_error(capsys, tmp_path):
+    bad(capsys, tmp_path, with_start_x("9" * 5000), field="toml")
+
+
+def test_a_4000_digit_hex_literal_is_one_short_line(capsys, tmp_path):
+    msg = bad(capsys, tmp_path, with_start_x("0x" + "f" * 4000), field="start.x")
+    assert "digits" in msg
+
+
+def test_a_deeply_nested_array_is_one_line(capsys, tmp_path):
+    bad(capsys, tmp_path, with_start_x("[" * 5000 + "]" * 5000), field="toml")
+
+
+@pytest.mark.parametrize("depth", [50, 200])
+def test_a_nested_point_is_one_line(capsys, tmp_path, depth):
+    text = BASIC.replace("[[3, 0], [4, 0], [4, 6], [3, 6]]", "[" * depth + "1" + "]" * depth + ", [4, 0], [4, 6]]", 1)
+    assert text != BASIC
+    bad(capsys, tmp_path, text)
+
+
+@pytest.mark.parametrize("seed", [str(2**64), str(2**63), str(2**32 - 1), "-1"])
+def test_seed_out_of_range_in_the_file_is_exit_2(capsys, tmp_path, seed):
+    text = re.sub(r"(?m)^seed = .*$", f"seed = {seed}", BASIC)
+    assert text != BASIC
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    code, _, err = run(capsys, "plan", f)
+    assert code == 2 and "planner.seed" in err and len(err.strip().splitlines()) == 1, err
+
+
+@pytest.mark.parametrize("seed", [str(2**64), str(2**63), str(2**32 - 1)])
+def test_seed_option_out_of_range_is_exit_2(capsys, tmp_path, seed):
+    f = tmp_path / "s.toml"
+    f.write_text(BASIC)
+    code, _, err = run(capsys, "plan", f, "--seed", seed)
+    assert code == 2 and "--seed" in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_the_largest_seed_plans(capsys, tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text(BASIC)
+    assert run(capsys, "plan", f, "--seed", str(2**32 - 2))[0] == 0
+
+
+def test_a_300_character_name_in_the_bench(capsys, tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text(BASIC.replace('name = "basic"', f'name = "{"n" * 300}"'))
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "bench", f, "--out", out, "--runs", "1", "--times", "0.02",
+                       "--planners", "RRTConnect", "--no-plot", "-q")
+    assert code == 0, err
+    logs = os.listdir(out / "ompl")
+    assert len(logs) == 1 and len(logs[0].encode()) <= 255
+
+
+def test_bench_log_names_stay_distinct_when_cut():
+    from planners.bench.outputs import _token
+
+    a, b = _token("x" * 300 + "a"), _token("x" * 300 + "b")
+    assert a != b and len(a) < 100
+
+
+# ------------------------------------------------------------------ item 8: encodings and messages
+
+
+def test_a_utf8_byte_order_mark_loads(tmp_path):
+    f = tmp_path / "bom.toml"
+    f.write_bytes(b"\xef\xbb\xbf" + BASIC.encode("utf-8"))
+    assert load_scenario(str(f)).bounds == load_scenario(os.path.join(ROOT, "scenarios", "basic.toml")).bounds
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be", "utf-32"])
+def test_utf16_is_one_clear_line(capsys, tmp_path, encoding):
+    msg = bad(capsys, tmp_path, BASIC.encode(encoding), field="file")
+    assert "UTF-8" in msg
+
+
+def test_latin1_names_the_offset(capsys, tmp_path):
+    msg = bad(capsys, tmp_path, ('name = "caf\xe9"\n' + BASIC).encode("latin-1"), field="file")
+    assert "offset" in msg
+
+
+def test_a_point_with_200000_coordinates_gives_a_short_line(capsys, tmp_path):
+    pt = "[" + ", ".join(["1.5"] * 200_000) + "]"
+    bad(capsys, tmp_path, BASIC.replace("[[3, 0], [4, 0], [4, 6], [3, 6]]", f"[{pt}, [4, 0], [4, 6]]", 1),
+        field="obstacles[0].polygon[0]", limit=300)
+
+
+def test_a_huge_unknown_key_and_string_value_are_clipped(capsys, tmp_path):
+    bad(capsys, tmp_path, "k" * 100_000 + " = 1\n" + BASIC, limit=500)
+    bad(capsys, tmp_path, BASIC.replace("[start]\nx = 1.0", f'[start]\nx = "{"s" * 100_000}"', 1),
+        field="start.x", limit=300)
+
+
+def test_huge_option_values_are_clipped(capsys, tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text(BASIC)
+    for args in (["--time", "x" * 100_000], ["--planner", "p" * 100_000], ["--seed", "9" * 100_000]):
+        code, _, err = run(capsys, "plan", f, *args)
+        assert code == 2 and len(err) < 500 and len(err.strip().splitlines()) == 1, err[:200]
+
+
+def test_clip_and_show_never_fail():
+    assert len(clip("x" * 10**6)) < 200
+    assert "digits" in show(10**100_000) and "digits" in show(-(16**4000))
+    nested = []
+    for _ in range(5000):
+        nested = [nested]
+    assert len(show(nested)) < 200
+    assert str(ScenarioError("f" * 10**5, "g" * 10**5, "m" * 10**6)).count("more characters") == 3
+
+
+def quiet_show(tmp_path, text: str):
+    """``cspace show`` in a fresh interpreter, where warnings print as a user sees them
+    (pytest would catch them in-process)."""
+    import subprocess
+    import sys
+
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    return subprocess.run([sys.executable, "-m", "planners.cli", "show", str(f)], cwd=ROOT, capture_output=True,
+                          text=True, timeout=120)
+
+
+def test_numpy_warnings_never_reach_the_terminal(tmp_path):
+    """A degenerate C-obstacle piece (a disk below the ulp) made the broad phase divide 0 by 0."""
+    r = quiet_show(tmp_path, "[bounds]\nxmin = 49999990.0\nxmax = 50000010.0\nymin = 49999990.0\n"
+                             "ymax = 50000010.0\n[[obstacles]]\ncenter = [50000000.0, 50000000.0]\nradius = 1e-9\n"
+                             "[start]\nx = 49999995.0\ny = 50000000.0\n[goal]\nx = 50000005.0\ny = 50000000.0\n")
+    assert r.returncode in (0, 2) and "Warning" not in r.stderr and len(r.stderr.splitlines()) <= 1, r.stderr
+
+
+def test_huge_bounds_plan_quietly(tmp_path):
+    text = BASIC
+    for key in ("xmax", "ymax"):
+        text = "\n".join(f"{key} = 1e120" if line.startswith(f"{key} =") else line for line in text.splitlines())
+    r = quiet_show(tmp_path, text)
+    assert r.returncode == 0 and r.stderr == "", r.stderr

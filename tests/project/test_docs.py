@@ -1,0 +1,212 @@
+"""The documentation is tested: every scenario and every command shown in README.md and
+docs/guide.md works as shown.
+
+* Every fenced ```toml block is a whole scenario file: it is loaded and planned (all its queries,
+  with its own ``[planner]`` defaults, the time capped at a couple of seconds), and it must come
+  out as its ``expect`` says. A block that is deliberately a fragment starts with the line
+  ``# fragment`` and is only parsed as TOML.
+* Every line of a fenced ```sh / ```bash / ```shell block is a command: it is run as written, in
+  a temporary folder holding links to ``scenarios/`` and ``scripts/`` (so the files it writes go
+  there, never into the repository), with ``cspace`` and ``python`` of the running interpreter.
+  Lines of one block run in order in the same folder (a block may plan the file it generated).
+  The exit status must be 0, or the one a trailing ``# exit N`` comment states. Only the parts
+  listed in ``SKIP`` (and, unless ``CSPACE_DOCS_SLOW=1``, in ``SLOW``) are not run, each with its
+  reason; a command that is neither run nor listed fails the test, so new sections are picked up.
+  Usage synopses (``cspace plan SCENARIO [--planner NAME] ...``) are ```text blocks, not commands.
+* Every ```python block of the README that starts with ``import`` (a whole program, not a listing
+  of signatures) runs from the repository root (docs/guide.md's run in tests/project/test_guide.py).
+* Every inline `cspace ...` / `python scripts/... ` span names a subcommand or script that exists,
+  and each option it shows is one its ``--help`` offers.
+"""
+from __future__ import annotations
+
+import functools
+import os
+import re
+import shlex
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT
+
+DOCS = ("README.md", os.path.join("docs", "guide.md"))
+PLAN_TIME_CAP = 2.0  # seconds per query for the toml blocks
+SE2_PLAN_TIME_CAP = 30.0  # SE(2): RRTConnect stops at its first solution; the cap is for loaded machines
+
+# Parts of commands that are not run (the exact text of the part, as in the docs).
+SKIP = {
+    "pip install -e .": "installs packages: the suite runs inside the installed environment",
+    'pip install -e ".[test]"': "installs packages: the suite runs inside the installed environment",
+    "pytest": "the suite itself (it would run this test again)",
+    "python scripts/make_figures.py": "regenerates every figure into docs/ (~1 min, writes into the repository); "
+                                      "tests/project/test_guide.py and test_make_figures.py cover its parts",
+    "python scripts/make_benchmarks_page.py": "runs every bench script (minutes, writes docs/benchmarks.md); "
+                                              "the bench scripts' quick modes have their own tests",
+}
+# Commands that are run only with CSPACE_DOCS_SLOW=1 (the default suite stays fast); measured on
+# the 2-core development machine.
+SLOW = {
+    "cspace stability --plot stability.png": "the whole catalogue, ~16 s; tests/planning/test_stability.py runs the "
+                                             "same catalogue through the same entry point",
+    "cspace bench scenarios/bug_trap.toml --planners RRTConnect,RRTstar --times 0.03,0.1,0.3 --runs 5 "
+    "--out bench_out": "30 runs in separate processes, ~18 s",
+    "cspace plan scenarios/ompl/circles.toml --all-queries --time 1 --json circ.json":
+        "100 queries, ~9 s; tests/planning/test_plan_api.py plans the same queries at the same budget",
+}
+RUN_SLOW = os.environ.get("CSPACE_DOCS_SLOW") == "1"
+
+
+def _read(doc: str) -> str:
+    with open(os.path.join(ROOT, doc), encoding="utf-8") as fh:
+        return fh.read()
+
+
+def _blocks(lang: str) -> list[tuple[str, int, str]]:
+    """(doc, line number, body) of every fenced block of that language in DOCS."""
+    out = []
+    for doc in DOCS:
+        text = _read(doc)
+        for m in re.finditer(r"^```(%s)[ \t]*\n(.*?)^```" % lang, text, re.S | re.M):
+            out.append((doc, text.count("\n", 0, m.start()) + 1, m.group(2)))
+    return out
+
+
+def _commands(body: str) -> list[tuple[str, int]]:
+    """The commands of a shell block: (command without its comment, expected exit status)."""
+    cmds = []
+    for line in body.replace("\\\n", " ").splitlines():
+        m = re.search(r"#\s*exit (\d+)\s*$", line)
+        code = re.sub(r"(^|\s)#.*$", "", line).strip()
+        if code:
+            cmds.append((code, int(m.group(1)) if m else 0))
+    return cmds
+
+
+def _parts(command: str) -> list[str]:
+    """The parts of ``a && b``."""
+    return [p.strip() for p in command.split("&&")]
+
+
+TOML_BLOCKS = _blocks("toml")
+SH_BLOCKS = _blocks("sh|bash|shell")
+
+
+def test_the_docs_show_scenarios_and_commands():
+    # The extraction finds what is there (a regex gone wrong would make the tests below vacuous).
+    assert len(TOML_BLOCKS) >= 2
+    assert sum(len(_commands(b)) for _, _, b in SH_BLOCKS) >= 15
+    assert ("cspace plan scenarios/narrow_closed.toml", 1) in [c for _, _, b in SH_BLOCKS for c in _commands(b)]
+
+
+@pytest.mark.parametrize("doc, line, body", TOML_BLOCKS, ids=[f"{d}:{n}" for d, n, _ in TOML_BLOCKS])
+def test_toml_block_loads_and_plans(doc, line, body, tmp_path):
+    if body.startswith("# fragment"):
+        try:
+            import tomllib
+        except ModuleNotFoundError:  # Python 3.10
+            import tomli as tomllib
+        tomllib.loads(body)
+        return
+    import planners
+    from cspace.io.load import load_scenario
+
+    path = tmp_path / "block.toml"
+    path.write_text(body, encoding="utf-8")
+    sc = load_scenario(str(path))  # a fault raises ScenarioError naming the field
+    # A rotating robot's first plan also builds its angle slabs (lazily, inside the budget).
+    cap = SE2_PLAN_TIME_CAP if sc.space == "se2" else PLAN_TIME_CAP
+    budget = min(sc.planner.get("time", 10.0 if sc.space == "se2" else 1.0), cap)
+    res = planners.plan(str(path), time=budget, all_queries=True)
+    solved = [q.solved for q in res.queries]
+    assert len(solved) == len(sc.all_queries()) >= 1
+    if sc.expect == "unsolvable":
+        assert not any(solved), f"{doc}:{line}: a query of an unsolvable scene was solved"
+    else:
+        assert all(solved), f"{doc}:{line}: queries not solved: {[i for i, s in enumerate(solved) if not s]}"
+
+
+def _run_block(doc: str, line: int, body: str, tmp_path) -> list[str]:
+    """Run every command of one block in tmp_path; return the parts skipped, with reasons."""
+    for name in ("scenarios", "scripts"):
+        os.symlink(os.path.join(ROOT, name), tmp_path / name)
+    env = dict(os.environ, PATH=os.path.dirname(sys.executable) + os.pathsep + os.environ.get("PATH", ""),
+               MPLBACKEND="Agg")
+    skipped = []
+    for command, want in _commands(body):
+        for part in _parts(command):
+            reason = SKIP.get(part) or (None if RUN_SLOW else SLOW.get(part))
+            if reason:
+                skipped.append(f"{part!r}: {reason}")
+                continue
+            argv = shlex.split(part)
+            run_env = dict(env)
+            while argv and re.fullmatch(r"[A-Z_][A-Z0-9_]*=.*", argv[0]):  # VAR=value prefixes
+                k, _, v = argv.pop(0).partition("=")
+                run_env[k] = v
+            if argv[0] == "python":
+                argv[0] = sys.executable
+            proc = subprocess.run(argv, cwd=tmp_path, env=run_env, capture_output=True, text=True, timeout=300)
+            assert proc.returncode == want, (
+                f"{doc}:{line}: `{part}` exited {proc.returncode}, the docs say {want}\n"
+                f"stdout: {proc.stdout[-2000:]}\nstderr: {proc.stderr[-2000:]}")
+            if want == 2:  # bad input: one line on stderr, no traceback
+                assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("error: "), proc.stderr
+    return skipped
+
+
+@pytest.mark.parametrize("doc, line, body", SH_BLOCKS, ids=[f"{d}:{n}" for d, n, _ in SH_BLOCKS])
+def test_shell_block_runs_as_written(doc, line, body, tmp_path):
+    skipped = _run_block(doc, line, body, tmp_path)
+    if skipped and len(skipped) == sum(len(_parts(c)) for c, _ in _commands(body)):
+        pytest.skip("; ".join(skipped))
+
+
+def test_skip_lists_name_only_commands_the_docs_show():
+    # A stale entry would silently skip nothing, and hide that the docs changed.
+    shown = {p for _, _, b in SH_BLOCKS for c, _ in _commands(b) for p in _parts(c)}
+    assert set(SKIP) | set(SLOW) <= shown, sorted((set(SKIP) | set(SLOW)) - shown)
+
+
+INLINE = sorted({(doc, m) for doc in DOCS
+                 for m in re.findall(r"`((?:cspace |python scripts/)[^`]*)`", _read(doc))})
+
+
+@pytest.mark.parametrize("doc, span", INLINE, ids=[f"{d}:{s}" for d, s in INLINE])
+def test_inline_command_names_exist(doc, span):
+    from planners.cli import COMMANDS
+
+    words = span.split()
+    if words[0] == "cspace":
+        if words[1] == "COMMAND":  # the guide's placeholder
+            return
+        assert words[1] in COMMANDS, f"{doc}: `{span}`: no command {words[1]!r}"
+        argv = [sys.executable, "-c", "from planners.cli import main; import sys; sys.exit(main())", words[1]]
+    else:
+        script = os.path.join(ROOT, words[1])
+        assert os.path.isfile(script), f"{doc}: `{span}`: no such script"
+        argv = [sys.executable, script]
+    options = [w for w in words[2:] if w.startswith("--")]
+    if options:
+        offered = _help(tuple(argv))
+        for opt in options:
+            assert re.search(r"(?<![\w-])%s(?![\w-])" % re.escape(opt), offered), f"{doc}: `{span}`: {opt}?"
+
+
+@functools.lru_cache(maxsize=None)
+def _help(argv: tuple) -> str:
+    proc = subprocess.run(list(argv) + ["--help"], capture_output=True, text=True, timeout=60, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout
+
+
+README_PYTHON = [(d, n, b) for d, n, b in _blocks("python") if d == "README.md" and b.startswith("import")]
+
+
+@pytest.mark.parametrize("doc, line, body", README_PYTHON, ids=[f"{d}:{n}" for d, n, _ in README_PYTHON])
+def test_readme_python_programs_run(doc, line, body, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    env: dict = {}
+    exec(compile(body, f"{doc}:{line}", "exec"), env)
+    assert env["res"].solved and env["cs"].is_free([(1, 1), (2.7, 3)]).tolist() == [True, False]
