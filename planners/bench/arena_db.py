@@ -31,6 +31,8 @@ import socket
 import sqlite3
 import time
 
+from ..pictures.bench_figure import proven_unsolvable
+
 ENUM_NAME = "status"
 STATUSES = ("Unknown status", "Invalid start", "Invalid goal", "Unrecognized goal type", "Timeout",
             "Approximate solution", "Exact solution", "Crash", "Abort", "Proven unsolvable")
@@ -70,8 +72,7 @@ def status_code(row: dict) -> int:
         return ABORT
     if row.get("solved"):
         return EXACT
-    if "proven unsolvable" in (row.get("message") or "") or (
-            row.get("reference", "optimum") == "optimum" and row.get("optimum") is None):
+    if proven_unsolvable(row):
         return UNSOLVABLE  # the run's own proof, or the exact reference's (no path exists)
     return TIMEOUT
 

@@ -72,9 +72,10 @@ def run_one(task: dict, scenario=None, cspace=None) -> dict:
         "error": _error(length, opt), "error_unsimplified": _error(raw_len, opt),
         # SE(2): the exact planner's certified path is an upper bound on the optimum; a run may beat it
         "upper": task.get("upper"), "error_upper": _error(length, task.get("upper")),
-        "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings["solve"],
-        "simplify_s": res.timings["simplify"], "state_checks": int(res.checks["states"]),
-        "motion_checks": int(res.checks["motions"]), "graph_states": res.checks.get("graph_states"),
+        # A route records only the stages it ran (a proof before sampling: no solve, no checks).
+        "first_solution_s": res.first_solution if ok else None, "solve_s": res.timings.get("solve", 0.0),
+        "simplify_s": res.timings.get("simplify", 0.0), "state_checks": int(res.checks.get("states", 0)),
+        "motion_checks": int(res.checks.get("motions", 0)), "graph_states": res.checks.get("graph_states"),
         "wall_s": None,
         "message": res.message, "progress": res.progress,
         # Measured by plan() on the solved path after its solve (None: unsolved, or a car).

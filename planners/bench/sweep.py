@@ -127,14 +127,17 @@ def summary(rows: list[dict], scenarios: list[dict] | None = None) -> str:
     bounded = {r["scenario"] for r in rows if r.get("reference") == "lower_bound"}
     lower = {r["scenario"] for r in rows if r.get("min_clearance_bound") == "lower"}
     upper = {r["scenario"] for r in rows if r.get("upper") is not None}
+    proven = False
     lines = [f"{'scenario':<20} {'planner':<16} {'budget':>7} {'median error':>13} {'min clearance':>14} "
              f"{'success':>8}" + (f" {'vs exact':>9}" if upper else "")]
     for (scen, p), c in cs.items():
         m = c["median"][-1]
         text = "-" if m is None else (f"<= {m:.4f}" if scen in bounded else f"{m:.4f}")
         v = vs[scen, p]["median"][-1] if scen in upper else None
+        ok = "proven" if c["proven"][-1] == 1.0 else f"{c['success'][-1]:.0%}"  # no path exists: not a failure
+        proven |= c["proven"][-1] == 1.0
         lines.append(f"{scen:<20} {p:<16} {c['time'][-1]:>7g} {text:>13} "
-                     f"{clearance_cell(clear[scen, p]['median'][-1], scen in lower):>14} {c['success'][-1]:>8.0%}"
+                     f"{clearance_cell(clear[scen, p]['median'][-1], scen in lower):>14} {ok:>8}"
                      + (f" {'-' if v is None else f'{v:+.4f}':>9}" if upper else ""))
     for s in scenarios or []:
         if "exact_s" in s:  # the exact planner's own row: its time, once (deterministic)
@@ -142,6 +145,8 @@ def summary(rows: list[dict], scenarios: list[dict] | None = None) -> str:
                          f"{'100%' if s['upper'] is not None else '0%':>8}"
                          + (f" {'+0.0000' if s['upper'] is not None else '-':>9}" if upper else "")
                          + f"  ({s['exact_s']:.3g} s: {s['exact_message']})")
+    if proven:
+        lines.append("proven: every run ended with a proof that no collision-free path exists (not a failure)")
     if bounded:
         lines.append(f"<= : {space_names(bounded, scenarios)} scenes have no exact optimum: length / (inscribed-disk "
                      "lower bound) - 1, an upper bound on the error")

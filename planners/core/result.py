@@ -66,6 +66,16 @@ class PlanResult:
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
 
+    @property
+    def proven_unsolvable(self) -> bool:
+        """Was this query proven to have no collision-free path (not just left unsolved)?
+
+        >>> PlanResult("s", False, False, np.zeros((0, 2)), math.inf, "exact", 0,
+        ...            message="proven unsolvable: start and goal in different components").proven_unsolvable
+        True
+        """
+        return self.proof is not None or "proven unsolvable" in self.message
+
     def as_dict(self, nested: bool = True) -> dict:
         """The JSON form (the ``--json`` output of ``cspace plan``).
 
@@ -94,7 +104,7 @@ class PlanResult:
             "min_clearance_obstacle": list(self.min_clearance_obstacle) if self.min_clearance_obstacle else None,
             "min_clearance_bound": self.min_clearance_bound,
             "touches": self.touches,
-            "proven_unsolvable": self.proof is not None or "proven unsolvable" in self.message,
+            "proven_unsolvable": self.proven_unsolvable,
         }
         if self.curves is not None:
             d["curves"] = self.curves

@@ -40,19 +40,36 @@ def curves(rows: list[dict], field: str = "error") -> dict:
         groups.setdefault((r["scenario"], r["planner"]), {}).setdefault(r["time_budget"], []).append(r)
     out = {}
     for key, by_t in groups.items():
-        c = {"time": [], "median": [], "q25": [], "q75": [], "success": [], "runs": []}
+        c = {"time": [], "median": [], "q25": [], "q75": [], "success": [], "proven": [], "runs": []}
         for t in sorted(by_t):
             rs = by_t[t]
             errs = [r[field] for r in rs if r["solved"] and _finite(r.get(field))]
             c["time"].append(t)
             c["runs"].append(len(rs))
             c["success"].append(sum(bool(r["solved"]) for r in rs) / len(rs))
+            c["proven"].append(sum(proven_unsolvable(r) for r in rs) / len(rs))
             q = np.percentile(errs, [50, 25, 75]).tolist() if errs else [None] * 3
             c["median"].append(q[0])
             c["q25"].append(q[1])
             c["q75"].append(q[2])
         out[key] = c
     return out
+
+
+def proven_unsolvable(row: dict) -> bool:
+    """Did this run end with a proof that no path exists: its own ("proven unsolvable" in its
+    message: a proof before sampling, the exact planners') or the exact reference's (a scene
+    whose exact optimum is None)? Such a run is not a failure of its planner.
+
+    >>> proven_unsolvable({"status": "ok", "solved": False, "message": "proven unsolvable before sampling: ..."})
+    True
+    >>> proven_unsolvable({"status": "ok", "solved": False, "reference": "optimum", "optimum": 2.0})
+    False
+    """
+    if row.get("solved") or row.get("status") in ("crashed", "timeout"):
+        return False
+    return "proven unsolvable" in (row.get("message") or "") or (
+        row.get("reference", "optimum") == "optimum" and "optimum" in row and row.get("optimum") is None)
 
 
 def _finite(v) -> bool:
@@ -188,7 +205,9 @@ def figure_error_vs_time(rows: list[dict]):
         else:
             top.set_ylim(ERROR_FLOOR * 10, 1.0)
             _set_log_ticks(top.yaxis, log_ticks(ERROR_FLOOR * 10, 1.0))
-            top.text(0.5, 0.5, "no run solved", transform=top.transAxes, ha="center", va="center", color="0.4")
+            impossible = all(proven_unsolvable(r) for r in rows if r["scenario"] == scen)
+            top.text(0.5, 0.5, "proven unsolvable:\nno path exists" if impossible else "no run solved",
+                     transform=top.transAxes, ha="center", va="center", color="0.4")
         top.set_title(scen)
         top.grid(True, which="major", alpha=0.3)
         top.tick_params(labelbottom=False)
