@@ -52,6 +52,7 @@ def _stable(row: dict) -> dict:
     return {k: v for k, v in row.items() if k not in drop}
 
 
+@pytest.mark.slow
 def test_outputs_and_schema(sweeps):
     base, codes = sweeps
     assert codes == {1: 0, 2: 0}
@@ -204,6 +205,7 @@ def test_missing_scenario_exit_2(capsys, tmp_path):
     assert code == 2 and len(err.splitlines()) == 1 and missing in err
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_finished_rows(tmp_path):
     out = tmp_path / "o"
     proc = subprocess.Popen([sys.executable, "-m", "planners.cli", "bench", BASIC, "--planners", "RRTConnect,RRTstar",
@@ -226,6 +228,7 @@ def test_ctrl_c_keeps_finished_rows(tmp_path):
         assert len(fh.read().splitlines()) == len(data["rows"]) + 1
 
 
+@pytest.mark.slow
 def test_dask_cluster_gives_the_same_rows(sweeps, tmp_path):
     distributed = pytest.importorskip("distributed")
     base, _ = sweeps

@@ -118,6 +118,7 @@ def test_cli_scheduler_streams_into_the_database(client, tmp_path):
     assert all(held == built <= 2 for held, built in client.run(cluster.held_stats).values())
 
 
+@pytest.mark.slow
 def test_cli_scheduler_unreachable_is_bad_input(tmp_path, capsys):
     args = ["bench", BASIC, "--planners", "RRTConnect", "--times", "0.01", "--runs", "1", "--out",
             str(tmp_path / "o"), "--scheduler", "tcp://127.0.0.1:9", "-q", "--no-plot"]

@@ -67,6 +67,7 @@ _seg = st.tuples(st.sampled_from("LSR"), st.floats(-4, 4).filter(lambda v: abs(v
 # A chain turning 12 rad (ends at an unwrapped angle): the oracle once joined its end to that
 # angle by spinning two turns in place and called a free curve colliding.
 @example([(4.0, 2.0, 1.5, 0.0)], (5.5, 3.0, -1.0), [("L", -2.0), ("L", -4.0)], 0.5)
+@pytest.mark.slow
 def test_curve_free_never_accepts_a_colliding_curve(tris, q0, segs, radius):
     sc, cs = _scene([_triangle(*t) for t in tris])
     ok = cs.curve_free(q0, segs, radius)

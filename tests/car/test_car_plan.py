@@ -89,6 +89,7 @@ def test_same_seed_same_path():
     assert a.solved and b.solved and np.array_equal(a.path, b.path)
 
 
+@pytest.mark.slow
 def test_cli_writes_curves_plot_and_animation(tmp_path):
     out = tmp_path / "r.json"
     r = cli("plan", os.path.join(SCENARIOS, "car", "u_turn.toml"), "--json", str(out),

@@ -190,6 +190,7 @@ def dead_pid() -> int:
     return p.pid
 
 
+@pytest.mark.slow
 def test_another_process_temporaries_survive_a_run(work, capsys):
     planted = [work / f"{TMP_PREFIX}{dead_pid()}-abcd", work / f"{TMP_PREFIX}{dead_pid()}-0123abcd.gif",
                work / f"{TMP_PREFIX}1-0123abcd.png"]
@@ -246,6 +247,7 @@ def interrupt(argv, delay: float, ready: bool):
 
 
 @pytest.mark.parametrize("run", list(RUNS))
+@pytest.mark.slow
 def test_ctrl_c_at_any_moment_of_our_code_is_interrupted_130(run):
     for delay in DELAYS:
         code, out, err = interrupt([sys.executable, "-c", READY, *RUNS[run]], delay, ready=True)
@@ -277,6 +279,7 @@ def test_our_frames_are_told_from_a_venv_inside_a_clone_named_cspace(tmp_path):
 
 
 @pytest.mark.parametrize("entry", [["-m", "planners.cli"], ["-m", "planners"]])
+@pytest.mark.slow
 def test_ctrl_c_early_in_python_m_is_never_our_traceback(entry):
     """From the start of the interpreter: before our code runs Python itself may die of the
     signal (no handler yet), report it in its own start-up (site, runpy) or lose it in a

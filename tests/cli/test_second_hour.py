@@ -88,6 +88,7 @@ def test_an_option_name_is_still_an_option():
 
 # ---------------------------------------------------------------- item 5: without OMPL
 
+@pytest.mark.slow
 def test_stability_skips_the_cases_that_need_ompl(tmp_path):
     j = tmp_path / "st.json"
     r = run(HIDE_OMPL, "stability", "--json", str(j), timeout=600)

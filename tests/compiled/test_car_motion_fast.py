@@ -96,6 +96,7 @@ def judged_colliding(sc, a, b, segs) -> bool:
 
 @compiled
 @pytest.mark.parametrize("name", [os.path.basename(f) for f in CAR_FILES])
+@pytest.mark.slow
 def test_compiled_agrees_with_pure_and_the_sweep(scenes, name):
     sc, cs, pure = scenes[name]
     seg, r = segments_of(sc), sc.turning_radius
@@ -160,6 +161,7 @@ def _pair(obstacles):
 @given(st.lists(_tri, max_size=3), st.lists(_wall, min_size=1, max_size=3),
        st.lists(st.tuples(st.tuples(st.floats(2, 10), st.floats(2, 10), st.floats(-3.1, 3.1)),
                           st.lists(_seg, min_size=1, max_size=4), st.floats(0.5, 3)), min_size=1, max_size=8))
+@pytest.mark.slow
 def test_hypothesis_chains_near_thin_walls(tris, walls, chains):
     cs, pure, polys = _pair([_triangle(*t) for t in tris] + [_thin(*w) for w in walls])
     for q0, segs, radius in chains:

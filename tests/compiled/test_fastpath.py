@@ -301,6 +301,7 @@ def test_compiled_classification_on_random_pieces(seed):
 
 
 @needs_c
+@pytest.mark.slow
 def test_compiled_entries_leave_huge_pieces_to_the_numpy_routes(monkeypatch):
     # _fast.entries classifies pieces of up to 1024 edges whose box holds up to 2^20
     # cells and hands the others back: a 2000-gon and a triangle whose box holds ~1.4

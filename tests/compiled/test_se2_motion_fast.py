@@ -132,6 +132,7 @@ def judged_colliding(sc, a, b) -> bool:
 
 @compiled
 @pytest.mark.parametrize("name", ["car-maze", "bug-trap-se2", "piano-corridor", "random-40", "small"])
+@pytest.mark.slow
 def test_compiled_agrees_with_pure_and_the_sweep(scenes, name):
     sc, cs, pure = scenes[name]
     motions = random_motions(sc, cs, 1200, seed=11)

@@ -99,6 +99,7 @@ def test_too_many_traced_vertices_are_refused_in_one_line(tmp_path, capsys):
     assert MAX_VERTICES < n < 1.4e6
 
 
+@pytest.mark.slow
 def test_a_noisy_map_within_the_limits_imports_exactly(tmp_path, capsys):
     # 256 x 256 cells, half occupied: tens of thousands of vertices and thousands of holes
     # (several regions). At tolerance 0 the obstacles are exactly the blocked cells: the

@@ -323,6 +323,7 @@ def test_vectorised_route_is_independent_of_start_vertex_and_orientation(seed, r
 
 @pytest.mark.parametrize("reverse", [False, True])
 @pytest.mark.parametrize("shift", [0, 1, 2, -1])
+@pytest.mark.slow
 def test_vectorised_route_finds_the_leftmost_of_a_flat_bottom(reverse, shift):
     # A horizontal bottom edge gives two lowest vertices; the fast path must start from
     # the left one wherever the pair sits in the array, including split across its end.

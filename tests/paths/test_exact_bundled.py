@@ -30,6 +30,7 @@ def free_components(cs):
 
 
 @pytest.mark.parametrize("path", FILES, ids=[os.path.relpath(f, SCENARIOS) for f in FILES])
+@pytest.mark.slow
 def test_exact_matches_independent_reference(path):
     sc = load_scenario(path)
     cs = CSpace.from_scenario(sc)

@@ -17,6 +17,7 @@ def run(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True, timeout=120, cwd=ROOT)
 
 
+@pytest.mark.slow
 def test_basic_group_writes_real_pictures(tmp_path):
     out = tmp_path / "figs"
     proc = run("--out", str(out), "--only", "basic,theta_cspace")

@@ -57,6 +57,7 @@ def test_every_planner_solves_in_the_bench_where_plan_does_with_the_same_length(
 
 
 @pytest.mark.parametrize("planner", sorted(routine.SLICED))
+@pytest.mark.slow
 def test_anytime_planners_solve_in_time_slices(basic, planner):
     # The slices are what the old bench got wrong (0 % success for RRTstar, PRMstar, BITstar).
     from planners.adapters.glue import planner_name

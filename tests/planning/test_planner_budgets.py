@@ -122,6 +122,7 @@ def test_start_equal_to_goal_is_a_one_point_path(write_toml, planner):
 
 
 @pytest.mark.parametrize("planner", ["PRM", "PRMstar"])
+@pytest.mark.slow
 def test_ctrl_c_stops_ompl_cleanly(planner):
     # Used to abort: "terminate called without an active exception" (SIGABRT).
     proc = subprocess.Popen([sys.executable, "-m", "planners.cli", "plan", str(SC / "narrow_passage.toml"),

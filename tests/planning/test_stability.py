@@ -23,6 +23,7 @@ CASES = {c.name: c for c in st.catalogue()}
 
 
 @pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.slow
 def test_case_meets_its_guarantee(name):
     row = st.run_case(CASES[name])
     assert row["passed"], f"{name}: {row['result']} error={row['error']} ({row['guarantee']})"
@@ -177,6 +178,7 @@ def test_a_nan_error_fails():
 # ---------------------------------------------------------------- the command
 
 
+@pytest.mark.slow
 def test_cli_writes_json_and_plot(tmp_path, capsys):
     j, p = tmp_path / "out.json", tmp_path / "out.png"
     assert main(["stability", "--json", str(j), "--plot", str(p)]) == 0

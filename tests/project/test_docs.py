@@ -44,6 +44,7 @@ SKIP = {
     "pip install -e .": "installs packages: the suite runs inside the installed environment",
     'pip install -e ".[test]"': "installs packages: the suite runs inside the installed environment",
     "pytest": "the suite itself (it would run this test again)",
+    "pytest -m slow": "the suite's slow pass (it would run this test again)",
     "python scripts/make_figures.py": "regenerates every figure into docs/ (~1 min, writes into the repository); "
                                       "tests/project/test_guide.py and test_make_figures.py cover its parts",
     "python scripts/make_benchmarks_page.py": "runs every bench script (minutes, writes docs/benchmarks.md); "
@@ -165,6 +166,7 @@ def _run_block(doc: str, line: int, body: str, tmp_path) -> list[str]:
 
 
 @pytest.mark.parametrize("doc, line, body", SH_BLOCKS, ids=[f"{d}:{n}" for d, n, _ in SH_BLOCKS])
+@pytest.mark.slow
 def test_shell_block_runs_as_written(doc, line, body, tmp_path):
     skipped = _run_block(doc, line, body, tmp_path)
     if skipped and len(skipped) == sum(len(_parts(c)) for c, _ in _commands(body)):

@@ -110,6 +110,7 @@ def test_solvable_scenes_still_sample():
     assert res.solved and res.proof is None and res.checks["states"] > 0
 
 
+@pytest.mark.slow
 def test_every_output_option_with_exact_in_se2(tmp_path, capsys):
     args = ["plan", DOOR, "--planner", "exact", "--plot", str(tmp_path / "p.png"), "--json", str(tmp_path / "r.json"),
             "--csv", str(tmp_path / "r.csv"), "--animate", str(tmp_path / "a.gif"), "-v", "--clearance", "0.02",
@@ -169,6 +170,7 @@ def _scene(length, width, gap, gap_y, box_x, box_y, box, t0, t1):
 @given(length=st.floats(0.4, 4.0), width=st.floats(0.1, 0.8), gap=st.floats(0.3, 3.0), gap_y=st.floats(3.0, 9.0),
        box_x=st.floats(1.0, 10.0), box_y=st.floats(1.0, 10.0), box=st.floats(0.2, 1.5),
        t0=st.floats(-math.pi, math.pi), t1=st.floats(-math.pi, math.pi))
+@pytest.mark.slow
 def test_random_scenes_exact_never_contradicts_a_sampled_path(length, width, gap, gap_y, box_x, box_y, box, t0, t1):
     try:
         sc = scenario_from_dict(_scene(length, width, gap, gap_y, box_x, box_y, box, t0, t1), "random.toml")

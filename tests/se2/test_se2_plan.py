@@ -80,6 +80,7 @@ def test_exact_in_se2_proves_unsolvable_or_says_why_not(tmp_path):
     assert r.returncode == 0 and "solved by exact" in r.stdout, r.stdout + r.stderr  # the slab graph
 
 
+@pytest.mark.slow
 def test_plot_and_animation(tmp_path):
     from PIL import Image
 

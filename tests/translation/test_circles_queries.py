@@ -36,6 +36,7 @@ def runs():
     return exact, sampled
 
 
+@pytest.mark.slow
 def test_every_query_has_an_exact_optimum(runs):
     exact, _ = runs
     assert len(exact.queries) == 100

@@ -121,6 +121,7 @@ def _exact_free(dc: DirectChecker, q) -> bool:
 
 
 @pytest.mark.parametrize("path", SCENARIOS, ids=[os.path.basename(p) for p in SCENARIOS])
+@pytest.mark.slow
 def test_bundled_scenarios_agree(path):
     cs = CSpace.from_scenario(path)
     dc = DirectChecker.from_cspace(cs)
