@@ -162,7 +162,31 @@ def _run_block(doc: str, line: int, body: str, tmp_path) -> list[str]:
                 f"stdout: {proc.stdout[-2000:]}\nstderr: {proc.stderr[-2000:]}")
             if want == 2:  # bad input: one line on stderr, no traceback
                 assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("error: "), proc.stderr
+    written = [e.name + ("/" if e.is_dir() else "") for e in os.scandir(tmp_path) if e.name not in ("scenarios", "scripts")]
+    kept = not_ignored(written)
+    assert kept == [], f"{doc}:{line}: run from the repository root, these outputs would show in git status: {kept}"
     return skipped
+
+
+def not_ignored(paths: list[str]) -> list[str]:
+    """Which of these paths (relative to the repository root) its .gitignore does not ignore
+    ([] where git or the repository's history is absent: nothing to judge against)."""
+    if not paths or not os.path.isdir(os.path.join(ROOT, ".git")):
+        return []
+    try:
+        proc = subprocess.run(["git", "-C", ROOT, "check-ignore", "--no-index", "--stdin"], input="\n".join(paths),
+                              capture_output=True, text=True, timeout=60)
+    except OSError:
+        return []
+    ignored = set(proc.stdout.split("\n"))
+    return [p for p in paths if p not in ignored]
+
+
+def test_the_ignore_check_tells_outputs_from_sources():
+    if not os.path.isdir(os.path.join(ROOT, ".git")):
+        pytest.skip("not a git checkout")
+    assert not_ignored(["path.png", "bench_out/", "plan.json"]) == []
+    assert not_ignored(["scenarios/basic.toml", "cspace/__init__.py"]) == ["scenarios/basic.toml", "cspace/__init__.py"]
 
 
 @pytest.mark.parametrize("doc, line, body", SH_BLOCKS, ids=[f"{d}:{n}" for d, n, _ in SH_BLOCKS])
