@@ -140,7 +140,27 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                 raise
             continue
         mod.register(sub)
+        show_defaults(sub.choices[name])
     return parser
+
+
+def show_defaults(parser: argparse.ArgumentParser) -> None:
+    """Say each option's default in its help where the help does not already: a number, a
+    word or a path (not a switch's False, nor None, which means "not given").
+
+    >>> p = argparse.ArgumentParser()
+    >>> _ = p.add_argument("--runs", type=int, default=10, help="runs")
+    >>> _ = p.add_argument("--quiet", action="store_true", help="less output")
+    >>> show_defaults(p)
+    >>> [a.help for a in p._actions[1:]]
+    ['runs (default: 10)', 'less output']
+    """
+    for action in parser._actions:
+        d = action.default
+        if d is None or d is False or d is argparse.SUPPRESS or not action.option_strings or action.help is None:
+            continue
+        if "default" not in action.help:
+            action.help += f" (default: {d})"
 
 
 def main(argv: list[str] | None = None) -> int:

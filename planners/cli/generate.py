@@ -42,7 +42,7 @@ def register(sub) -> None:
     p = sub.add_parser("generate", help="write a random scenario (random, maze, narrow, disks, office)",
                        description="Generate a valid scenario file: start and goal free, solvable unless asked.")
     p.add_argument("kind", choices=KINDS)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="the random seed: the same seed writes the same scene")
     p.add_argument("--size", type=int, default=None,
                    help="obstacles (random, disks), cells per side (maze), rooms per side (office)")
     p.add_argument("--ratio", type=float, default=1.001, help="narrow: passage width / robot width")

@@ -20,7 +20,8 @@ def register(sub) -> None:
     p.add_argument("file", help="map YAML (.yaml) or OMPL.app problem (.cfg)")
     p.add_argument("--out", required=True, help="scenario TOML to write (never one of the inputs)")
     add_import_options(p)
-    p.add_argument("--verbose", "-v", action="store_true")
+    p.add_argument("--verbose", "-v", action="store_true",
+                   help="on an internal error, print its traceback; let numpy and matplotlib warnings through")
     p.set_defaults(run=run)
 
 

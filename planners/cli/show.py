@@ -21,7 +21,8 @@ def register(sub) -> None:
                         "the angle slab that holds this angle (radians, default 0)")
     p.add_argument("--clearance", type=number, help="safety margin D: the C-obstacles of the robot inflated by "
                                                      "the disk of radius D (default: the scenario's)")
-    p.add_argument("--verbose", "-v", action="store_true")
+    p.add_argument("--verbose", "-v", action="store_true",
+                   help="on an internal error, print its traceback; let numpy and matplotlib warnings through")
     p.set_defaults(run=run)
 
 

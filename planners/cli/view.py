@@ -31,7 +31,8 @@ def register(sub) -> None:
     p.add_argument("--no-compress", action="store_true",
                    help="inline plotly.js as plain text (about 4.8 MB) instead of gzip-packed (about 1.9 MB, "
                         "unpacked by the browser's DecompressionStream; browsers of 2023 on)")
-    p.add_argument("--verbose", "-v", action="store_true")
+    p.add_argument("--verbose", "-v", action="store_true",
+                   help="print the plan in detail, as `cspace plan -v` does, and the time the page took")
     p.set_defaults(run=run)
 
 

@@ -235,3 +235,20 @@ def test_a_disk_below_the_ulp_of_its_centre_is_refused_in_one_line(write_toml):
                                   .replace("[robot]\npolygon = [[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]]",
                                            "[robot]\nradius = 1e-200")), "--planner", "exact")
     assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
+@pytest.mark.parametrize("name", sorted(__import__("planners.cli", fromlist=["COMMANDS"]).COMMANDS))
+def test_every_option_says_what_it_does_and_its_default(name):
+    # `cspace COMMAND --help` explains each option, and shows each default that is a value
+    # (a switch's False and a "not given" None are not shown)
+    import argparse
+
+    from planners.cli.command import build_parser
+
+    sub = next(a for a in build_parser(name)._actions if isinstance(a, argparse._SubParsersAction)).choices[name]
+    for action in sub._actions:
+        if not action.option_strings or action.help == argparse.SUPPRESS:
+            continue
+        assert action.help, f"cspace {name} {action.option_strings[0]}: no help text"
+        if action.default not in (None, False, argparse.SUPPRESS):
+            assert "default" in action.help, f"cspace {name} {action.option_strings[0]}: default {action.default!r} unsaid"
