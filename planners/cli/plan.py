@@ -6,6 +6,7 @@ import time
 
 from ..adapters.glue import OMPL_HINT, ompl_available
 from ..output import PLOT_FORMATS, check_distinct, check_output, write_json
+from ..pictures.titles import planner_words
 
 
 def register(sub) -> None:
@@ -274,7 +275,7 @@ def summary(res, verbose: bool = False) -> str:
     results = res.queries or [res]
     for i, r in enumerate(results):
         tag = f"{r.scenario}" + (f" query {i}" if res.queries else "")
-        by = "exact" if r.planner == "exact" else f"{r.planner} (seed {r.seed})"
+        by = planner_words(r)
         if r.solved:
             lines.append(f"{tag}: solved by {by}: length {r.length:.6g}, "
                          f"{len(r.path)} waypoints, solve {r.timings.get('solve', 0.0) * 1e3:.1f} ms")

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..output import atomic_path
+from .titles import plan_title
 
 OBSTACLE = "#3b3b3b"
 COBSTACLE = "#f2b8a0"
@@ -363,8 +364,7 @@ def figure_result(res, scenario=None, cspace=None, poses: int = 4):
         if sc.clearance > 0:
             labels["margin"] = f"robot with its safety margin {sc.clearance:g}"
     if len(results) == 1:
-        status = f"length {res.length:.4g}" if res.solved else "not solved"
-        ax.set_title(f"{sc.name}: {res.planner}, seed {res.seed}, {status}")  # no wall time: same plan, same picture
+        ax.set_title(plan_title(sc.name, res))
         if res.solved:
             labels["path"] = f"path (length {res.length:.4g})"
     else:

@@ -192,3 +192,18 @@ def test_gap_ignores_theta_of_poses():
     # Across a path of slope 0.1 / 8 the perpendicular meets the walls at that angle, longer than the
     # corridor is wide; the gap reported is the corridor's width, wall to wall.
     assert a.width == pytest.approx(0.3, rel=1e-9)
+
+
+def test_titles_say_proven_unsolvable_and_give_no_seed_to_the_exact_planner():
+    # the picture's title, the page's and the command line say the same (issue 51): a query with
+    # a proof is "proven unsolvable", not "not solved"; the seedless exact planner shows no seed
+    from planners.pictures.view.figure import scene_layout
+
+    impossible = plan(os.path.join(SCEN, "se2", "wide_square.toml"), planner="RRTConnect", time=5)
+    exact = plan(os.path.join(SCEN, "basic.toml"), planner="exact")
+    sampled = plan(os.path.join(SCEN, "basic.toml"), planner="RRTConnect", seed=4, time=5)
+    for res, want, unwanted in ((impossible, "proven unsolvable", "not solved"), (exact, "exact, length", "seed"),
+                                (sampled, "RRTConnect, seed 4, length", "not solved")):
+        png = plot.figure_result(res).axes[0].get_title()
+        page = scene_layout(res.scenario_data, res, [], [])["title"]["text"]
+        assert png == page and want in png and unwanted not in png, (png, page)

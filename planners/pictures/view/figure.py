@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from ..plot import PATH
+from ..titles import plan_title
 from . import traces as tr
 
 DEFAULT_POSES = 120  # frames of the robot along the path
@@ -200,17 +201,15 @@ def play_menu(n: int) -> dict:
 def scene_layout(sc, res, sliders: list, menus: list) -> dict:
     """Equal-scale axes on the bounds (pan by drag, zoom by wheel), the title, the controls.
 
-    >>> class R: planner, seed, solved, length, message = "exact", 0, True, 2.0, ""
+    >>> class R: planner, seed, solved, length, message, proof = "exact", 0, True, 2.0, "", None
     >>> lay = scene_layout(tr.example_scene(), R(), [], [])
     >>> lay["yaxis"]["scaleanchor"], lay["dragmode"]
     ('x', 'pan')
     """
     xmin, xmax, ymin, ymax = sc.bounds
     pad = 0.02 * max(xmax - xmin, ymax - ymin)
-    status = f"length {res.length:.4g}" if res.solved else ("proven unsolvable" if "proven unsolvable"
-                                                             in res.message else "not solved")
     bottom = 60 + 100 * len(sliders)
-    return {"title": {"text": f"{sc.name}: {res.planner}, seed {res.seed}, {status}"},
+    return {"title": {"text": plan_title(sc.name, res)},
             "xaxis": {"range": [xmin - pad, xmax + pad], "title": {"text": "x"}, "constrain": "domain"},
             "yaxis": {"range": [ymin - pad, ymax + pad], "title": {"text": "y"}, "scaleanchor": "x",
                       "scaleratio": 1, "constrain": "domain"},

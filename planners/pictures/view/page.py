@@ -18,6 +18,7 @@ import html
 import math
 
 from ...output import write_text
+from ..titles import planner_words
 from .figure import DEFAULT_ANGLES, DEFAULT_POSES, figure_dict
 
 STYLE = """body{font-family:system-ui,sans-serif;margin:12px;color:#222}
@@ -136,7 +137,7 @@ def report_text(res, scenario=None, extra: str = "") -> str:
     s: solved by exact: length 2.5
     """
     sc = scenario or getattr(res, "scenario_data", None)
-    by = "exact" if res.planner == "exact" else f"{res.planner} (seed {res.seed})"
+    by = planner_words(res)
     lines = [f"{res.scenario}: solved by {by}: length {res.length:.6g}" if res.solved
              else f"{res.scenario}: NOT solved by {by}: {res.message}"]
     if sc is not None:

@@ -1,0 +1,47 @@
+"""How a plan is named in words: who planned it and what came of it.
+
+One wording for the command line's summary, the picture's title and the page: the exact
+planners take no seed (the same scene gives the same path), a sampling planner's seed is
+part of its name, and a query proven unsolvable says so rather than "not solved".
+"""
+from __future__ import annotations
+
+SEEDLESS = ("exact",)
+
+
+def planner_words(res) -> str:
+    """The planner, with its seed where it has one.
+
+    >>> class R: planner, seed = "RRTConnect", 3
+    >>> planner_words(R()), planner_words(type("E", (), {"planner": "exact", "seed": 0})())
+    ('RRTConnect (seed 3)', 'exact')
+    """
+    return res.planner if res.planner in SEEDLESS else f"{res.planner} (seed {res.seed})"
+
+
+def outcome_words(res) -> str:
+    """The outcome: the path's length, "proven unsolvable" (no path exists), or "not solved".
+
+    >>> class R: solved, length, message, proof = False, float("inf"), "proven unsolvable: ...", None
+    >>> outcome_words(R())
+    'proven unsolvable'
+    """
+    if res.solved:
+        return f"length {res.length:.4g}"
+    proven = getattr(res, "proof", None) is not None or "proven unsolvable" in (res.message or "")
+    return "proven unsolvable" if proven else "not solved"
+
+
+def plan_title(scene: str, res) -> str:
+    """A picture's title: the scene, the planner (and seed), the outcome; no wall time (the
+    same plan gives the same picture).
+
+    >>> class R: planner, seed, solved, length, message, proof = "exact", 0, True, 17.42051, "", None
+    >>> plan_title("basic", R())
+    'basic: exact, length 17.42'
+    >>> R.planner = "RRTConnect"
+    >>> plan_title("basic", R())
+    'basic: RRTConnect, seed 0, length 17.42'
+    """
+    by = res.planner if res.planner in SEEDLESS else f"{res.planner}, seed {res.seed}"
+    return f"{scene}: {by}, {outcome_words(res)}"
