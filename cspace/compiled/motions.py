@@ -36,15 +36,13 @@ def se2_motion(cs, max_refine: int, floor_rel: float):
     True
     """
     _fast = extension()
-    if _fast is None or getattr(cs, "_fast", None) is None or not cs.robot_pieces:
+    if not _handles_apply(_fast, cs):
         return None
-    f64 = contiguous
     (o_off, o_xy), (r_off, r_xy) = packed(cs.obstacle_pieces), packed(cs.robot_pieces)
-    obs, rob = cs.obstacle_pieces, cs.robot_pieces
     handle = _fast.se2_motion_handle(
-        cs._fast, cs.checks, f64(cs._lo), f64(cs._hi), o_off, o_xy, r_off, r_xy,
-        cs.slabs, len(obs), len(rob), int(max_refine), float(cs.scale), float(cs.radius), floor_rel * cs.extent,
-        ANGLE_SLACK)
+        cs._fast, cs.checks, contiguous(cs._lo), contiguous(cs._hi), o_off, o_xy, r_off, r_xy,
+        cs.slabs, len(cs.obstacle_pieces), len(cs.robot_pieces), int(max_refine), float(cs.scale), float(cs.radius),
+        floor_rel * cs.extent, ANGLE_SLACK)
     return functools.partial(_fast.se2_motion, handle)
 
 
@@ -70,17 +68,15 @@ def car_curve(cs, max_hulls: int, floor_rel: float, arc_chunk: float):
     True
     """
     _fast = extension()
-    if _fast is None or getattr(cs, "_fast", None) is None or not cs.robot_pieces:
+    if not _handles_apply(_fast, cs):
         return None
-    f64 = contiguous
     (o_off, o_xy), (r_off, r_xy) = packed(cs.obstacle_pieces), packed(cs.robot_pieces)
-    obs, rob = cs.obstacle_pieces, cs.robot_pieces
-    o_edge = f64(np.array([e for edges in cs._obstacle_edges for e in edges], dtype=np.float64).reshape(-1, 4))
+    o_edge = contiguous(np.array([e for edges in cs._obstacle_edges for e in edges], dtype=np.float64).reshape(-1, 4))
     xmin, xmax, ymin, ymax = cs.bounds
     handle = _fast.car_handle(
-        cs._fast, cs.checks, f64(cs._lo), f64(cs._hi), o_off, o_xy, o_edge, r_off,
-        r_xy, cs.slabs, len(obs), len(rob), int(max_hulls), float(cs.scale), float(cs.radius),
-        floor_rel * cs.extent, float(arc_chunk), xmin, xmax, ymin, ymax)
+        cs._fast, cs.checks, contiguous(cs._lo), contiguous(cs._hi), o_off, o_xy, o_edge, r_off,
+        r_xy, cs.slabs, len(cs.obstacle_pieces), len(cs.robot_pieces), int(max_hulls), float(cs.scale),
+        float(cs.radius), floor_rel * cs.extent, float(arc_chunk), xmin, xmax, ymin, ymax)
     return functools.partial(_fast.car_curve, handle)
 
 
@@ -127,3 +123,9 @@ def dubins_word(d: float, alpha: float, beta: float):
     """
     _fast = extension()
     return None if _fast is None else _fast.dubins_word(d, alpha, beta)
+
+
+def _handles_apply(ext, cs) -> bool:
+    """Can a compiled motion handle be made over ``cs``: the extension in use, the SE(2)
+    pose handle built (the C-space was made on the compiled path) and a robot to turn?"""
+    return ext is not None and getattr(cs, "_fast", None) is not None and bool(cs.robot_pieces)
