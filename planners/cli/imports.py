@@ -72,6 +72,25 @@ def import_options(args, src: str):
                          unknown=args.unknown or "obstacle", tolerance=args.tolerance)
 
 
+def imported_scenario(args, src: str, options, outputs: list):
+    """Import the map or OMPL.app problem ``src`` with ``options`` (:func:`import_options`), check
+    each ``(path, option)`` output against every file the import read (never written over one),
+    print the import's warnings, and return its Scenario with ``--space`` and
+    ``--turning-radius`` applied (plan and view share this)."""
+    from cspace.io.importers.imported import import_file
+    from cspace.io.load import scenario_from_dict
+
+    from ..output import check_output
+
+    imp = import_file(src, options)
+    for out, opt in outputs:
+        if out is not None:
+            check_output(out, opt, inputs=imp.inputs)
+    for w in imp.warnings:
+        sys.stderr.write(f"warning: {w}\n")
+    return scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
+
+
 def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
     import math
 

@@ -25,8 +25,7 @@ def register(sub) -> None:
                                                      "instead of the scenario's, all on one C-space")
     p.add_argument("--no-simplify", action="store_true", help="keep the planner's raw path")
     add_space_options(p)
-    p.add_argument("--turning-radius", type=number, help="a car's minimum turning radius (space dubins or "
-                                                         "reeds-shepp); default: the scenario's")
+    add_car_and_margin_options(p)
     p.add_argument("--plot", help="save a picture of the path (.png, .svg or .pdf)")
     p.add_argument("--animate", help="save an animation of the robot moving along the path (.gif)")
     p.add_argument("--html", help="write one offline, interactive page of the plan (.html; needs plotly), "
@@ -35,8 +34,6 @@ def register(sub) -> None:
     p.add_argument("--csv", help="write the path's waypoints as CSV (x,y or x,y,theta, with a header)")
     p.add_argument("--proof", help="a rotating robot or a car proven to have no path: write the proof (JSON), "
                                    "which `cspace check-proof SCENARIO PROOF` re-checks independently")
-    p.add_argument("--clearance", type=number, help="safety margin D: keep the robot at least D from every "
-                                                     "obstacle (default: the scenario's clearance, else 0)")
     from ..adapters.objectives import OBJECTIVE_PLANNERS, OBJECTIVES
 
     takers = f"{', '.join(OBJECTIVE_PLANNERS[:-1])} or {OBJECTIVE_PLANNERS[-1]}"
@@ -61,6 +58,25 @@ def add_space_options(p) -> None:
                                                  "from the robot and the scene)")
 
 
+def add_car_and_margin_options(p) -> None:
+    """``--turning-radius`` and ``--clearance`` (plan and view share them)."""
+    p.add_argument("--turning-radius", type=number, help="a car's minimum turning radius (space dubins or "
+                                                         "reeds-shepp); default: the scenario's")
+    p.add_argument("--clearance", type=number, help="safety margin D: keep the robot at least D from every "
+                                                     "obstacle (default: the scenario's clearance, else 0)")
+
+
+def check_clearance(args, src: str) -> None:
+    """``--clearance``: a finite margin of the supported magnitudes (one line, exit 2, otherwise)."""
+    if args.clearance is not None:
+        from cspace.io.scenario.fields import clearance_fault
+
+        from ..errors import InputError
+
+        if fault := clearance_fault(args.clearance):
+            raise InputError(src, "--clearance", fault)
+
+
 def number(s: str) -> float:
     return float(s)
 
@@ -81,11 +97,7 @@ def run(args) -> int:
         raise InputError(src, "--seed", f"must be a non-negative integer, got {args.seed}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError(src, "--iterations", f"must be a positive integer, got {args.iterations}")
-    if args.clearance is not None:
-        from cspace.io.scenario.fields import clearance_fault
-
-        if fault := clearance_fault(args.clearance):
-            raise InputError(src, "--clearance", fault)
+    check_clearance(args, src)
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError(src, "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     from ..adapters.glue import MAX_TIME, SEED_LIMIT, planner_name
@@ -159,18 +171,12 @@ def run(args) -> int:
     scenario = src
     t_import = time.perf_counter()  # a load done here (an import, a queries file) is this run's load
     if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
-        from cspace.io.importers.imported import import_file
-        from cspace.io.load import scenario_from_dict
+        from .imports import imported_scenario
 
-        imp = import_file(src, options)
-        for out, opt in ((args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"),
-                         (args.csv, "--csv"), (args.proof, "--proof")):
-            if out is not None:
-                check_output(out, opt, inputs=imp.inputs)
-        for w in imp.warnings:
-            sys.stderr.write(f"warning: {w}\n")
         try:
-            scenario = scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
+            scenario = imported_scenario(args, src, options, [
+                (args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
+                (args.csv, "--csv"), (args.proof, "--proof")])
         except ScenarioError as exc:
             if queries is not None and exc.field in from_queries:  # the pose came from the queries file
                 raise InputError(args.queries, f"queries[0].{exc.field}", exc.message) from None

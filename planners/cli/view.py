@@ -15,15 +15,17 @@ def register(sub) -> None:
                                    "the robot moving along the path and the report; needs plotly "
                                    "(pip install -e \".[view]\"). Exit 0 solved, 1 not solved (the page is "
                                    "written either way), 2 bad input.")
-    p.add_argument("scenario", help="scenario TOML file")
+    p.add_argument("scenario", help="scenario TOML file, map YAML (.yaml) or OMPL.app problem (.cfg)")
     p.add_argument("--out", required=True, metavar="FILE.html", help="the page to write")
-    from .plan import add_space_options, integer, number
+    from .imports import add_import_options
+    from .plan import add_car_and_margin_options, add_space_options, integer, number
 
     p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, "
                                      "else RRTConnect")
     p.add_argument("--time", type=number, help="time limit in seconds; default: the scenario's, else 1")
     p.add_argument("--seed", type=integer, help="random seed; default: the scenario's, else 0")
     add_space_options(p)
+    add_car_and_margin_options(p)
     p.add_argument("--angles", type=integer, default=32,
                    help="rotating robots and cars: steps of the angle slider over the slab C-spaces (default 32)")
     p.add_argument("--poses", type=integer, default=120,
@@ -33,6 +35,7 @@ def register(sub) -> None:
                         "unpacked by the browser's DecompressionStream; browsers of 2023 on)")
     p.add_argument("--verbose", "-v", action="store_true",
                    help="print the plan in detail, as `cspace plan -v` does, and the time the page took")
+    add_import_options(p)
     p.set_defaults(run=run)
 
 
@@ -54,8 +57,13 @@ def run(args) -> int:
         raise InputError(src, "--angles", f"must be an integer from 1 to 720, got {args.angles}")
     if not 2 <= args.poses <= 2000:
         raise InputError(src, "--poses", f"must be an integer from 2 to 2000, got {args.poses}")
+    from .imports import import_options, input_files
+    from .plan import check_clearance
+
+    check_clearance(args, src)
     check_input(src)
-    check_output(args.out, "--out", {".html": "html", ".htm": "html"}, inputs=[src])
+    options = import_options(args, src)
+    check_output(args.out, "--out", {".html": "html", ".htm": "html"}, inputs=input_files(src, args.robot, None))
     from ..pictures.view import check_plotly
 
     check_plotly(args.out, "--out")
@@ -72,7 +80,19 @@ def run(args) -> int:
     from ..pictures.view import write_view
     from .plan import summary
 
-    res = plan(src, planner=args.planner, time=args.time, seed=args.seed, space=args.space, slabs=args.slabs)
+    scenario, t_import = src, time.perf_counter()
+    if options is not None:  # a map or an OMPL.app problem: imported here, as `cspace plan` does
+        from .imports import imported_scenario
+
+        scenario = imported_scenario(args, src, options, [(args.out, "--out")])
+    import_s = time.perf_counter() - t_import
+    loaded = options is not None  # a Scenario, its space and radius applied
+    res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, slabs=args.slabs,
+               space=None if loaded else args.space, turning_radius=None if loaded else args.turning_radius,
+               clearance=args.clearance)
+    if loaded:  # the import's time is this run's load
+        res.timings["load"] = res.timings.get("load", 0.0) + import_s
+        res.timings["total"] = res.timings.get("total", 0.0) + import_s
     print(summary(res, verbose=args.verbose))
     t0 = time.perf_counter()
     write_view(res, args.out, poses=args.poses, angles=args.angles, compress=not args.no_compress)

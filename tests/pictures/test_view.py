@@ -179,6 +179,31 @@ def test_cli_view(tmp_path):
     assert inputs.returncode == 2
 
 
+def test_cli_view_takes_plan_s_import_and_margin_options(tmp_path):
+    # what a user plans they can view (issue 51, point 5): an imported map with its robot, start and
+    # goal, a safety margin, a car's turning radius; a scenario TOML still refuses the import options
+    out = tmp_path / "m.html"
+    office = os.path.join(SCENARIOS, "maps", "office.yaml")
+    view = [sys.executable, "-m", "planners.cli", "view"]
+    run = subprocess.run(view + [office, "--radius", "0.2", "--start", "0.5,0.5", "--goal", "9.5,6.5",
+                                 "--clearance", "0.05", "--out", str(out)], capture_output=True, text=True, cwd=ROOT)
+    assert run.returncode == 0, run.stderr
+    assert "margin asked 0.05" in run.stdout and out.stat().st_size > 1_000_000
+    assert "office" in json.loads(unpack(out.read_text(encoding="utf-8"), "figure-gz"))["layout"]["title"]["text"]
+    car = subprocess.run(view + [SCENES["car"], "--turning-radius", "0.9", "--out", str(tmp_path / "c.html")],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert car.returncode in (0, 1) and car.stderr == "", car.stderr
+    for args, option in (([office, "--start", "0.5,0.5"], "goal"), ([SCENES["translation"], "--radius", "0.2"], "--radius"),
+                         ([SCENES["translation"], "--clearance", "-1"], "--clearance")):
+        bad = subprocess.run(view + args + ["--out", str(tmp_path / "b.html")], capture_output=True, text=True, cwd=ROOT)
+        assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and option in bad.stderr, bad.stderr
+        assert not (tmp_path / "b.html").exists()
+    image = os.path.join(SCENARIOS, "maps", "office.pgm")  # the map's image is an input: never written over
+    over = subprocess.run(view + [office, "--radius", "0.2", "--start", "0.5,0.5", "--goal", "9.5,6.5", "--out", image],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert over.returncode == 2
+
+
 def test_cli_plan_html(tmp_path):
     out = tmp_path / "p.html"
     run = subprocess.run([sys.executable, "-m", "planners.cli", "plan", SCENES["car"], "--html", str(out)],
