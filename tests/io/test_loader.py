@@ -232,3 +232,57 @@ def test_probe_batch_matches_a_union_per_pose(name):
         want.append(next((k for k, o in enumerate(obstacles) if body.intersects(o)), None))
     got = probe.first_hits(poses)
     assert got == want and any(h is None for h in got) and any(h is not None for h in got)
+
+
+FULL = BASE + """
+[robot]
+polygon = [[-0.2, -0.2], [0.2, -0.2], [0.0, 0.3]]
+[[obstacles]]
+polygon = [[4.0, 4.0], [6.0, 4.0], [6.0, 6.0], [4.0, 6.0]]
+[planner]
+name = "RRTConnect"
+time = 1.0
+"""
+
+
+def _keys(doc: dict, where: str = "") -> list[str]:
+    """Every key of a TOML document, dotted (a list of tables as its first element)."""
+    out = []
+    for k, v in doc.items():
+        path = f"{where}.{k}" if where else k
+        out.append(path)
+        if isinstance(v, dict):
+            out += _keys(v, path)
+        elif isinstance(v, list) and v and isinstance(v[0], dict):
+            out += _keys(v[0], f"{path}[0]")
+    return out
+
+
+def _rename(text: str, dotted: str, new: str) -> str:
+    """The document with the key ``dotted`` renamed ``new`` (by its line inside its table)."""
+    *tables, key = dotted.replace("[0]", "").split(".")
+    lines, table = text.splitlines(), ""
+    for i, line in enumerate(lines):
+        if line.startswith("["):
+            table = line.strip("[]")
+        elif table == ".".join(tables) and line.split("=")[0].strip() == key:
+            lines[i] = line.replace(key, new, 1)
+            return "\n".join(lines) + "\n"
+    raise AssertionError(dotted)
+
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib
+
+
+@pytest.mark.parametrize("dotted", [k for k in _keys(tomllib.loads(FULL))
+                                    if "." in k and not k.startswith("planner.")])
+def test_a_misspelt_key_is_named_with_its_correction(dotted, write_toml):
+    # a typo in a key (xmaxx) is reported as the unknown key with a suggestion, never as the
+    # key it was meant to be being missing (issue 51, point 7)
+    key = dotted.rsplit(".", 1)[1]
+    with pytest.raises(ScenarioError) as exc:
+        load_scenario(write_toml(_rename(FULL, dotted, key + key[-1])))
+    assert exc.value.field.endswith(key + key[-1]) and f"did you mean {key}?" in exc.value.message, str(exc.value)

@@ -38,9 +38,9 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
     tol = v.number(data.get("disk_tolerance", DEFAULT_RELATIVE_ERROR), "disk_tolerance", positive=True)
 
     b = v.table(data, "bounds", required=True)
+    v.no_extra(b, "bounds", {"xmin", "xmax", "ymin", "ymax"})  # first: a misspelt key explains a missing one
     xmin, xmax = v.number(b.get("xmin"), "bounds.xmin"), v.number(b.get("xmax"), "bounds.xmax")
     ymin, ymax = v.number(b.get("ymin"), "bounds.ymin"), v.number(b.get("ymax"), "bounds.ymax")
-    v.no_extra(b, "bounds", {"xmin", "xmax", "ymin", "ymax"})
     if not xmin < xmax:
         raise v.err("bounds", f"xmin ({xmin}) must be less than xmax ({xmax})")
     if not ymin < ymax:
