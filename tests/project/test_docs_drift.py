@@ -121,6 +121,10 @@ def test_every_quoted_output_is_marked():
 def test_quoted_output_matches_a_fresh_run(block):
     if block.slow and not RUN_SLOW:
         pytest.skip("slow (CSPACE_DOCS_SLOW=1 runs it)")
+    from cspace.compiled import fastpath
+
+    if not fastpath.compiled():  # the pure path's grids are coarser: other counters, the same answers
+        pytest.skip("the guide quotes the compiled fast path's counters (grid cells, exact checks)")
     GUIDE_OUT.run(block, timeout=300)
     with open(GUIDE_OUT.GUIDE, encoding="utf-8") as fh:
         text = fh.read()
