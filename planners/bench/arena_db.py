@@ -259,6 +259,32 @@ def insert_run(conn, exp_id: int, plan_id: int, row: dict) -> int:
     return run_id
 
 
+def stored_run(conn, exp_id: int, plan_id: int, seed: int) -> dict | None:
+    """A stored run read back as the bench's row fields, as far as the database keeps them (the
+    run properties of :data:`RUN_PROPS`; its progress points); None if it is not stored. The
+    database keeps a run's status, not its message: a stored run says what its status says."""
+    names = [n for n, _, _ in RUN_PROPS]
+    got = conn.execute(f"SELECT id, {', '.join(column(n) for n in names)} FROM runs WHERE experimentid = ? "
+                       "AND plannerid = ? AND seed = ?", (exp_id, plan_id, int(seed))).fetchone()
+    if got is None:
+        return None
+    v = dict(zip(names, got[1:]))
+    status, lower = v["status"], v["min clearance is lower bound"]
+    message = {UNSOLVABLE: "proven unsolvable (a stored run)", CRASH: "crashed (a stored run)",
+               ABORT: "killed at its hard limit (a stored run)"}.get(status, "")
+    return {"status": {CRASH: "crashed", ABORT: "timeout"}.get(status, "ok"), "solved": bool(v["solved"]),
+            "solve_s": v["time"], "length": v["simplified solution length"],
+            "length_unsimplified": v["solution length"], "simplify_s": v["simplification time"],
+            "min_clearance": v["min clearance"],
+            "min_clearance_bound": None if lower is None else ("lower" if lower else "exact"),
+            "error": v["length error"], "error_upper": v["length error vs exact planner"],
+            "first_solution_s": v["first solution time"], "state_checks": v["state checks"],
+            "motion_checks": v["motion checks"], "graph_states": v["graph states"], "wall_s": v["wall time"],
+            "message": message,
+            "progress": [list(p) for p in conn.execute("SELECT time, best_cost FROM progress WHERE runid = ? "
+                                                       "ORDER BY time", (got[0],))]}
+
+
 def run_keys(conn) -> list[tuple]:
     """Every stored run's identity: (experiment properties..., planner, seed), for tests and resume."""
     props = ", ".join(f"e.{k}" for k, _ in EXP_PROPS if k != "reference")

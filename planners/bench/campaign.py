@@ -91,6 +91,19 @@ class Campaign:
                 out.append(t)
         return out
 
+    def stored_rows(self, tasks: list[dict]) -> list[dict]:
+        """The rows of the tasks whose run the database holds, read back from it (what
+        ``--resume`` skips still belongs to the campaign's outputs)."""
+        from .rows import complete_row
+
+        out = []
+        for t in tasks:
+            e = self.experiment(t, create=False)
+            got = None if e is None else adb.stored_run(self.conn, e, self.planner(t["planner"]), t["seed"])
+            if got is not None:
+                out.append(complete_row(t, got, got["wall_s"]))
+        return out
+
     def select(self, tasks: list[dict], resume: bool) -> list[dict]:
         """The tasks left to run: all (refused if some are stored), or, resuming, those not stored."""
         done = self.stored_tasks(tasks)

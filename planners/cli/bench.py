@@ -177,15 +177,18 @@ def run(args) -> int:
     check_scenarios(objective, held)
     os.makedirs(out, exist_ok=True)
     tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on, objective)
-    campaign = None
+    campaign, stored = None, []
     if db or log:
         from ..bench.campaign import Campaign
 
         campaign = Campaign(db, tasks)
-        n = len(tasks)
+        n, every = len(tasks), tasks
         tasks = campaign.select(tasks, getattr(args, "resume", False))
-        if not args.quiet and len(tasks) < n:
-            sys.stderr.write(f"--resume: {n - len(tasks)} of {n} runs already in {db}\n")
+        if len(tasks) < n:  # resumed: the stored runs are read back, so --out describes the campaign
+            todo = {campaign.task_key(t) for t in tasks}
+            stored = campaign.stored_rows([t for t in every if campaign.task_key(t) not in todo])
+            if not args.quiet:
+                sys.stderr.write(f"--resume: {n - len(tasks)} of {n} runs already in {db}\n")
     t0 = time.perf_counter()
     try:
         rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
@@ -194,6 +197,11 @@ def run(args) -> int:
     finally:
         if campaign is not None:
             campaign.finish(log)
+    if stored:  # in the sweep's row order, as if every run had been made now
+        place = {campaign.task_key(t): i for i, t in enumerate(every)}
+        for r in stored:
+            r.pop("order", None)
+        rows = sorted(stored + rows, key=lambda r: place[campaign.task_key(r)])
     meta = {"scenarios": scenarios, "planners": planners, "times": times, "runs": args.runs,
             "iterations": args.iterations, "objective": objective, "workers": args.workers, "scheduler": args.scheduler,
             "wall_s": time.perf_counter() - t0, "complete": not interrupted,

@@ -216,3 +216,30 @@ def test_the_resume_script_counts_lost_and_repeated_runs(capsys):
     assert load_script("bench_resume").main(["--trials", "1", "--seeds", "3", "--seed", "1"]) == 0
     out = capsys.readouterr().out
     assert "1 kills: lost 0, repeated 0, incomplete 0" in out and "-> 6/6" in out
+
+
+def test_resume_writes_the_whole_campaign_to_out(tmp_path):
+    # --out describes the campaign, not only the runs made now (issue 51, point 3): after a partial
+    # resume, and after a resume with nothing left to run, it holds every run, the stored ones
+    # read back from the database as the first sweep wrote them
+    import csv
+    import json
+
+    db = tmp_path / "w.db"
+    args = ["--planners", "RRTConnect", "--times", "0.01", "--db", db]
+    assert bench(BASIC, *args, "--runs", 2, "--out", tmp_path / "a") == 0
+    assert bench(BASIC, *args, "--runs", 3, "--out", tmp_path / "b", "--resume") == 0
+    assert bench(BASIC, *args, "--runs", 3, "--out", tmp_path / "c", "--resume") == 0  # nothing left to run
+
+    def rows(folder):
+        with open(tmp_path / folder / "results.csv", newline="") as fh:
+            return list(csv.DictReader(fh))
+
+    first, resumed, again = rows("a"), rows("b"), rows("c")
+    assert [r["seed"] for r in resumed] == [r["seed"] for r in again] == ["0", "1", "2"]
+    kept = ("planner", "time_budget", "seed", "status", "solved", "length", "length_unsimplified", "optimum",
+            "error", "first_solution_s", "solve_s", "simplify_s", "state_checks", "motion_checks", "min_clearance")
+    for a, b in zip(first, resumed):
+        assert {k: a[k] for k in kept} == {k: b[k] for k in kept}
+    assert {k: again[2][k] for k in kept} == {k: resumed[2][k] for k in kept}  # seed 2, run by the second sweep
+    assert len(json.loads((tmp_path / "c" / "results.json").read_text())["rows"]) == 3
