@@ -215,7 +215,9 @@ def run(args) -> int:
     if args.animate and res.solved:
         from ..pictures.animate import animate_path
 
-        animate_path(res, args.animate)
+        t0 = time.perf_counter()
+        frames = animate_path(res, args.animate)
+        sys.stderr.write(f"animation: {args.animate} written ({frames} frames, {time.perf_counter() - t0:.1f} s)\n")
     elif args.animate:
         sys.stderr.write(f"note: --animate {args.animate}: nothing to animate (not solved)\n")
     if args.html is not None:

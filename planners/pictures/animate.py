@@ -1,6 +1,7 @@
 """An animation of the robot moving along a path (GIF, via Pillow), at the poses of
-:func:`planners.pictures.poses.poses_along`. :func:`animate_path` writes an animated
-GIF with matplotlib's animation module and Pillow (a matplotlib dependency): no ffmpeg.
+:func:`planners.pictures.poses.poses_along`. :func:`animate_path` draws the frames with
+matplotlib (the scene once, the moving robot blitted over it) and writes the GIF with Pillow
+(a matplotlib dependency): no ffmpeg.
 """
 from __future__ import annotations
 
@@ -11,16 +12,21 @@ from ..output import atomic_path
 from .poses import poses_along, robot_polygons  # noqa: F401  (robot_polygons: the animation's API)
 
 
-def animate_path(res, out: str, frames: int = 80, fps: int = 20, scenario=None) -> None:
+def animate_path(res, out: str, frames: int = 80, fps: int = 20, scenario=None, dpi: int = 80,
+                 progress: bool | None = None) -> int:
     """Write an animated GIF of the robot moving along ``res.path`` (a solved PlanResult).
 
-    The scene (bounds, obstacles) is drawn once; each frame moves the robot's footprint
-    and draws the path travelled so far.
+    The scene (bounds, obstacles, axes) is drawn once and kept as the background; each frame
+    restores it and draws only what moves: the robot's footprint and the path travelled so
+    far (matplotlib's blitting), so a frame costs the robot, not the scene. ``progress``: a bar
+    on a terminal (None: when stderr is one). Returns the number of frames written.
     """
+    from PIL import Image
+
+    from ..progress import Progress
     from .plot import frame_axes, mpl, poly_patch, draw_scene
 
     plt = mpl()[0]
-    from matplotlib.animation import FuncAnimation, PillowWriter
 
     sc = scenario or res.scenario_data
     if sc is None:
@@ -57,15 +63,23 @@ def animate_path(res, out: str, frames: int = 80, fps: int = 20, scenario=None) 
         trail.set_data(poses[: i + 1, 0], poses[: i + 1, 1])
         return [*patches, dot, trail]
 
-    class GifWriter(PillowWriter):
-        """Pillow's GIF writer, told the format (the atomic temporary has no extension)."""
-
-        def finish(self):
-            self._frames[0].save(self.outfile, format="GIF", save_all=True, append_images=self._frames[1:],
-                                 duration=int(1000 / self.fps), loop=0)
-
-    anim = FuncAnimation(fig, frame, frames=len(poses), blit=False)
     fig.tight_layout()
-    with atomic_path(out, "--animate") as tmp:
-        anim.save(tmp, writer=GifWriter(fps=fps), dpi=80)
+    fig.set_dpi(dpi)
+    for artist in (*patches, dot, trail):  # left out of the background
+        artist.set_animated(True)
+    fig.canvas.draw()  # the scene, axes and labels: drawn once, then kept as the background
+    background = fig.canvas.copy_from_bbox(fig.bbox)
+    images = []
+    with Progress(len(poses), "animating", unit="frame", delay=0.5, enabled=progress) as bar:
+        for i in range(len(poses)):
+            fig.canvas.restore_region(background)
+            for artist in frame(i):
+                ax.draw_artist(artist)
+            fig.canvas.blit(fig.bbox)
+            images.append(Image.frombuffer("RGBA", fig.canvas.get_width_height(), fig.canvas.buffer_rgba(),
+                                           "raw", "RGBA", 0, 1).convert("RGB"))
+            bar.update()
     plt.close(fig)
+    with atomic_path(out, "--animate") as tmp:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=int(1000 / fps), loop=0)
+    return len(images)

@@ -90,6 +90,36 @@ def test_plot_and_animation(tmp_path):
     assert png.stat().st_size > 10_000
     with Image.open(gif) as im:
         assert im.format == "GIF" and im.n_frames >= 20
+        first = im.convert("RGB").tobytes()
+        im.seek(im.n_frames - 1)
+        last = im.convert("RGB").tobytes()
+    assert first != last  # the robot moves
+    assert r.stderr.count("\n") == 1 and r.stderr.startswith(f"animation: {gif} written ({im.n_frames} frames"), r.stderr
+
+
+def test_an_animation_frame_is_the_scene_with_the_robot_at_its_pose(tmp_path):
+    # the blitted frames (the scene drawn once, the robot over it) are what a full redraw of the same
+    # frame gives: the background holds no robot, and each frame holds the robot where the path puts it
+    import numpy as np
+    from PIL import Image
+
+    from planners.pictures.animate import animate_path
+
+    res = planners.plan(os.path.join(SCENARIOS, "se2", "bar_door.toml"), seed=1)
+    gif = tmp_path / "a.gif"
+    assert animate_path(res, str(gif), frames=12, progress=False) == 12
+    with Image.open(gif) as im:
+        frames = []
+        for k in range(im.n_frames):
+            im.seek(k)
+            frames.append(np.asarray(im.convert("RGB"), dtype=int))
+    green = [((f[..., 1] > f[..., 0] + 40) & (f[..., 1] > f[..., 2] + 20)).sum() for f in frames]
+    assert min(green) > 50  # the robot (green) in every frame ...
+    moved = [np.abs(frames[k] - frames[k + 1]).sum() for k in range(len(frames) - 1)]
+    assert min(moved) > 0  # ... and it moves
+    # no frame keeps the robot of another: frame k's green pixels lie around pose k only
+    xs = [np.nonzero((f[..., 1] > f[..., 0] + 40) & (f[..., 1] > f[..., 2] + 20))[1] for f in frames]
+    assert xs[0].max() < xs[-1].min()  # bar_door's path runs left to right: first and last robots apart
 
 
 def test_show_draws_one_slab(tmp_path):
