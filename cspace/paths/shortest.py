@@ -136,8 +136,6 @@ def shortest_path(pieces: list, bounds, start, goal, time_limit: float | None = 
 
 
 def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method, free) -> ShortestPath:
-    import shapely
-
     from .pathcheck import Degenerate, path_violations, split_pieces
     from ..kernel.polygons.polygon import as_array
     from .shortest_lazy import lazy_astar
@@ -148,9 +146,7 @@ def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method, free
     bounds = tuple(_point(bounds[:2], "bounds")) + tuple(_point(bounds[2:], "bounds"))
     scene = _scene(pieces, bounds, free)
     parts = scene.parts
-    ps, pg = shapely.Point(s), shapely.Point(g)
-    comp_s = next((k for k, p in enumerate(parts) if p.covers(ps)), None)
-    comp_g = next((k for k, p in enumerate(parts) if p.covers(pg)), None)
+    comp_s, comp_g = _components(parts, s, g)
     stats = {"counts": {"free_components": len(parts)}}
     degenerate = split_pieces(pieces)[1]
     deg = Degenerate(degenerate, parts[comp_s] if comp_s is not None else None) if degenerate else None
@@ -208,6 +204,35 @@ def _shortest(pieces, bounds, start, goal, time_limit, on_progress, method, free
         stats["reason"] = f"the path failed the exact check against the pieces (edge {bad[0][0]}, piece {bad[0][1]})"
         return ShortestPath(False, np.zeros((0, 2)), math.inf, False, stats)
     return ShortestPath(True, pts[path], length, False, stats)
+
+
+def _components(parts: list, s: tuple, g: tuple) -> tuple:
+    """The indices of F's components (closed: a boundary point counts) holding s and g (None: in
+    no component, so not in the free C-space)."""
+    import shapely
+
+    ps, pg = shapely.Point(s), shapely.Point(g)
+    return (next((k for k, p in enumerate(parts) if p.covers(ps)), None),
+            next((k for k, p in enumerate(parts) if p.covers(pg)), None))
+
+
+def separated(pieces: list, bounds, start, goal) -> bool:
+    """Do start and goal lie in different components of the free C-space F (a proof that no
+    path joins them, the one :func:`shortest_path` gives)? Builds F only (no reflex corners,
+    no mesh; kept for the searches on the same pieces). False when they share a component or
+    one of them is not free.
+
+    >>> wall = np.array([[1., 0], [2, 0], [2, 3], [1, 3]])
+    >>> separated([wall], (0, 3, 0, 3), (0.5, 1), (2.5, 1)), separated([wall], (0, 3, 0, 4), (0.5, 1), (2.5, 1))
+    (True, False)
+    """
+    from ..kernel.polygons.polygon import as_array
+
+    pieces = [as_array(p, copy=False, nonempty=True) for p in pieces]
+    s, g = _point(start, "start"), _point(goal, "goal")
+    bounds = tuple(_point(bounds[:2], "bounds")) + tuple(_point(bounds[2:], "bounds"))
+    comp_s, comp_g = _components(_scene(pieces, bounds).parts, s, g)
+    return comp_s is not None and comp_g is not None and comp_s != comp_g
 
 
 def _channel(scene, comp: int, s, g, pieces, bounds, deadline) -> np.ndarray | None:

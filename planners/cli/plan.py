@@ -287,7 +287,8 @@ def summary(res, verbose: bool = False) -> str:
         if r.solved:
             lines.append(f"{tag}: solved by {by}: length {r.length:.6g}, "
                          f"{len(r.path)} waypoints, solve {r.timings.get('solve', 0.0) * 1e3:.1f} ms")
-        elif "proven unsolvable" in r.message and r.proof is not None:
+        elif r.message.startswith("proven unsolvable before sampling") or (
+                "proven unsolvable" in r.message and r.proof is not None):
             lines.append(f"{tag}: {r.message}")
         elif r.planner == "exact" and "proven unsolvable" in r.message:
             lines.append(f"{tag}: proven unsolvable (start and goal are in different free components)")

@@ -61,3 +61,28 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
         stages=["visibility"], start=tuple(query.start), goal=tuple(query.goal), message=message,
         length_unsimplified=float(sp.length) if sp.solved else None, first_path_cpu=found_cpu,
     )
+
+
+def separated_proof(sc, cspace, query, time_limit: float | None = None) -> PlanResult | None:
+    """A translating robot's query proven unsolvable before sampling: start and goal in different
+    components of the free C-space (:func:`cspace.paths.shortest.separated`, the exact
+    planner's proof; F is kept for later searches on the same C-space), as a PlanResult; None
+    when they share a component (the time limit is not used: building F is not interruptible,
+    and it is the first stage of the exact planner's search).
+
+    >>> from cspace import CSpace
+    >>> from cspace.io.load import load_scenario
+    >>> import os
+    >>> sc = load_scenario(os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "narrow_closed.toml"))
+    >>> separated_proof(sc, CSpace.from_scenario(sc), sc.all_queries()[0]).message.startswith("proven unsolvable")
+    True
+    """
+    from cspace.paths.shortest import separated
+
+    if not separated(cspace.pieces, cspace.bounds, query.start, query.goal):
+        return None
+    return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 2)), length=math.inf,
+                      planner="", seed=0, start=tuple(query.start), goal=tuple(query.goal), timings={},
+                      checks={}, stages=["free components"],
+                      message="proven unsolvable before sampling: start and goal are in different free "
+                              "components (no collision-free path exists)")

@@ -181,16 +181,14 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     else:
         from .routine import run_planner
 
-        proven, spent = (_proofs_before_sampling(sc, cspace, queries, tlim, name, sd) if se2
-                         else ([None] * len(queries), [0.0] * len(queries)))
+        proven, spent = _proofs_before_sampling(sc, cspace, queries, tlim, name, sd, se2)
         todo = [pair for pair, p in zip(poses, proven) if p is None]
         sampled = iter(run_planner(adapter, name, todo, tlim, sd, iterations=iterations, simplify=simplify,
                                    slices=slices, on_progress=on_progress, scenario=sc.name, objective=objective)
                        if todo else [])
         results = [p if p is not None else next(sampled) for p in proven]
-        if se2:
-            for r, t in zip(results, spent):
-                r.timings = {"proof": t, **r.timings}
+        for r, t in zip(results, spent):
+            r.timings = {"proof": t, **r.timings}
         # (No inscribed-disk rule after a failure: the proof before sampling is at least as strong,
         # since every POSSIBLE region lies in the disk's free space, and the rule's C-space build,
         # seconds on a large map, would run past --time.)
@@ -311,19 +309,24 @@ def make_adapter(sc: Scenario, cspace):
     return TranslationSpace(cspace)
 
 
-def _proofs_before_sampling(sc: Scenario, cspace, queries, tlim: float, name: str, seed: int) -> tuple[list, list]:
-    """A rotating robot's queries that the slab graph's POSSIBLE regions prove unsolvable within a
-    small share of the time limit (:func:`planners.core.exact_se2.quick_proof`): answered
-    without sampling; None for the others; and the seconds each check took. A point robot does
-    not turn: nothing to prove."""
-    if not cspace.body_pieces:
+def _proofs_before_sampling(sc: Scenario, cspace, queries, tlim: float, name: str, seed: int,
+                            rotates: bool) -> tuple[list, list]:
+    """The queries proven unsolvable before any sampling, answered without it; None for the
+    others; and the seconds each check took. A rotating robot: the slab graph's POSSIBLE regions
+    within a small share of the time limit (:func:`planners.core.exact_se2.quick_proof`; a point
+    robot does not turn: nothing to prove). A translating one: start and goal in different
+    components of the free C-space (:func:`planners.core.exact.separated_proof`)."""
+    if rotates and not cspace.body_pieces:
         return [None] * len(queries), [0.0] * len(queries)
-    from .exact_se2 import quick_proof
+    if rotates:
+        from .exact_se2 import quick_proof as prove
+    else:
+        from .exact import separated_proof as prove
 
     out, spent = [], []
     for q in queries:
         t = _now()
-        r = quick_proof(sc, cspace, q, tlim) if tuple(q.start) != tuple(q.goal) else None
+        r = prove(sc, cspace, q, tlim) if tuple(q.start) != tuple(q.goal) else None
         if r is not None:
             r.planner, r.seed = name, seed
         out.append(r)

@@ -150,9 +150,21 @@ def test_exact_unsolvable_reads_proven_without_a_seed():
 
 
 def test_a_failed_sampling_planner_explains_and_suggests_exact():
-    res = plan(SC / "narrow_closed.toml", planner="RRTConnect", time=0.2)
+    # a solvable scene on a budget of one iteration: not found, at any machine speed
+    res = plan(SC / "narrow_passage.toml", planner="RRTConnect", time=5, iterations=1)
     assert not res.solved
     assert "no path found within the budget" in res.message and "--planner exact" in res.message
+
+
+def test_a_translating_robot_without_a_path_is_proven_before_sampling():
+    # no sampling budget is spent when the free space's components separate start and goal
+    # (issue 51, point 6): the answer comes from the same proof as the exact planner's
+    res = plan(SC / "narrow_closed.toml", planner="RRTConnect", time=60)
+    assert not res.solved and res.proven_unsolvable and "different free components" in res.message
+    assert res.stages[-1] == "free components" and "solve" not in res.timings and res.timings["proof"] > 0
+    assert res.timings["total"] < 30  # far from the budget: nothing was sampled
+    ok = plan(SC / "basic.toml", planner="RRTConnect", time=5, seed=1)
+    assert ok.solved and "proof" in ok.timings  # the check runs, and lets a solvable query through
     from planners.core.routine import failure_message
 
     msg = failure_message("Approximate solution")
