@@ -53,7 +53,8 @@ def register(sub) -> None:
     from ..cli.plan import add_space_options
 
     add_space_options(p)
-    p.add_argument("--quiet", "-q", action="store_true", help="no progress line")
+    p.add_argument("--quiet", "-q", action="store_true",
+                   help="no progress bar and no reference lines (the summary table still prints)")
     # Test hook: the child of this (planner, seed) calls os.abort(), as a segfaulting planner would.
     p.add_argument("--abort-on", help=argparse.SUPPRESS)
     p.set_defaults(run=run)
@@ -210,8 +211,8 @@ def run(args) -> int:
     # killed before it writes (kill -9, a power cut) leaves the earlier results whole.
     clear_outputs(out)
     interrupted = write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
+    sys.stderr.write(summary(rows, scenarios) + "\n")  # the result: printed with -q too
     if not args.quiet:
-        sys.stderr.write(summary(rows, scenarios) + "\n")
         sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
                          + (" (interrupted)" if interrupted else "") + "\n")
     return 130 if interrupted else 0

@@ -243,3 +243,11 @@ def test_resume_writes_the_whole_campaign_to_out(tmp_path):
         assert {k: a[k] for k in kept} == {k: b[k] for k in kept}
     assert {k: again[2][k] for k in kept} == {k: resumed[2][k] for k in kept}  # seed 2, run by the second sweep
     assert len(json.loads((tmp_path / "c" / "results.json").read_text())["rows"]) == 3
+
+
+def test_quiet_keeps_the_summary_table(tmp_path, capsys):
+    # -q drops the progress bar and the reference lines, not the result (issue 51, point 7)
+    assert bench(BASIC, "--planners", "RRTConnect", "--times", "0.01", "--runs", 1, "--out", tmp_path / "q") == 0
+    err = capsys.readouterr().err
+    assert err.splitlines()[0].split()[:3] == ["scenario", "planner", "budget"], err
+    assert any(line.split()[:2] == ["basic", "RRTConnect"] for line in err.splitlines()), err
