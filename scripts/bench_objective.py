@@ -19,6 +19,7 @@ Usage: python scripts/bench_objective.py [--iterations N] [--reps R] [scenario.t
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import random
 import statistics
@@ -58,6 +59,20 @@ def run(sc, cs, objective: str, iterations: int, seed: int) -> tuple[float, floa
     return r.timings["solve"] / iterations, (r.min_clearance if r.solved else float("nan"))
 
 
+def solved_median(values: list) -> str:
+    """The median over the solved runs (an unsolved run's clearance is nan), with how many those
+    were when not all; "unsolved" when none was (never a bare nan).
+
+    >>> solved_median([0.5, 0.7, 0.6]), solved_median([0.5, float("nan"), 0.7]), solved_median([float("nan")] * 2)
+    ('0.6', '0.6 (2/3)', 'unsolved')
+    """
+    done = [v for v in values if math.isfinite(v)]
+    if not done:
+        return "unsolved"
+    text = f"{statistics.median(done):.4g}"
+    return text if len(done) == len(values) else f"{text} ({len(done)}/{len(values)})"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("scenarios", nargs="*")
@@ -90,8 +105,8 @@ def main() -> None:
         worst = max(worst, ratio)
         print(f"{sc.name:<14} {1e6 * statistics.median(t['length']):12.1f} {1e6 * statistics.median(t['clearance']):15.1f} "
               f"{ratio:6.2f} {'yes' if ratio <= TARGET else 'NO':>5}  {statistics.median(floors):11.2f}  "
-              f"{statistics.median(c['length']):21.4g} "
-              f"{statistics.median(c['clearance']):9.4g}")
+              f"{solved_median(c['length']):>21} "
+              f"{solved_median(c['clearance']):>9}")
     print(f"worst ratio clearance / length per iteration: {worst:.2f}x (target <= {TARGET:g}x: "
           f"{'met' if worst <= TARGET else 'NOT met'})")
 
