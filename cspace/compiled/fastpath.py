@@ -8,7 +8,9 @@ the environment, read at import, forces the pure path.
 The C routines decide only what Shewchuk's stage-A float filter certifies and answer
 "undecided" (-1) otherwise; the caller then runs the pure path, which is exact
 (rationals). So both paths give the same answers, the pure one being the oracle
-(tests/compiled/test_fastpath.py checks that on random and degenerate queries).
+(tests/compiled/test_fastpath.py checks that on random and degenerate queries). The handles of
+the SE(2) and car motion checks are made by :mod:`cspace.compiled.motions`, which reaches the
+extension through :func:`extension` only (this module owns it).
 """
 from __future__ import annotations
 
