@@ -261,7 +261,8 @@ def comb(teeth: int, width: float, gap: float, depth: float, base: float) -> np.
     ``depth`` pointing up (+y), ``gap`` apart; lower-left corner at the origin.
 
     >>> c = comb(3, 1.0, 1.0, 4.0, 1.0)
-    >>> len(c), float(abs(np.cross(c, np.roll(c, -1, 0)).sum()) / 2)
+    >>> n = np.roll(c, -1, 0)
+    >>> len(c), float(abs((c[:, 0] * n[:, 1] - c[:, 1] * n[:, 0]).sum()) / 2)  # the shoelace area
     (12, 17.0)
     """
     pitch = width + gap
