@@ -105,7 +105,7 @@ class CarCSpace(SE2CSpace):
         doubles (cspace/compiled/_carwords.c, _carmotion.c); anything it declines runs here.
 
         >>> import numpy as np
-                >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+        >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
         >>> box = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
         >>> cs = CarCSpace((0, 10, 0, 10), [sq], [box], slabs=16)
         >>> cs.car_motion_free((1.0, 1.0, 0.0), (8.0, 1.0, 0.0), "reeds-shepp", 1.0)  # along y = 1
@@ -149,7 +149,7 @@ class CarCSpace(SE2CSpace):
         >>> import numpy as np
         >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
         >>> box = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
-                >>> cs = CarCSpace((0, 10, 0, 10), [sq], [box], slabs=16)
+        >>> cs = CarCSpace((0, 10, 0, 10), [sq], [box], slabs=16)
         >>> cs.curve_free((2, 2, 0), [("L", math.pi / 2), ("S", 5)], 1.0)  # quarter turn, then up x = 3
         True
         >>> cs.curve_free((2, 2, 0), [("S", 3), ("L", math.pi / 2), ("S", 5)], 1.0)  # up x = 6: hits

@@ -186,8 +186,7 @@ def run(args) -> int:
         n, every = len(tasks), tasks
         tasks = campaign.select(tasks, getattr(args, "resume", False))
         if len(tasks) < n:  # resumed: the stored runs are read back, so --out describes the campaign
-            todo = {campaign.task_key(t) for t in tasks}
-            stored = campaign.stored_rows([t for t in every if campaign.task_key(t) not in todo])
+            stored = campaign.stored_rows(every)
             if not args.quiet:
                 sys.stderr.write(f"--resume: {n - len(tasks)} of {n} runs already in {db}\n")
     t0 = time.perf_counter()

@@ -91,6 +91,13 @@ def imported_scenario(args, src: str, options, outputs: list):
     return scenario_from_dict(imp.data, src, space=args.space, turning_radius=args.turning_radius)
 
 
+def count_as_load(res, seconds: float) -> None:
+    """Add the seconds spent loading here (an import, a queries file: not by ``plan()``) to the
+    result's ``load`` and ``total`` times (plan and view share this)."""
+    res.timings["load"] = res.timings.get("load", 0.0) + seconds
+    res.timings["total"] = res.timings.get("total", 0.0) + seconds
+
+
 def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
     import math
 

@@ -201,8 +201,9 @@ def run(args) -> int:
             raise InputError(src, "--objective", exc.message) from None
         raise
     if options is not None or queries is not None:  # loaded here, not by plan()
-        res.timings["load"] = res.timings.get("load", 0.0) + import_s
-        res.timings["total"] = res.timings.get("total", 0.0) + import_s
+        from .imports import count_as_load
+
+        count_as_load(res, import_s)
     print(summary(res, verbose=args.verbose))
     if args.json is not None:
         write_json(args.json, res.as_dict(), "--json")
@@ -287,11 +288,8 @@ def summary(res, verbose: bool = False) -> str:
         if r.solved:
             lines.append(f"{tag}: solved by {by}: length {r.length:.6g}, "
                          f"{len(r.path)} waypoints, solve {r.timings.get('solve', 0.0) * 1e3:.1f} ms")
-        elif r.message.startswith("proven unsolvable before sampling") or (
-                "proven unsolvable" in r.message and r.proof is not None):
+        elif r.proven_unsolvable:  # its message says by which proof
             lines.append(f"{tag}: {r.message}")
-        elif r.planner == "exact" and "proven unsolvable" in r.message:
-            lines.append(f"{tag}: proven unsolvable (start and goal are in different free components)")
         elif r.planner == "exact":
             lines.append(f"{tag}: NOT solved by exact: {r.message}")
         else:

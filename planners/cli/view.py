@@ -91,8 +91,9 @@ def run(args) -> int:
                space=None if loaded else args.space, turning_radius=None if loaded else args.turning_radius,
                clearance=args.clearance)
     if loaded:  # the import's time is this run's load
-        res.timings["load"] = res.timings.get("load", 0.0) + import_s
-        res.timings["total"] = res.timings.get("total", 0.0) + import_s
+        from .imports import count_as_load
+
+        count_as_load(res, import_s)
     print(summary(res, verbose=args.verbose))
     t0 = time.perf_counter()
     write_view(res, args.out, poses=args.poses, angles=args.angles, compress=not args.no_compress)

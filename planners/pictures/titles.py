@@ -20,23 +20,23 @@ def planner_words(res) -> str:
 
 
 def outcome_words(res) -> str:
-    """The outcome: the path's length, "proven unsolvable" (no path exists), or "not solved".
+    """The outcome: the path's length, "proven unsolvable" (no path exists: the result's
+    ``proven_unsolvable``, :class:`planners.core.result.PlanResult`'s rule), or "not solved".
 
-    >>> class R: solved, length, message, proof = False, float("inf"), "proven unsolvable: ...", None
+    >>> class R: solved, length, proven_unsolvable = False, float("inf"), True
     >>> outcome_words(R())
     'proven unsolvable'
     """
     if res.solved:
         return f"length {res.length:.4g}"
-    proven = getattr(res, "proof", None) is not None or "proven unsolvable" in (res.message or "")
-    return "proven unsolvable" if proven else "not solved"
+    return "proven unsolvable" if res.proven_unsolvable else "not solved"
 
 
 def plan_title(scene: str, res) -> str:
     """A picture's title: the scene, the planner (and seed), the outcome; no wall time (the
     same plan gives the same picture).
 
-    >>> class R: planner, seed, solved, length, message, proof = "exact", 0, True, 17.42051, "", None
+    >>> class R: planner, seed, solved, length, proven_unsolvable = "exact", 0, True, 17.42051, False
     >>> plan_title("basic", R())
     'basic: exact, length 17.42'
     >>> R.planner = "RRTConnect"

@@ -201,7 +201,7 @@ def play_menu(n: int) -> dict:
 def scene_layout(sc, res, sliders: list, menus: list) -> dict:
     """Equal-scale axes on the bounds (pan by drag, zoom by wheel), the title, the controls.
 
-    >>> class R: planner, seed, solved, length, message, proof = "exact", 0, True, 2.0, "", None
+    >>> class R: planner, seed, solved, length, message, proven_unsolvable = "exact", 0, True, 2.0, "", False
     >>> lay = scene_layout(tr.example_scene(), R(), [], [])
     >>> lay["yaxis"]["scaleanchor"], lay["dragmode"]
     ('x', 'pan')

@@ -133,6 +133,7 @@ def report_text(res, scenario=None, extra: str = "") -> str:
     ...     scenario, planner, seed, solved, length, message = "s", "exact", 0, True, 2.5, ""
     ...     timings, checks, stages, path, proof, cspace_report = {"solve": 0.001}, {}, [], [], None, None
     ...     min_clearance = min_clearance_bound = None
+    ...     proven_unsolvable = False
     >>> print(report_text(R()).splitlines()[0])
     s: solved by exact: length 2.5
     """
@@ -164,7 +165,7 @@ def report_text(res, scenario=None, extra: str = "") -> str:
         lines.append(f"PROVEN UNSOLVABLE: a proof over {len(res.proof.get('slabs', []))} slabs; the angle slider "
                      "also shows, in green, the components the proof lists for the slab at that angle "
                      "(re-check it: cspace plan --proof FILE, then cspace check-proof)")
-    elif "proven unsolvable" in res.message:
+    elif res.proven_unsolvable:  # no proof file: the free space's components separate start and goal
         lines.append("PROVEN UNSOLVABLE: start and goal are in different free components")
     return "\n".join(lines + ([extra] if extra else []))
 
