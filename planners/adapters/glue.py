@@ -116,10 +116,11 @@ def planner_name(name: str | None, source: str = "<options>", field: str = "plan
     if name is None:
         return DEFAULT_PLANNER
     table = {p.lower(): p for p in PLANNERS}
-    table["exact"] = "exact"
+    table["exact"], table["auto"] = "exact", "auto"
     canon = table.get(str(name).lower())
     if canon is None:
-        raise ScenarioError(source, field, f"unknown planner {name!r} (choose from: exact, {', '.join(PLANNERS)})")
+        raise ScenarioError(source, field, f"unknown planner {name!r} (choose from: auto, exact, "
+                                           f"{', '.join(PLANNERS)})")
     return canon
 
 

@@ -32,7 +32,7 @@ def register(sub) -> None:
                                    "path, per time budget. Exit 0 done, 2 bad input, 130 interrupted "
                                    "(finished rows are written).")
     p.add_argument("scenario", nargs="+", help="scenario TOML files")
-    p.add_argument("--planners", help=f"comma-separated OMPL planners (default {','.join(DEFAULT_PLANNERS)}; "
+    p.add_argument("--planners", help=f"comma-separated OMPL planners or auto (default {','.join(DEFAULT_PLANNERS)}; "
                                       "with --objective clearance or balanced, those of them that take it)")
     p.add_argument("--times", default=",".join(f"{t:g}" for t in DEFAULT_TIMES),
                    help="comma-separated time budgets in seconds (default 0.01,0.03,0.1,0.3,1)")
@@ -61,14 +61,16 @@ def register(sub) -> None:
 
 
 def parse_planners(text: str, source: str = "bench") -> list[str]:
-    """Canonical OMPL planner names from a comma-separated list (``exact`` is the reference, not a contestant).
+    """Canonical planner names from a comma-separated list: OMPL's, and ``auto`` (``exact`` is the
+    reference, not a contestant).
 
-    >>> parse_planners("rrtconnect,BITstar")
-    ['RRTConnect', 'BITstar']
+    >>> parse_planners("rrtconnect,BITstar,AUTO")
+    ['RRTConnect', 'BITstar', 'auto']
     """
     from ..adapters.glue import PLANNERS
 
     table = {p.lower(): p for p in PLANNERS}
+    table["auto"] = "auto"
     names = [s.strip() for s in str(text).split(",") if s.strip()]
     if not names:
         raise InputError(source, "--planners", "empty list")
@@ -76,7 +78,7 @@ def parse_planners(text: str, source: str = "bench") -> list[str]:
     for n in names:
         canon = table.get(n.lower())
         if canon is None:
-            raise InputError(source, "--planners", f"unknown planner {n!r} (choose from: {', '.join(PLANNERS)})")
+            raise InputError(source, "--planners", f"unknown planner {n!r} (choose from: auto, {', '.join(PLANNERS)})")
         if canon in out:
             raise InputError(source, "--planners", f"planner {canon} given twice")
         out.append(canon)

@@ -16,7 +16,9 @@ def register(sub) -> None:
                                    "exit 0 solved, 1 not solved, 2 bad input.")
     p.add_argument("scenario", help="scenario TOML file, or a ROS map (.yaml) or OMPL.app problem (.cfg) to "
                                     "import on the fly (see the options for imported files)")
-    p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, else RRTConnect")
+    p.add_argument("--planner", help="OMPL planner (case-insensitive), 'exact' or 'auto' (the proof, the slab "
+                                     "graph, sampling and refinement in one budget); default: the scenario's, else auto "
+                                     "for a rotating robot or a car, RRTConnect for a translating one")
     p.add_argument("--time", type=number, help="time limit in seconds; default: the scenario's, else 1")
     p.add_argument("--seed", type=integer, help="random seed; default: the scenario's, else 0")
     p.add_argument("--iterations", type=integer, help="also stop after this many planner iterations (deterministic budget)")
@@ -294,7 +296,7 @@ def summary(res, verbose: bool = False) -> str:
             lines.append(f"{tag}: NOT solved by exact: {r.message}")
         else:
             lines.append(f"{tag}: NOT solved by {by} within the limit: {r.message}")
-        if r.solved and r.planner == "exact" and r.path.shape[1] == 3:
+        if r.solved and r.path.shape[1] == 3 and (r.planner == "exact" or r.answered_by in ("slab graph", "refinement")):
             lines.append(r.message)
         if r.solved:
             lines.append(clearance_line(r))

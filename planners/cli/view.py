@@ -20,8 +20,9 @@ def register(sub) -> None:
     from .imports import add_import_options
     from .plan import add_car_and_margin_options, add_space_options, integer, number
 
-    p.add_argument("--planner", help="OMPL planner (case-insensitive) or 'exact'; default: the scenario's, "
-                                     "else RRTConnect")
+    p.add_argument("--planner", help="OMPL planner (case-insensitive), 'exact' or 'auto'; default: the "
+                                     "scenario's, else auto for a rotating robot or a car, RRTConnect for a "
+                                     "translating one")
     p.add_argument("--time", type=number, help="time limit in seconds; default: the scenario's, else 1")
     p.add_argument("--seed", type=integer, help="random seed; default: the scenario's, else 0")
     add_space_options(p)

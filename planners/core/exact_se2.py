@@ -33,7 +33,7 @@ CAR_SLABS = 128     # the finest partition a car's proof-only search tries
 # start and goal (16 slabs at most): ~2-3x the 8 slabs' cost (~20 ms on the bundled scenes, the
 # regions kept for the next query), and it proves a corner a long robot cannot turn.
 QUICK_WIDTH = 2 * math.pi / 16
-_REGIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> its SlabRegions
+_REGIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> {room: its SlabRegions}
 # C-space -> the (start, goal) pairs whose proof before sampling ran to its end and found no proof.
 # That search is deterministic (the same regions, slabs and graph), so asking again answers the same;
 # a search cut short by its time budget is not remembered (a longer one might still prove).
@@ -41,15 +41,24 @@ _NO_PROOF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def search(cspace, query, time_limit: float | None, *, possible_only: bool = False, refine: bool = True,
-           min_width: float | None = None):
+           min_width: float | None = None, room: float = 0.0):
     """The slab-graph search on an SE(2) C-space's pieces (body frame; its margin, if any,
     inflates the robot for the path, while a proof is made for the body itself). The slab
-    regions are kept with the C-space, so the queries of one scene share them."""
+    regions are kept with the C-space, so the queries of one scene share them.
+
+    ``room`` > 0 asks for a path that keeps that much more clearance: the robot is inflated by
+    a polygon holding the disk of radius ``room`` as well (its own regions, kept too); a start
+    or goal closer than that to an obstacle raises ValueError."""
     from cspace.se2.exact import exact_se2_search
 
-    regions = _regions_of(cspace)
+    margin = list(cspace.margin or [])
+    if room > 0:
+        from cspace.kernel.minkowski.margin import margin_shapes
+
+        margin += margin_shapes(float(room))
+    regions = _regions_of(cspace, float(room))
     return exact_se2_search(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, tuple(query.start),
-                            tuple(query.goal), time_limit=time_limit, margin=cspace.margin or None,
+                            tuple(query.goal), time_limit=time_limit, margin=margin or None,
                             possible_only=possible_only, refine=refine, regions=regions,
                             **({} if min_width is None else {"min_width": min_width}))
 
@@ -80,42 +89,40 @@ def prepare(cspace, exact: bool = False) -> float:
     return time.perf_counter() - t
 
 
-def _regions_of(cspace):
-    """The C-space's :class:`cspace.se2.slab_graph.SlabRegions`, made on first use and kept."""
+def _regions_of(cspace, room: float = 0.0):
+    """The C-space's :class:`cspace.se2.slab_graph.SlabRegions` (with the extra clearance
+    ``room``, see :func:`search`), made on first use and kept."""
     from cspace.se2.exact import slab_regions
 
-    regions = _REGIONS.get(cspace)
-    if regions is None:
-        regions = _REGIONS[cspace] = slab_regions(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds,
-                                                  cspace.margin or None)
-    return regions
+    kept = _REGIONS.setdefault(cspace, {})
+    if room not in kept:
+        margin = list(cspace.margin or [])
+        if room > 0:
+            from cspace.kernel.minkowski.margin import margin_shapes
+
+            margin += margin_shapes(room)
+        kept[room] = slab_regions(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, margin or None)
+    return kept[room]
 
 
 def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None = None,
-              simplify: bool = True) -> PlanResult:
-    """``planner = "exact"`` for a rotating robot (``space = "se2"``) or a car (a proof or nothing)."""
+              simplify: bool = True, refine: bool = True) -> PlanResult:
+    """``planner = "exact"`` for a rotating robot (``space = "se2"``) or a car (a proof or nothing).
+    ``refine=False``: the first slabs only (``auto``'s second stage)."""
     from cspace.io.load import ScenarioError
 
     car = sc.space != "se2"
     t0 = time.perf_counter()
     # a car's proof-only search stops at CAR_SLABS slabs: past that, a proof is unlikely and the
     # user is waiting for the advice to sample
-    res = search(cspace, query, time_limit, possible_only=car, min_width=2 * math.pi / CAR_SLABS if car else None)
+    res = search(cspace, query, time_limit, possible_only=car, refine=refine,
+                 min_width=2 * math.pi / CAR_SLABS if car else None)
     search_s = time.perf_counter() - t0
     st = res.stats
-    checks = {"slabs": st["slabs"], "refinements": st["refinements"],
-              **{f"{g}_{k}": v for g, d in st.get("graphs", {}).items() for k, v in d.items()},
-              **{f"regions_{k}": v for k, v in st.get("regions_built", {}).items()}}
-    timings = {"solve": search_s, "solve_cpu": st["cpu_seconds"],
-               **{f"slab_{k}": v for k, v in st.get("seconds", {}).items()}}
-    base = dict(scenario=sc.name, planner="exact", seed=0, start=tuple(query.start), goal=tuple(query.goal),
-                checks=checks, stages=["slab graph"])
+    base, timings = _described(sc, query, res, search_s)
     graph = f"{st['slabs']} slabs, {st['refinements']} refinements"
     if res.status == "unsolvable":
-        return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
-                          message=f"proven unsolvable: no collision-free path exists at any resolution (the "
-                                  f"slab graph's POSSIBLE regions separate start and goal; {graph})",
-                          proof=res.proof, **base)
+        return from_search(sc, query, res, search_s)
     if car:
         from ..adapters.glue import ompl_available
 
@@ -147,6 +154,29 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     return PlanResult(solved=True, exact=True, path=path, length=length, timings=timings,
                       message=f"certified path from the slab graph ({graph}; length {raw_len:.6g}, {note})",
                       length_unsimplified=raw_len, first_path_cpu=found_cpu, **base)
+
+
+def _described(sc, query, res, search_s: float) -> tuple[dict, dict]:
+    """The fields every answer of the slab graph's search shares, and its timings."""
+    st = res.stats
+    checks = {"slabs": st["slabs"], "refinements": st["refinements"],
+              **{f"{g}_{k}": v for g, d in st.get("graphs", {}).items() for k, v in d.items()},
+              **{f"regions_{k}": v for k, v in st.get("regions_built", {}).items()}}
+    timings = {"solve": search_s, "solve_cpu": st["cpu_seconds"],
+               **{f"slab_{k}": v for k, v in st.get("seconds", {}).items()}}
+    base = dict(scenario=sc.name, planner="exact", seed=0, start=tuple(query.start), goal=tuple(query.goal),
+                checks=checks, stages=["slab graph"])
+    return base, timings
+
+
+def from_search(sc, query, res, search_s: float) -> PlanResult:
+    """A search that proved start and goal separated, as a PlanResult carrying its proof."""
+    base, timings = _described(sc, query, res, search_s)
+    graph = f"{res.stats['slabs']} slabs, {res.stats['refinements']} refinements"
+    return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
+                      message=f"proven unsolvable: no collision-free path exists at any resolution (the "
+                              f"slab graph's POSSIBLE regions separate start and goal; {graph})",
+                      proof=res.proof, **base)
 
 
 def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:

@@ -55,6 +55,8 @@ def _resolve(scenario, planner, time_limit, seed, iterations=None, space=None, t
 
     if planner is not None:
         name = planner_name(planner, "plan()", "planner")
+    elif opts.get("name") is None and sc.rotates:  # a rotating robot or a car: the planner that always answers
+        name = "auto"
     else:
         name = planner_name(opts.get("name"), src, "planner.name")
     # SE(2) builds its angle slabs lazily, inside the planner's time: a longer default.
@@ -80,7 +82,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     """Plan a collision-free path for a scenario (a path or a :class:`Scenario`).
 
     ``planner``, ``time`` and ``seed`` override the scenario's ``[planner]`` table
-    (defaults: RRTConnect, 1 s, seed 0; without OMPL, a call that names no planner plans
+    (defaults: ``auto`` for a rotating robot or a car (:mod:`planners.core.auto`: the proof,
+    the slab graph, sampling, refinement, in one budget), RRTConnect for a translating one,
+    1 s (10 s when the robot rotates), seed 0; without OMPL, a call that names no planner plans
     with ``exact`` and warns, as ``cspace plan`` does). ``iterations`` adds a deterministic budget
     in planner iterations. With ``all_queries`` every ``[[queries]]`` entry is
     planned on the same C-space (and, for PRM-family planners, the same roadmap),
@@ -178,6 +182,11 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         from .exact import exact_plan
 
         results = [exact_plan(sc, cspace, q, time_limit=tlim) for q in queries]
+    elif name == "auto":
+        from .auto import auto_plan
+
+        results = [auto_plan(sc, cspace, adapter, q, pair, tlim, sd, source=src, iterations=iterations,
+                             simplify=simplify) for q, pair in zip(queries, poses)]
     else:
         from .routine import run_planner
 
@@ -192,9 +201,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         # (No inscribed-disk rule after a failure: the proof before sampling is at least as strong,
         # since every POSSIBLE region lies in the disk's free space, and the rule's C-space build,
         # seconds on a large map, would run past --time.)
-        if hasattr(adapter, "curves"):
-            for r in results:
-                r.curves = adapter.curves(r.path) if r.solved else []
+    if hasattr(adapter, "curves") and name != "exact":
+        for r in results:
+            r.curves = adapter.curves(r.path) if r.solved else []
     for r in results:
         r.clearance, r.objective = sc.clearance, objective
         _measure_clearance(r, adapter)

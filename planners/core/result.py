@@ -62,6 +62,9 @@ class PlanResult:
     # A rotating robot's proof that no path exists (cspace.se2.exact's JSON form; written
     # by ``cspace plan --proof FILE``, re-checked by ``cspace check-proof``); None otherwise.
     proof: dict | None = field(default=None, repr=False, compare=False)
+    # ``auto`` (planners.core.auto): the stage that answered ("proof", "slab graph", "sampling",
+    # "refinement"; None where none did or for another planner).
+    answered_by: str | None = None
     # The objects behind the result, for plots and further queries (not serialised).
     scenario_data: Scenario | None = field(default=None, repr=False, compare=False)
     cspace: CSpace | None = field(default=None, repr=False, compare=False)
@@ -105,6 +108,7 @@ class PlanResult:
             "min_clearance_bound": self.min_clearance_bound,
             "touches": self.touches,
             "proven_unsolvable": self.proven_unsolvable,
+            "answered_by": self.answered_by,
         }
         if self.curves is not None:
             d["curves"] = self.curves

@@ -7,16 +7,30 @@ part of its name, and a query proven unsolvable says so rather than "not solved"
 from __future__ import annotations
 
 SEEDLESS = ("exact",)
+SEEDLESS_STAGES = ("slab graph", "proof", "refinement")  # auto's stages that draw no sample
+
+
+def _seeded(res) -> bool:
+    """Does the plan's answer depend on its seed (a sampling planner, or auto's sampling stage)?"""
+    stage = getattr(res, "answered_by", None)
+    return res.planner not in SEEDLESS and stage not in SEEDLESS_STAGES
 
 
 def planner_words(res) -> str:
-    """The planner, with its seed where it has one.
+    """The planner, the stage of ``auto`` that answered, and the seed where it matters.
 
-    >>> class R: planner, seed = "RRTConnect", 3
+    >>> class R: planner, seed, answered_by = "RRTConnect", 3, None
     >>> planner_words(R()), planner_words(type("E", (), {"planner": "exact", "seed": 0})())
     ('RRTConnect (seed 3)', 'exact')
+    >>> R.planner, R.answered_by = "auto", "slab graph"
+    >>> planner_words(R())
+    'auto (slab graph)'
     """
-    return res.planner if res.planner in SEEDLESS else f"{res.planner} (seed {res.seed})"
+    stage = getattr(res, "answered_by", None)
+    inner = [stage] if stage else []
+    if _seeded(res):
+        inner.append(f"seed {res.seed}")
+    return f"{res.planner} ({', '.join(inner)})" if inner else res.planner
 
 
 def outcome_words(res) -> str:
@@ -43,5 +57,6 @@ def plan_title(scene: str, res) -> str:
     >>> plan_title("basic", R())
     'basic: RRTConnect, seed 0, length 17.42'
     """
-    by = res.planner if res.planner in SEEDLESS else f"{res.planner}, seed {res.seed}"
+    stage = getattr(res, "answered_by", None)
+    by = ", ".join([res.planner] + ([stage] if stage else []) + ([f"seed {res.seed}"] if _seeded(res) else []))
     return f"{scene}: {by}, {outcome_words(res)}"

@@ -229,7 +229,7 @@ def test_a_car_plan_counts_its_curves_as_motions():
 
     cs = build_cspace(sc)
     before = cs.report()["checks"].get("curves", 0)
-    res = planners.plan(sc, seed=2, time=10.0, cspace=cs)
+    res = planners.plan(sc, planner="RRTConnect", seed=2, time=10.0, cspace=cs)
     assert res.solved
     asked = cs.report()["checks"]["curves"] - before
     assert res.checks["motions"] == asked >= len(res.path) - 1

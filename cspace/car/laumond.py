@@ -1,0 +1,81 @@
+"""A collision-free SE(2) path turned into certified Reeds–Shepp curves (Laumond's method).
+
+A Reeds–Shepp car is small-time locally controllable: the shortest Reeds–Shepp curve between
+two poses q and q' stays within a neighbourhood of q that shrinks to q as q' -> q (its length
+goes to 0 with the poses' distance). So along a collision-free SE(2) path (any robot motion,
+sideways and in place included), which keeps a positive distance from the obstacles,
+short enough pieces have Reeds–Shepp curves that are free too (Laumond, Jacobs, Taïx and Murray,
+"A motion planner for nonholonomic mobile robots", IEEE T-RA 1994).
+
+:func:`to_reeds_shepp` does exactly that: it tries the curve from one pose of the SE(2) path to
+the next; where the car motion check (certified: :meth:`cspace.car.motion.CarCSpace.car_motion_free`)
+refuses it, the SE(2) motion is cut in half at its middle pose (a free pose: it lies on the free
+path) and both halves are tried, down to a depth and a number of checks that bound the work.
+Every curve of the result is certified; the conversion fails (None) rather than return one that
+is not. It does not prove anything when it fails: the SE(2) path may pass too close to an
+obstacle for the curves to follow it within the budget (a path with more clearance converts
+with fewer pieces).
+
+A Dubins car (forward only) is not locally controllable: the method does not apply to it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..se2.motion import interpolate
+
+MAX_DEPTH = 24        # halvings of one SE(2) motion (2^-24 of it: far below any useful piece)
+MAX_CHECKS = 100_000  # curve checks for a whole path, at most (about 6 us each on the compiled path)
+
+
+def to_reeds_shepp(cspace, path, radius: float, *, max_depth: int = MAX_DEPTH, max_checks: int = MAX_CHECKS,
+                   deadline=None) -> np.ndarray | None:
+    """Poses along the SE(2) ``path`` (an (N, 3) array whose every motion, OMPL's SE(2)
+    interpolation, is collision-free) such that the shortest Reeds–Shepp curve of turning
+    ``radius`` between consecutive poses is certified free on ``cspace`` (a
+    :class:`cspace.car.motion.CarCSpace`); None when a motion needs more than ``max_depth``
+    halvings, the checks exceed ``max_checks`` or ``deadline()`` returns True.
+
+    >>> from cspace.car.motion import CarCSpace
+    >>> box = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
+    >>> walls = [np.array([[0., 0], [4.6, 0], [4.6, 10], [0, 10]]), np.array([[5.4, 0], [10, 0], [10, 10], [5.4, 10]])]
+    >>> cs = CarCSpace((0, 10, 0, 10), walls, [box], slabs=16)  # a corridor 0.2 longer than the car
+    >>> sideways = np.array([[5.0, 3.0, 0.0], [5.0, 5.0, 0.0]])  # 2 sideways: no one curve fits
+    >>> cs.car_motion_free((5.0, 3.0, 0.0), (5.0, 5.0, 0.0), "reeds-shepp", 0.5)
+    False
+    >>> out = to_reeds_shepp(cs, sideways, 0.5)
+    >>> len(out), out[0].tolist(), out[-1].tolist()
+    (129, [5.0, 3.0, 0.0], [5.0, 5.0, 0.0])
+    >>> all(cs.car_motion_free(tuple(a), tuple(b), "reeds-shepp", 0.5) for a, b in zip(out[:-1], out[1:]))
+    True
+    """
+    rows = [tuple(map(float, p)) for p in np.asarray(path, dtype=np.float64).reshape(-1, 3)]
+    if not rows:
+        return None
+    out = [rows[0]]
+    budget = [int(max_checks)]
+    for a, b in zip(rows[:-1], rows[1:]):
+        if not _convert(cspace, a, b, float(radius), int(max_depth), budget, deadline, out):
+            return None
+    return np.array(out, dtype=np.float64)
+
+
+def _convert(cspace, a, b, radius: float, depth: int, budget: list, deadline, out: list) -> bool:
+    """Append to ``out`` the poses after ``a`` up to ``b`` whose curves are certified: the curve
+    a -> b itself, else the two halves of the SE(2) motion a -> b, depth first (an explicit stack:
+    the order of the poses is the path's)."""
+    stack = [(a, b, depth)]
+    while stack:
+        p, q, d = stack.pop()
+        if budget[0] <= 0 or (deadline is not None and deadline()):
+            return False
+        budget[0] -= 1
+        if cspace.car_motion_free(p, q, "reeds-shepp", radius):
+            out.append(q)
+            continue
+        if d == 0:
+            return False
+        m = interpolate(p, q, 0.5)  # on the free SE(2) motion: a free pose
+        stack.append((m, q, d - 1))  # popped after the first half is done
+        stack.append((p, m, d - 1))
+    return True

@@ -1,0 +1,181 @@
+"""``auto`` (planners/core/auto.py), the default for rotating robots and cars: it answers every
+bundled scene, its paths pass the independent sweep (scripts/sweep_oracle.py, shapely: not the
+C-space that certified them), its "proven unsolvable" carries a proof the independent checker
+accepts, it answers wherever RRTConnect or exact does, and it says which stage answered.
+"""
+from __future__ import annotations
+
+import glob
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+import planners
+from conftest import SCENARIOS, load_script
+from cspace.car.curves import reeds_shepp_segments
+from cspace.io.load import load_scenario, scenario_from_dict
+from planners.cli import main
+from planners.core.auto import STAGES
+from planners.core.proof_check import check_proof
+
+ROTATING = sorted(glob.glob(os.path.join(SCENARIOS, "se2", "*.toml"))) + \
+    sorted(glob.glob(os.path.join(SCENARIOS, "car", "*.toml")))
+oracle = load_script("sweep_oracle")
+
+
+def judged_free(sc, path) -> bool:
+    """The independent sweep: SE(2) motions as OMPL interpolates them, a car's along its curves."""
+    if sc.turning_radius is not None:
+        f = (lambda a, b: reeds_shepp_segments(a, b, sc.turning_radius)) if sc.space == "reeds-shepp" else None
+        if f is None:
+            from cspace.car.curves import dubins_segments
+
+            f = lambda a, b: dubins_segments(a, b, sc.turning_radius)  # noqa: E731
+        j = oracle.car_sweep_check(sc, path, f, sc.turning_radius)
+    else:
+        j = oracle.sweep_check(sc, path)
+    return not j["collides"] and not j["out_of_bounds"]
+
+
+def assert_sound(sc, res, query_index: int = 0):
+    """A path the sweep accepts from the exact start to the exact goal, or a proof the checker accepts."""
+    assert res.planner == "auto" and res.answered_by in STAGES, (res.planner, res.answered_by, res.message)
+    if res.solved:
+        assert tuple(res.path[0]) == tuple(res.start) and tuple(res.path[-1]) == tuple(res.goal)
+        assert judged_free(sc, res.path), res.message
+    else:
+        assert res.proven_unsolvable and res.proof is not None, res.message
+        verdict = check_proof(sc, res.proof, query_index)
+        assert verdict.valid, verdict
+
+
+@pytest.mark.parametrize("path", ROTATING, ids=lambda p: "/".join(p.split(os.sep)[-2:]))
+def test_the_default_answers_every_bundled_rotating_scene(path):
+    sc = load_scenario(path)
+    res = planners.plan(path)  # no planner named: auto
+    assert res.solved or res.proven_unsolvable, res.message
+    assert res.solved == (sc.expect != "unsolvable")
+    assert_sound(sc, res)
+    stages = res.timings
+    assert set(res.stages) >= {res.answered_by} and all(stages[s] >= 0 for s in STAGES if s in stages)
+    assert stages["solve"] >= max(stages.get(s, 0.0) for s in STAGES)
+
+
+def test_a_translating_robot_keeps_rrtconnect_and_auto_answers_it_too():
+    basic = os.path.join(SCENARIOS, "basic.toml")
+    assert planners.plan(basic).planner == "RRTConnect"
+    res = planners.plan(basic, planner="auto", seed=3)
+    assert res.solved and res.answered_by in ("sampling", "refinement")
+    closed = planners.plan(os.path.join(SCENARIOS, "narrow_closed.toml"), planner="auto")
+    assert closed.proven_unsolvable and closed.answered_by == "proof" and not closed.solved
+
+
+def test_same_scene_same_seed_same_path():
+    for name in ("se2/bug_trap.toml", "car/parking.toml", "se2/door_tight.toml"):
+        a, b = (planners.plan(os.path.join(SCENARIOS, *name.split("/")), seed=5) for _ in range(2))
+        assert a.answered_by == b.answered_by and np.array_equal(a.path, b.path), name
+
+
+def _door(gap: float, length: float, offset: float, theta: float) -> dict:
+    """A wall across a 10 x 10 box with a door of width ``gap`` at height 5 + offset; a bar
+    ``length`` x 0.3 crossing from left to right, starting at angle ``theta``."""
+    lo, hi = 5 + offset - gap / 2, 5 + offset + gap / 2
+    return {"name": "door", "space": "se2", "bounds": {"xmin": 0, "xmax": 10, "ymin": 0, "ymax": 10},
+            "robot": {"polygon": [[-length / 2, -0.15], [length / 2, -0.15], [length / 2, 0.15],
+                                  [-length / 2, 0.15]]},
+            "start": {"x": 2.0, "y": 5.0, "theta": theta}, "goal": {"x": 8.0, "y": 5.0, "theta": 0.0},
+            "obstacles": [{"polygon": [[4.8, 0], [5.2, 0], [5.2, lo], [4.8, lo]]},
+                          {"polygon": [[4.8, hi], [5.2, hi], [5.2, 10], [4.8, 10]]}]}
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=list(HealthCheck))
+@given(gap=st.floats(0.2, 0.6), length=st.floats(0.5, 2.5), offset=st.floats(-2, 2),
+       theta=st.floats(-math.pi, math.pi - 1e-6))
+def test_auto_answers_wherever_rrtconnect_or_exact_does(gap, length, offset, theta):
+    sc = scenario_from_dict(_door(gap, length, offset, theta))
+    auto = planners.plan(sc, planner="auto", time=60.0)
+    assert_sound(sc, auto)
+    if auto.solved or auto.proven_unsolvable:
+        return
+    exact = planners.plan(sc, planner="exact", time=60.0)
+    rrt = planners.plan(sc, planner="RRTConnect", time=60.0, iterations=20_000)
+    assert not (exact.solved or exact.proven_unsolvable or rrt.solved), (auto.message, exact.message)
+
+
+def test_the_cli_says_which_stage_answered_and_writes_its_proof(tmp_path, capsys):
+    door, trap = os.path.join(SCENARIOS, "se2", "bar_door.toml"), os.path.join(SCENARIOS, "se2", "bug_trap_l.toml")
+    js = tmp_path / "r.json"
+    assert main(["plan", door, "--json", str(js)]) == 0
+    out = capsys.readouterr().out
+    d = json.loads(js.read_text())
+    assert d["planner"] == "auto" and d["answered_by"] == "slab graph" and "slab graph" in d["timings"]
+    assert "solved by auto (slab graph)" in out and "seed" not in out.splitlines()[0]
+    proof = tmp_path / "p.json"
+    assert main(["plan", trap, "--proof", str(proof), "--json", str(js)]) == 1
+    assert json.loads(js.read_text())["proven_unsolvable"] is True
+    capsys.readouterr()
+    assert main(["check-proof", trap, str(proof)]) == 0
+    assert capsys.readouterr().out.startswith("proof valid")
+
+
+def test_a_sampled_answer_names_its_seed():
+    res = planners.plan(os.path.join(SCENARIOS, "se2", "bug_trap.toml"), seed=7)
+    from planners.pictures.titles import plan_title, planner_words
+
+    if res.answered_by == "sampling":
+        assert planner_words(res) == "auto (sampling, seed 7)" and "seed 7" in plan_title("s", res)
+    else:
+        assert "seed" not in planner_words(res)
+
+
+def _corridor(slack: float) -> dict:
+    """A car 0.6 x 0.4 in a corridor ``slack`` longer than the car, to be moved 2 sideways."""
+    lo, hi = 5.0 - 0.3 - slack / 2, 5.0 + 0.3 + slack / 2
+    return {"name": "corridor", "space": "reeds-shepp", "turning_radius": 0.5,
+            "bounds": {"xmin": 0, "xmax": 10, "ymin": 0, "ymax": 10},
+            "robot": {"polygon": [[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]]},
+            "start": {"x": 5.0, "y": 3.0, "theta": 0.0}, "goal": {"x": 5.0, "y": 5.0, "theta": 0.0},
+            "obstacles": [{"polygon": [[0, 0], [lo, 0], [lo, 10], [0, 10]]},
+                          {"polygon": [[hi, 0], [10, 0], [10, 10], [hi, 10]]}]}
+
+
+@pytest.mark.parametrize("slack,parts", [(0.2, 1), (0.4, 3), (0.3, 2)])
+def test_laumond_curves_follow_a_sideways_path_and_pass_the_sweep(slack, parts):
+    """A car can't drive sideways, but it can follow a sideways SE(2) path closely enough with
+    many short Reeds–Shepp curves: every curve passes the independent sweep."""
+    from cspace.car.laumond import to_reeds_shepp
+    from planners.core.plan import build_cspace
+
+    sc = scenario_from_dict(_corridor(slack))
+    cs = build_cspace(sc)
+    se2 = np.array([[5.0, 3.0 + 2.0 * k / parts, 0.0] for k in range(parts + 1)])
+    out = to_reeds_shepp(cs, se2, 0.5)
+    assert out is not None
+    assert tuple(out[0]) == (5.0, 3.0, 0.0) and tuple(out[-1]) == (5.0, 5.0, 0.0)
+    assert judged_free(sc, out)
+    # the judge is not blind: one curve for the whole move swings into a wall
+    assert not judged_free(sc, se2[[0, -1]])
+
+
+def test_laumond_converts_where_the_room_is_a_hundredth_of_the_car():
+    from cspace.car.laumond import to_reeds_shepp
+    from planners.core.plan import build_cspace
+
+    cs = build_cspace(scenario_from_dict(_corridor(0.02)))
+    out = to_reeds_shepp(cs, np.array([[5.0, 3.0, 0.0], [5.0, 5.0, 0.0]]), 0.5)
+    assert out is not None and len(out) > 1000
+    assert all(cs.car_motion_free(tuple(a), tuple(b), "reeds-shepp", 0.5) for a, b in zip(out[:-1], out[1:]))
+
+
+def test_laumond_gives_up_within_its_budget_rather_than_return_a_colliding_curve():
+    from cspace.car.laumond import to_reeds_shepp
+    from planners.core.plan import build_cspace
+
+    cs = build_cspace(scenario_from_dict(_corridor(0.05)))
+    through = np.array([[5.0, 3.0, 0.0], [5.0, 5.0, 0.0]])
+    assert to_reeds_shepp(cs, through, 0.5, max_checks=10) is None
+    assert to_reeds_shepp(cs, through, 0.5, max_depth=2) is None
