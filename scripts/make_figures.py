@@ -330,6 +330,14 @@ def figures() -> list[Figure]:
     out.append(Figure("car_u_turn", "car", "car: a three-point turn in a narrow street", se2_plan_figure("u_turn", folder="car")))
     out.append(Figure("car_loading_dock", "car", "car: backing into a loading bay", se2_plan_figure("loading_dock", folder="car")))
     out.append(Figure("car_maze", "car", "car: Dubins through a maze", se2_plan_figure("maze", folder="car")))
+    out.append(Figure("car_parallel_tight", "car", "car: parallel parking with 10 % slack (auto: Laumond's curves)",
+                      se2_plan_figure("parallel_tight", folder="car")))
+    out.append(Figure("car_dead_end_alley", "car", "car: turning round at the end of a dead-end alley",
+                      se2_plan_figure("dead_end_alley", folder="car")))
+    out.append(Figure("car_garage_reverse", "car", "car: a garage entered in reverse",
+                      se2_plan_figure("garage_reverse", folder="car")))
+    out.append(Figure("car_u_turn_cusps", "car", "car: a U-turn with two cusps",
+                      se2_plan_figure("u_turn_cusps", folder="car")))
     out.append(Figure("map_office", "maps", "a ROS occupancy map imported and planned", map_figure()))
     out.append(Figure("circles_queries", "circles", "OMPL circles: 100 queries, 1 s each", circles_figure()))
     out.append(Figure("bench_bug_trap", "bench", "cspace bench: bug_trap, RRTConnect vs RRTstar", bench_figure()))

@@ -79,3 +79,41 @@ def _convert(cspace, a, b, radius: float, depth: int, budget: list, deadline, ou
         stack.append((m, q, d - 1))  # popped after the first half is done
         stack.append((p, m, d - 1))
     return True
+
+
+def shortcut(cspace, poses, radius: float, *, deadline=None) -> np.ndarray:
+    """Fewer poses along a path of certified Reeds–Shepp curves: from each kept pose, the farthest
+    later pose that one certified curve reaches (tried at strides 1, 2, 4, ... then bisected back;
+    stride 1 is the curve the path already has), so a path of many short curves from
+    :func:`to_reeds_shepp` becomes one of a few long ones before a costlier shortening. Every
+    curve of the result is certified; ``deadline()`` True keeps the rest as it is.
+
+    >>> from cspace.car.motion import CarCSpace
+    >>> cs = CarCSpace((0, 10, 0, 10), [np.array([[4., 0], [6, 0], [6, 4], [4, 4]])],
+    ...                [np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])], slabs=16)
+    >>> shortcut(cs, np.array([[1.0, 6.0, 0.0], [2.0, 6.0, 0.0], [3.0, 6.0, 0.0], [8.0, 6.0, 0.0]]), 0.5).tolist()
+    [[1.0, 6.0, 0.0], [8.0, 6.0, 0.0]]
+    """
+    rows = [tuple(map(float, p)) for p in np.asarray(poses, dtype=np.float64).reshape(-1, 3)]
+    n = len(rows)
+    if n < 3:
+        return np.array(rows, dtype=np.float64).reshape(-1, 3)
+
+    def free(i: int, j: int) -> bool:
+        return j == i + 1 or cspace.car_motion_free(rows[i], rows[j], "reeds-shepp", radius)
+
+    out, i = [rows[0]], 0
+    while i < n - 1:
+        if deadline is not None and deadline():
+            out.extend(rows[i + 1:])
+            break
+        good, stride = i + 1, 2
+        while i + stride < n and free(i, i + stride):  # gallop while one curve reaches
+            good, stride = i + stride, 2 * stride
+        bad = min(i + stride, n)  # the first stride refused (or past the end)
+        while bad - good > 1:  # the farthest reachable pose between them
+            mid = (good + bad) // 2
+            good, bad = (mid, bad) if free(i, mid) else (good, mid)
+        out.append(rows[good])
+        i = good
+    return np.array(out, dtype=np.float64)

@@ -38,7 +38,8 @@ SAMPLE_MIN = 0.05   # seconds: sampling's turn before the refinement, at least
 TRANSLATION_SAMPLE_SHARE = 0.5
 # A Reeds–Shepp car's SE(2) path is asked to keep this much room (x the robot's reach from its
 # reference point), the largest its start and goal allow first.
-ROOMS = (0.05, 0.01, 0.002)  # a translating robot: sampling, then the exact shortest path
+ROOMS = (0.05, 0.01, 0.002)
+BOUNDED_PAST = 32  # poses: a car's path longer than this gets the bounded shortening only  # a translating robot: sampling, then the exact shortest path
 STAGES = ("slab graph", "proof", "sampling", "refinement")
 
 
@@ -162,16 +163,18 @@ def _slab_graph(sc, cspace, adapter, query, source, budget: float, simplify: boo
 def _reeds_shepp(sc, cspace, adapter, query, se2_path, budget: float, simplify: bool, search_s: float):
     """A certified SE(2) path driven as certified Reeds–Shepp curves (Laumond's method), shortened
     under the car's validator; None if the conversion fails within ``budget``."""
-    from cspace.car.laumond import to_reeds_shepp
+    from cspace.car.laumond import shortcut, to_reeds_shepp
 
     from .exact_se2 import shorten
 
     t = _now()
     end = t + max(budget, 0.0)
     poses = to_reeds_shepp(cspace, se2_path, adapter.radius, deadline=lambda: _now() > end)
-    convert_s = _now() - t
     if poses is None:
         return None
+    curves = len(poses) - 1
+    poses = shortcut(cspace, poses, adapter.radius, deadline=lambda: _now() > end)
+    convert_s = _now() - t
     ok, why = adapter.verify(poses, query.start, query.goal)
     if not ok:  # every curve was certified: a failure here is a fault, reported, never hidden
         return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,
@@ -181,15 +184,16 @@ def _reeds_shepp(sc, cspace, adapter, query, se2_path, budget: float, simplify: 
     raw_len = adapter.length(poses)
     path, note = poses, "not shortened"
     t2 = _now()
-    if simplify:
-        path, note = shorten(adapter, poses, query)
+    if simplify:  # bounded: a long wriggle of short curves costs OMPL's full simplifier seconds
+        path, note = shorten(adapter, poses, query, bounded=len(poses) > BOUNDED_PAST)
     return PlanResult(scenario=sc.name, solved=True, exact=True, path=path, length=adapter.length(path),
                       planner="auto", seed=0, start=tuple(query.start), goal=tuple(query.goal),
                       timings={"solve": search_s + convert_s, "simplify": _now() - t2},
-                      checks={"se2_waypoints": len(se2_path), "curves": len(poses) - 1},
+                      checks={"se2_waypoints": len(se2_path), "curves": curves},
                       stages=["slab graph", "Reeds-Shepp curves"] + (["simplify"] if simplify else []),
                       message=f"certified Reeds-Shepp path from the slab graph's SE(2) path ({len(se2_path)} "
-                              f"poses, driven as {len(poses) - 1} curves; length {raw_len:.6g}, {note})",
+                              f"poses, driven as {curves} curves, {len(poses) - 1} after shortcuts; length {raw_len:.6g}, "
+                              f"{note})",
                       length_unsimplified=raw_len, first_path_cpu=found_cpu)
 
 

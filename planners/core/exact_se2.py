@@ -28,6 +28,7 @@ from .result import PlanResult
 
 QUICK_SHARE = 0.1   # of the time limit, at most, for the proof before sampling
 QUICK_MAX = 1.0     # seconds, at most, whatever the limit
+SHORTCUT_TRIES = 100  # the vertex reduction of a bounded shortening tries at least this many shortcuts
 CAR_SLABS = 128     # the finest partition a car's proof-only search tries
 # The proof before sampling refines the first 8 slabs once, where the POSSIBLE graph still joins
 # start and goal (16 slabs at most): ~2-3x the 8 slabs' cost (~20 ms on the bundled scenes, the
@@ -179,10 +180,12 @@ def from_search(sc, query, res, search_s: float) -> PlanResult:
                       proof=res.proof, **base)
 
 
-def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:
+def shorten(adapter, path: np.ndarray, query, bounded: bool = False) -> tuple[np.ndarray, str]:
     """``path`` shortened by OMPL's simplifier under the adapter's certified motion validator,
     and verified again; the original path where OMPL is missing or the result is not better.
-    Deterministic: OMPL's random stream is seeded with 0 (:func:`make_setup`)."""
+    Deterministic: OMPL's random stream is seeded with 0 (:func:`make_setup`). ``bounded``: only
+    OMPL's vertex reduction, a number of tries bounded by the path's size (the whole simplifier's
+    rounds are not bounded: seconds on a car's path of hundreds of short curves)."""
     from ..adapters.glue import make_setup, ompl, ompl_available
 
     if not ompl_available() or len(path) < 3:
@@ -196,7 +199,10 @@ def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:
         s = si.allocState()
         adapter.set_state(s, pose)
         p.append(s)
-    og.PathSimplifier(si).simplifyMax(p)
+    if not bounded:
+        og.PathSimplifier(si).simplifyMax(p)
+    else:  # shortcuts between random vertices, a bounded number of tries (OMPL's rounds are not)
+        og.PathSimplifier(si).reduceVertices(p, max(SHORTCUT_TRIES, 4 * len(path)))
     out = adapter.path_array(p)
     out[0], out[-1] = path[0], path[-1]  # the exact ends (the states' round trip may round x, y)
     ok, _ = adapter.verify(out, query.start, query.goal)
