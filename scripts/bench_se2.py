@@ -304,7 +304,8 @@ def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RR
               ("bar_door.toml", "bug_trap.toml", "car_maze.toml", "piano_corridor.toml", "tee_slot.toml")]
     scenes += [generated("random", 40, CAR, 1.5), generated("maze", 8, CAR, 2.0), generated("maze", 14, CAR, 2.0)]
     scenes += [load_scenario(os.path.join(ROOT, "scenarios", "car", f)) for f in
-               ("maze.toml", "parking.toml", "loading_dock.toml", "u_turn.toml")]
+               ("maze.toml", "parking.toml", "loading_dock.toml", "u_turn.toml", "parallel_tight.toml",
+                "dead_end_alley.toml", "garage_reverse.toml", "u_turn_cusps.toml")]
     if only:
         scenes = [sc for sc in scenes if any(w in sc.name for w in only)]
     rows = []
@@ -325,9 +326,9 @@ def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RR
 
         def one_round(seed):
             runs = {"ours": se2_peers.ours_first(sc, cs, adapter, q, seed, budget, planner)}
-            for name, chk in checkers.items():
+            for name, chk in checkers.items():  # auto's peer: OMPL's RRTConnect
                 runs[name] = se2_peers.peer_first(adapter, chk, adapter.pose(q.start), adapter.pose(q.goal), seed,
-                                                  budget, planner, resolution)
+                                                  budget, "RRTConnect" if planner == "auto" else planner, resolution)
             return runs
 
         for seed in range(seeds):  # interleaved: every method once per round
@@ -365,7 +366,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="fewer states, motions and seeds")
     ap.add_argument("--parts", default="VMT", help="V validity, M motions, T plans, P side by side with peers")
     ap.add_argument("--peers", default="shapely,coal", help="part P's peers (coal needs the bench extra)")
-    ap.add_argument("--planners", default="RRTConnect,RRTstar", help="part P's planners")
+    ap.add_argument("--planners", default="RRTConnect,RRTstar", help="part P's planners (auto: ours is the "
+                                                                     "auto planner, the peers RRTConnect)")
     ap.add_argument("--scenes", default="", help="part P: only the scenes whose name contains one of these "
                                                  "comma-separated words (e.g. parking,loading_dock,u_turn)")
     ap.add_argument("--repeats", type=int, default=3, help="part P: runs per method of a seed whose runs all take "

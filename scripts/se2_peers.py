@@ -8,7 +8,8 @@ robot's prisms by a rotation about z. ``peer_first(adapter, checker, start, goal
 plans with OMPL on the adapter's own state space (the same bounds and weights as ours), the
 checker and OMPL's default motion validator; ``ours_first(sc, cs, adapter, query, seed, limit)``
 is cspace's time to its first certified path: the proof before sampling (planners.core.exact_se2)
-and the one planning routine stopped at its first solution, unsimplified, as the peer is.
+and the one planning routine stopped at its first solution, unsimplified, as the peer is (with
+``planner="auto"``: auto's stages, unsimplified; its peer is then RRTConnect).
 Both return ``(path or None, CPU seconds)``.
 """
 from __future__ import annotations
@@ -136,6 +137,13 @@ def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str = "
     from planners.core.routine import run_planner
 
     c0 = time.process_time()
+    if planner == "auto":  # its stages, unshortened as the peer's path is; a path or a proof ends it
+        from planners.core.auto import auto_plan
+
+        pose = adapter.pose
+        res = auto_plan(sc, cs, adapter, query, (pose(query.start), pose(query.goal)), limit, seed,
+                        source=sc.name, simplify=False)
+        return (res.path if res.solved else None), time.process_time() - c0
     if quick_proof(sc, cs, query, limit) is not None:
         return None, time.process_time() - c0
     pose = adapter.pose

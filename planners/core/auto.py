@@ -97,8 +97,8 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     sampled = None
     if clock.left() > 0:
         # Where a refinement follows, sampling gets a short turn: long enough for an open scene
-        # (a few times what the proof and the first slabs took), short of the refinement's time.
-        budget = clock.left() if share == 1.0 else min(share * clock.left(), max(SAMPLE_MIN, 2 * clock.elapsed()))
+        # (as long as the first slabs and the proof took), short of the refinement's time.
+        budget = clock.left() if share == 1.0 else min(share * clock.left(), max(SAMPLE_MIN, clock.elapsed()))
         sampled = clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, seed,
                                                               iterations=iterations, simplify=simplify,
                                                               scenario=sc.name)[0])
