@@ -165,13 +165,14 @@ def test_car_clearance_is_a_tight_lower_bound_of_the_curves(path):
     res = plan(path, seed=0)
     assert res.solved
     sc = res.scenario_data
-    assert res.min_clearance_bound == "lower" and res.min_clearance > 0
+    assert res.min_clearance_bound == "lower"
     step = 2e-3
     oracle = _dense_oracle(res, step)
     r = sc.turning_radius
     rho = robot_radius([p.polygon for p in sc.robot])
     lip = 1.0 + rho / r  # the most a robot point moves per unit driven
     slack = TOL * max(r, rho) + step * lip  # the bound's aim, and the oracle's own sampling error
+    assert res.min_clearance > 0 or oracle <= slack  # 0 only where the curves come within the bound's aim
     assert res.min_clearance <= oracle + 1e-9
     assert res.min_clearance >= oracle - slack - 1e-9
     # where it says: the robot there is that far (or a little farther) from the obstacles
