@@ -14,7 +14,7 @@
 
 Side by side with OMPL + coal: ``python scripts/bench_se2.py --parts P --planners auto``.
 
-Usage: python scripts/bench_auto.py [--parts SC] [--seeds N] [--limit S] [--json FILE]
+Usage: python scripts/bench_auto.py [--parts SC] [--seeds N | --quick] [--limit S] [--json FILE]
 
 >>> ratio(0.3, 0.15, 0.5)
 2.0
@@ -104,9 +104,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--parts", default="SC", help="S the SE(2) scenes, C the Reeds-Shepp car scenes")
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--quick", action="store_true", help="3 seeds (the benchmarks page's run)")
     ap.add_argument("--limit", type=float, default=10.0, help="seconds per plan")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args(argv)
+    if a.quick:
+        a.seeds = 3
     out = {}
     if "S" in a.parts:
         files = sorted(glob.glob(os.path.join(ROOT, "scenarios", "se2", "*.toml")))
