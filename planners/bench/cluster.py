@@ -111,16 +111,103 @@ def run_batch(batch: list[dict], sha: str) -> list[dict]:
     return rows
 
 
+CONNECT_TIMEOUT = 10.0  # seconds for the connection and the scheduler's first words
+
+
+DEFAULT_PORT = 8786  # a Dask scheduler's (its dashboard is 8787, and speaks HTTP)
+
+
+MAX_HANDSHAKE = 1 << 20  # bytes a scheduler's handshake may announce (a few hundred in practice)
+
+
+def scheduler_address(address: str) -> tuple[str, int]:
+    """``(host, port)`` of a ``--scheduler`` address: ``tcp://HOST:PORT``, ``HOST:PORT`` or ``HOST``
+    (port 8786). Every other form is one exit-2 line: an empty address, another protocol
+    (``tls://`` needs certificates, ``ucx://`` a UCX build, ``inproc://`` this process), a path.
+
+    >>> scheduler_address("tcp://10.0.0.5:8786"), scheduler_address("[::1]:9000"), scheduler_address("node7")
+    (('10.0.0.5', 8786), ('::1', 9000), ('node7', 8786))
+    """
+    from urllib.parse import urlsplit
+
+    from cspace.io.scenario.messages import printable
+
+    text = str(address).strip()
+    if not text:
+        raise InputError("bench", "--scheduler", "an empty address names no scheduler (tcp://HOST:8786)")
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme.lower() != "tcp":
+        raise InputError("bench", "--scheduler", f"{printable(scheme)}:// is not supported: give the scheduler's "
+                                                 "tcp://HOST:PORT address")
+    try:
+        parts = urlsplit("tcp://" + rest)
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise InputError("bench", "--scheduler", f"not an address {printable(text)!r}: {exc}") from None
+    if not host or parts.path not in ("", "/") or parts.query or parts.fragment or parts.username:
+        raise InputError("bench", "--scheduler", f"not an address {printable(text)!r} (expected tcp://HOST:PORT)")
+    return host, DEFAULT_PORT if port is None else port
+
+
+def probe(host: str, port: int, timeout: float | None = None) -> None:
+    """Connect to ``host:port`` and read the first words a Dask scheduler sends (it speaks first:
+    the 8-byte length of its handshake), all within ``timeout`` seconds; one exit-2 line if the
+    peer is unreachable, silent (an HTTP port such as Dask's own dashboard), closes, or says
+    something else (an SSH server's banner would read as a length of exabytes)."""
+    import socket
+    import struct
+    import time
+
+    from cspace.io.scenario.messages import printable
+
+    timeout = CONNECT_TIMEOUT if timeout is None else timeout
+    where = f"{host}:{port}"
+    deadline = time.monotonic() + timeout
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except socket.timeout:
+        raise InputError("bench", "--scheduler", f"no connection to {where} within {timeout:g} s") from None
+    except (OSError, ValueError, OverflowError) as exc:
+        raise InputError("bench", "--scheduler", f"cannot connect to {where}: "
+                                                 f"{getattr(exc, 'strerror', None) or exc}") from None
+    got = b""
+    with sock:
+        try:
+            while len(got) < 8:
+                sock.settimeout(max(deadline - time.monotonic(), 0.001))
+                chunk = sock.recv(8 - len(got))
+                if not chunk:
+                    raise InputError("bench", "--scheduler", f"{where} closed the connection without a word: "
+                                                             "not a Dask scheduler")
+                got += chunk
+        except socket.timeout:
+            raise InputError("bench", "--scheduler", f"{where} said nothing within {timeout:g} s: not a Dask "
+                                                     f"scheduler (a scheduler listens on {DEFAULT_PORT}, its "
+                                                     "dashboard on 8787)") from None
+        except OSError as exc:
+            raise InputError("bench", "--scheduler", f"{where}: {exc.strerror or exc}") from None
+    (size,) = struct.unpack("<Q", got)
+    if not 0 < size <= MAX_HANDSHAKE:
+        raise InputError("bench", "--scheduler", f"{where} is not a Dask scheduler (it said "
+                                                 f"{printable(got.decode('latin-1'))!r})")
+
+
 def connect(scheduler: str):
-    """A Dask client of the scheduler at this address (exit 2 if dask or the scheduler is missing)."""
+    """A Dask client of the scheduler at this address (exit 2 if dask or the scheduler is missing,
+    or the address does not answer as one within :data:`CONNECT_TIMEOUT`)."""
+    host, port = scheduler_address(scheduler)
     try:
         from distributed import Client
     except ImportError:
         raise InputError("bench", "--scheduler", "needs dask[distributed] (pip install 'cspace[cluster]')") from None
+    probe(host, port)
+    address = f"tcp://[{host}]:{port}" if ":" in host else f"tcp://{host}:{port}"
     try:
-        return Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise InputError("bench", "--scheduler", f"cannot connect to {scheduler}: {exc}") from None
+        return Client(address, timeout=f"{CONNECT_TIMEOUT:g}s")
+    except Exception as exc:  # noqa: BLE001 - whatever the handshake raised: the address does not work
+        raise InputError("bench", "--scheduler", f"cannot connect to {address}: {type(exc).__name__}: {exc}") from None
 
 
 def sweep_on_cluster(tasks: list[dict], scheduler, on_batch, seconds: float = BATCH_SECONDS) -> None:
