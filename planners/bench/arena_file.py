@@ -15,7 +15,8 @@
 4. **the schema** (created or upgraded: tables, columns, the run-key index, the status enum)
    and a write probe (a table created and dropped, so SQLite's journal beside the file must be
    writable: a read-only folder is refused now, not at the first stored run), in the same
-   transaction: a refusal anywhere rolls all of it back.
+   transaction: a refusal anywhere rolls all of it back, and so does an up-to-date database's
+   check (its bytes stay as they were until a run is stored).
 
 Every refusal is an :class:`planners.errors.InputError` on ``--db`` (one line, exit 2), and a
 file this call created is removed again.
@@ -140,10 +141,15 @@ def open_campaign_db(path: str, make_schema) -> tuple[sqlite3.Connection, int]:
         try:
             conn.execute("BEGIN IMMEDIATE")
             check_contents(conn, path)
+            before = (conn.execute("PRAGMA schema_version").fetchone()[0], conn.total_changes)
             make_schema(conn)
+            changed = (conn.execute("PRAGMA schema_version").fetchone()[0], conn.total_changes) != before
             conn.execute("CREATE TABLE cspace_write_probe (x)")  # the journal must be writable too
             conn.execute("DROP TABLE cspace_write_probe")
-            conn.commit()
+            if changed:
+                conn.commit()
+            else:  # an up-to-date database: the probe's write is undone, the file keeps every byte
+                conn.rollback()
         except sqlite3.Error as exc:
             with contextlib.suppress(sqlite3.Error):
                 conn.rollback()

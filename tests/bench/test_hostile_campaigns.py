@@ -256,7 +256,7 @@ def test_quoted_identifiers_and_hostile_experiment_names_stay_in_the_log_folder(
     conn.execute('ALTER TABLE runs ADD "a""b;c" TEXT')
     conn.execute("UPDATE runs SET \"a\"\"b;c\" = 'x;y\n|>>>'")
     (eid,) = conn.execute("SELECT id FROM experiments LIMIT 1").fetchone()
-    names = ["../../escaped", str(tmp_path / "abs"), "line\n|>>>\nbreak", "\x1b[31mred"]
+    names = [os.path.join(os.pardir, os.pardir, "escaped"), str(tmp_path / "abs"), "line\n|>>>\nbreak", "\x1b[31mred"]
     for i, name in enumerate(names):
         conn.execute("INSERT INTO experiments (name, totaltime, timelimit, memorylimit, runcount, version, "
                      "hostname, cpuinfo, date, seed, setup, iterations, objective, reference, scenario_sha256, "
@@ -421,3 +421,13 @@ def test_an_internal_error_in_bench_does_not_point_to_an_option_it_lacks(tmp_pat
     assert bench(BASIC, *ARGS, "--out", tmp_path / "o") == 3
     err = one_line(capsys, "internal error: RuntimeError: planted fault")
     assert "--verbose" not in err
+
+
+def test_a_refused_sweep_leaves_an_up_to_date_database_byte_for_byte(tmp_path, capsys, good_db):
+    # the checks and the write probe of a database that needs no upgrade are rolled back: a sweep
+    # refused after them (its runs already stored, no --resume) leaves the file as it was
+    db = copy(good_db, tmp_path / "same.db")
+    before = digest(db)
+    assert bench(BASIC, *ARGS, "--out", tmp_path / "o", "--db", db) == 2
+    one_line(capsys, "already holds 2 of this sweep's 2 runs")
+    assert digest(db) == before
