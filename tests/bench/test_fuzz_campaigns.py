@@ -34,7 +34,8 @@ pytest.importorskip("ompl")
 BASIC = os.path.join(conftest.ROOT, "scenarios", "basic.toml")
 SWEEP = ["--planners", "RRTConnect", "--times", "0.01", "--runs", "1", "-q", "--no-plot"]
 NAMES = st.one_of(st.text(max_size=30), st.sampled_from([
-    os.path.join(os.pardir, os.pardir, "escaped"), "/tmp/abs", "..", ".", "", "a/b", "x\n|>>>\ny", "\x1b[2J", "con", "a;b", 'q"uote',
+    os.path.join(os.pardir, os.pardir, "escaped"), "/tmp/abs", "..", ".", "", "a/b", "x\n|>>>\ny", "\x1b[2J",
+    "con", "a;b", 'q"uote',
     "<a href='http://127.0.0.1:9/'>l</a>", "\u202eevil", "a" * 300]))
 
 

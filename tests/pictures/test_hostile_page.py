@@ -155,3 +155,16 @@ def test_a_hostile_name_fetches_nothing_and_makes_no_link(browser, tmp_path):
         assert b.eval("document.getElementById('errors').textContent") == "", hash_
         assert b.eval("document.title") == "ok", hash_
         assert b.state()["sliders"]["pose"] == pose, hash_
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (a full disk)")
+@pytest.mark.parametrize("command,option", [("plan", "--html"), ("view", "--out")])
+def test_a_page_on_a_full_disk_names_its_own_option(tmp_path, capsys, command, option):
+    from conftest import SCENARIOS
+    from planners.cli import main
+
+    full = tmp_path / "full.html"
+    full.symlink_to("/dev/full")
+    assert main([command, os.path.join(SCENARIOS, "basic.toml"), "--planner", "exact", option, str(full)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{full}: {option}: cannot write" in err[0], err
