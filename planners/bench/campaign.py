@@ -47,7 +47,7 @@ class Campaign:
         from .arena_file import open_campaign_db
 
         self.path, self.fd = path, None
-        self.failure: str | None = None  # the first database error after the checks (exit 2 at the end)
+        self.failure: InputError | None = None  # the first fault after the checks (exit 2 at the end)
         if path:
             self.conn, self.fd = open_campaign_db(path, adb.make_schema)
         else:
@@ -110,12 +110,17 @@ class Campaign:
         from .rows import complete_row
 
         out = []
-        for t in tasks:
-            e = self.experiment(t, create=False)
-            p = None if e is None else self.known_planner(t["planner"])
-            got = None if p is None else adb.stored_run(self.conn, e, p, t["seed"])
-            if got is not None:
-                out.append(complete_row(t, got, got["wall_s"]))
+        try:
+            for t in tasks:
+                e = self.experiment(t, create=False)
+                p = None if e is None else self.known_planner(t["planner"])
+                got = None if p is None else adb.stored_run(self.conn, e, p, t["seed"])
+                if got is not None:
+                    out.append(complete_row(t, got, got["wall_s"]))
+        except sqlite3.Error as exc:
+            from .arena_file import describe
+
+            raise InputError(self.path, "--db", describe(exc)) from None
         return out
 
     def select(self, tasks: list[dict], resume: bool) -> list[dict]:
@@ -161,13 +166,14 @@ class Campaign:
         from .arena_file import describe
 
         if self.failure is None:
-            self.failure = (f"{describe(exc)} after {self.stored} runs were stored: those are kept, "
-                            f"{len(self.pending)} finished runs are not (every row is in --out)")
+            self.failure = InputError(self.path or "bench", "--db",
+                                      f"{describe(exc)} after {self.stored} runs were stored: those are kept, "
+                                      f"{len(self.pending)} finished runs are not (every row is in --out)")
 
     def check(self) -> None:
         """Exit 2 (one line) if storing failed during the sweep; call once the outputs are written."""
         if self.failure is not None:
-            raise InputError(self.path or "bench", "--db" if self.path else "--log", self.failure)
+            raise self.failure
 
     def on_row(self, row: dict) -> None:
         """The sweep's hook: one finished run, stored at once."""
@@ -183,7 +189,10 @@ class Campaign:
             if log_dir:
                 from .ompl_log import write_logs
 
-                logs = write_logs(self.conn, log_dir, inputs)
+                try:
+                    logs = write_logs(self.conn, log_dir, inputs)
+                except InputError as exc:  # a log that cannot be written: said at the end, --out first
+                    self.failure = self.failure or exc
             self.conn.close()
             if self.path and self.failure is None:
                 try:  # OMPL's own views (best planner per experiment), as its converter makes them

@@ -152,10 +152,11 @@ def scheduler_address(address: str) -> tuple[str, int]:
 
 
 def probe(host: str, port: int, timeout: float | None = None) -> None:
-    """Connect to ``host:port`` and read the first words a Dask scheduler sends (it speaks first:
-    the 8-byte length of its handshake), all within ``timeout`` seconds; one exit-2 line if the
-    peer is unreachable, silent (an HTTP port such as Dask's own dashboard), closes, or says
-    something else (an SSH server's banner would read as a length of exabytes)."""
+    """Connect to ``host:port`` and read the handshake a Dask scheduler sends first (an 8-byte
+    length, then that many bytes of msgpack frames naming its ``compression`` and
+    ``pickle-protocol``), all within ``timeout`` seconds; one exit-2 line if the peer is
+    unreachable, silent (an HTTP port such as Dask's own dashboard), closes, stops half-way, or
+    says something else (an SSH server's banner would read as a length of exabytes)."""
     import socket
     import struct
     import time
@@ -172,26 +173,34 @@ def probe(host: str, port: int, timeout: float | None = None) -> None:
     except (OSError, ValueError, OverflowError) as exc:
         raise InputError("bench", "--scheduler", f"cannot connect to {where}: "
                                                  f"{getattr(exc, 'strerror', None) or exc}") from None
-    got = b""
+    def read(n: int, got: bytes = b"") -> bytes:
+        while len(got) < n:
+            sock.settimeout(max(deadline - time.monotonic(), 0.001))
+            chunk = sock.recv(min(n - len(got), 1 << 16))
+            if not chunk:
+                raise InputError("bench", "--scheduler", f"{where} closed the connection "
+                                                         f"{'half-way' if got else 'without a word'}: not a Dask "
+                                                         "scheduler")
+            got += chunk
+        return got
+
     with sock:
         try:
-            while len(got) < 8:
-                sock.settimeout(max(deadline - time.monotonic(), 0.001))
-                chunk = sock.recv(8 - len(got))
-                if not chunk:
-                    raise InputError("bench", "--scheduler", f"{where} closed the connection without a word: "
-                                                             "not a Dask scheduler")
-                got += chunk
+            head = read(8)
+            (size,) = struct.unpack("<Q", head)
+            if not 0 < size <= MAX_HANDSHAKE:
+                raise InputError("bench", "--scheduler", f"{where} is not a Dask scheduler (it said "
+                                                         f"{printable(head.decode('latin-1'))!r})")
+            body = read(size)
         except socket.timeout:
-            raise InputError("bench", "--scheduler", f"{where} said nothing within {timeout:g} s: not a Dask "
-                                                     f"scheduler (a scheduler listens on {DEFAULT_PORT}, its "
+            raise InputError("bench", "--scheduler", f"{where} did not answer as a Dask scheduler within "
+                                                     f"{timeout:g} s (a scheduler listens on {DEFAULT_PORT}, its "
                                                      "dashboard on 8787)") from None
         except OSError as exc:
             raise InputError("bench", "--scheduler", f"{where}: {exc.strerror or exc}") from None
-    (size,) = struct.unpack("<Q", got)
-    if not 0 < size <= MAX_HANDSHAKE:
-        raise InputError("bench", "--scheduler", f"{where} is not a Dask scheduler (it said "
-                                                 f"{printable(got.decode('latin-1'))!r})")
+    if b"pickle-protocol" not in body and b"compression" not in body:
+        raise InputError("bench", "--scheduler", f"{where} is not a Dask scheduler (its first message is not "
+                                                 "a handshake)")
 
 
 def connect(scheduler: str):
@@ -204,10 +213,28 @@ def connect(scheduler: str):
         raise InputError("bench", "--scheduler", "needs dask[distributed] (pip install 'cspace[cluster]')") from None
     probe(host, port)
     address = f"tcp://[{host}]:{port}" if ":" in host else f"tcp://{host}:{port}"
-    try:
-        return Client(address, timeout=f"{CONNECT_TIMEOUT:g}s")
-    except Exception as exc:  # noqa: BLE001 - whatever the handshake raised: the address does not work
-        raise InputError("bench", "--scheduler", f"cannot connect to {address}: {type(exc).__name__}: {exc}") from None
+    # Dask's own connection, under a deadline too: a peer that passed the probe and then stalls
+    # costs the timeout, not the run (the thread is left behind; the command ends anyway).
+    import threading
+
+    got: list = []
+
+    def make():
+        try:
+            got.append(Client(address, timeout=f"{CONNECT_TIMEOUT:g}s"))
+        except Exception as exc:  # noqa: BLE001 - whatever the handshake raised: the address does not work
+            got.append(exc)
+
+    worker = threading.Thread(target=make, name="cspace-dask-connect", daemon=True)
+    worker.start()
+    worker.join(3 * CONNECT_TIMEOUT + 5)
+    if not got:
+        raise InputError("bench", "--scheduler", f"{address} passed the handshake, then did not connect within "
+                                                 f"{3 * CONNECT_TIMEOUT + 5:g} s")
+    if isinstance(got[0], Exception):
+        raise InputError("bench", "--scheduler", f"cannot connect to {address}: {type(got[0]).__name__}: "
+                                                 f"{got[0]}")
+    return got[0]
 
 
 def sweep_on_cluster(tasks: list[dict], scheduler, on_batch, seconds: float = BATCH_SECONDS) -> None:

@@ -431,3 +431,18 @@ def test_a_refused_sweep_leaves_an_up_to_date_database_byte_for_byte(tmp_path, c
     assert bench(BASIC, *ARGS, "--out", tmp_path / "o", "--db", db) == 2
     one_line(capsys, "already holds 2 of this sweep's 2 runs")
     assert digest(db) == before
+
+
+@pytest.mark.parametrize("greeting", [b"\x01" + b"\x00" * 7, b"\x10" + b"\x00" * 7 + b"0123456789abcdef",
+                                      b"\x05" + b"\x00" * 7 + b"ab"])
+def test_a_server_that_mimics_the_handshake_s_length_is_refused_within_the_timeout(monkeypatch, greeting):
+    # a plausible length, then nothing, a wrong message, or half a message: the probe reads the
+    # whole handshake under the deadline and checks it (Dask's own connect would wait for ever)
+    pytest.importorskip("distributed")
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 0.5)
+    srv = Server(greeting)
+    try:
+        with pytest.raises(cluster.InputError, match="--scheduler"):
+            cluster.connect(f"tcp://127.0.0.1:{srv.port}")
+    finally:
+        srv.close()
