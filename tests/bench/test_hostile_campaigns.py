@@ -141,13 +141,22 @@ def test_a_database_that_cannot_be_written_is_refused_before_the_sweep(tmp_path,
     assert digest(db) == before and not (tmp_path / "o" / "results.json").exists()
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="root writes read-only files")
 def test_a_read_only_file_is_refused(tmp_path, capsys, good_db):
+    # read-only by its mode, or (root writes those) immutable (chattr +i)
     db = copy(good_db, tmp_path / "ro.db")
     os.chmod(db, 0o444)
-    assert bench(BASIC, "--planners", "RRTConnect", "--times", "0.03", "--runs", 1, "--out", tmp_path / "o",
-                 "--db", db) == 2
-    one_line(capsys, "--db", "cannot write")
+    immutable = os.geteuid() == 0
+    if immutable and subprocess.run(["chattr", "+i", str(db)], capture_output=True).returncode != 0:
+        pytest.skip("root, and no chattr +i here")
+    try:
+        before = digest(db)
+        assert bench(BASIC, "--planners", "RRTConnect", "--times", "0.03", "--runs", 1, "--out", tmp_path / "o",
+                     "--db", db) == 2
+        one_line(capsys, "--db", "cannot write")
+        assert digest(db) == before
+    finally:
+        if immutable:
+            subprocess.run(["chattr", "-i", str(db)], capture_output=True)
 
 
 def test_every_damaged_page_is_refused_unchanged(tmp_path, capsys, good_db):
@@ -446,3 +455,23 @@ def test_a_server_that_mimics_the_handshake_s_length_is_refused_within_the_timeo
             cluster.connect(f"tcp://127.0.0.1:{srv.port}")
     finally:
         srv.close()
+
+
+def test_a_database_in_a_read_only_folder_is_refused_before_the_sweep(tmp_path, capsys, good_db):
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    db = copy(good_db, folder / "c.db")
+    os.chmod(folder, 0o555)
+    immutable = os.geteuid() == 0
+    if immutable and subprocess.run(["chattr", "+i", str(folder)], capture_output=True).returncode != 0:
+        pytest.skip("root, and no chattr +i here")
+    try:
+        before = digest(db)
+        assert bench(BASIC, "--planners", "RRTConnect", "--times", "0.03", "--runs", 1, "--out", tmp_path / "o",
+                     "--db", db) == 2
+        one_line(capsys, "--db", "cannot write")
+        assert digest(db) == before and os.listdir(folder) == ["c.db"]
+    finally:
+        if immutable:
+            subprocess.run(["chattr", "-i", str(folder)], capture_output=True)
+        os.chmod(folder, 0o755)
