@@ -255,11 +255,12 @@ def run(args) -> int:
     # Never mix two sweeps in one folder: an earlier sweep's outputs go only now, so a sweep
     # killed before it writes (kill -9, a power cut) leaves the earlier results whole.
     clear_outputs(out)
-    interrupted = write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
+    late = write_deferring_sigint(rows, out, meta, plot=not args.no_plot)  # a signal while writing: its number
+    interrupted = bool(late) or interrupted
     sys.stderr.write(summary(rows, scenarios) + "\n")  # the result: printed with -q too
     if not args.quiet:
         sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
                          + (" (interrupted)" if interrupted else "") + "\n")
     if campaign is not None:
         campaign.check()  # a database error during the sweep: one line, exit 2, now that --out is written
-    return interrupt.exit_code() if interrupted else 0
+    return (128 + late if late else interrupt.exit_code()) if interrupted else 0
