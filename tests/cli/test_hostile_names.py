@@ -57,3 +57,22 @@ def test_a_name_from_a_file_name_is_shown_escaped(tmp_path):
     assert r.returncode == 0, r.stderr
     assert CONTROL.search((r.stdout + r.stderr).replace("\n", "")) is None
     assert "evil\\x1b[31m\\n|>>>" in r.stdout
+
+
+MATH = ["a $\\frac{1 x$ b", "$$", "$x^$", "back\\slash $\\undefined$", "50$ and 60$"]
+
+
+@pytest.mark.parametrize("name", MATH, ids=range(len(MATH)))
+def test_a_name_is_text_in_every_picture_never_mathtext(tmp_path, name):
+    # matplotlib reads $...$ as mathtext: a scene's name with dollars raised a ParseException
+    # (exit 3) in plot titles; names are text in the plot, the animation and the bench figure
+    from planners.cli import main
+
+    text = open(BASIC, encoding="utf-8").read().replace('name = "basic"', f"name = {toml_string(name)}", 1)
+    f = tmp_path / "s.toml"
+    f.write_text(text, encoding="utf-8")
+    assert main(["plan", str(f), "--planner", "exact", "--plot", str(tmp_path / "p.png"),
+                 "--animate", str(tmp_path / "a.gif")]) == 0
+    assert main(["bench", str(f), "--planners", "RRTConnect", "--times", "0.01", "--runs", "1", "-q",
+                 "--out", str(tmp_path / "b")]) == 0
+    assert (tmp_path / "p.png").stat().st_size and (tmp_path / "b" / "error_vs_time.png").stat().st_size
