@@ -153,6 +153,8 @@ def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
     """
     from importlib.metadata import PackageNotFoundError, version
 
+    from cspace.io.scenario.messages import printable
+
     try:
         ver = version("ompl")
     except PackageNotFoundError:  # pragma: no cover
@@ -170,8 +172,8 @@ def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
         lines = [f"OMPL version {ver}", f"Experiment {_token(scen)}_t{budget:g}",
                  "2 experiment properties", f"optimum REAL = {_val(opt)}", f"budget REAL = {budget!r}",
                  f"Running on {socket.gethostname()}", f"Starting at {date}",
-                 "<<<|", f"cspace bench: scenario {scen} ({rs[0]['file']}), budget {budget:g} s, "
-                         f"error against the exact shortest path", "|>>>",
+                 "<<<|", printable(f"cspace bench: scenario {scen} ({rs[0]['file']}), budget {budget:g} s, "
+                                   "error against the exact shortest path"), "|>>>",
                  "<<<|", "|>>>", "0 is the random seed", f"{budget!r} seconds per run", "0 MB per run",
                  f"{max(len(v) for v in planners.values())} runs per planner",
                  f"{sum(r['wall_s'] or 0.0 for r in rs)!r} seconds spent to collect the data",

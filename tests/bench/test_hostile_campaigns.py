@@ -314,6 +314,9 @@ def test_control_characters_in_a_file_name_do_not_reach_the_log_or_terminal(tmp_
     assert "\x1b" not in err
     files = [str(p) for p in logs.glob("*.log")]
     assert len(files) == 1 and "\x1b" not in Path(files[0]).read_text()
+    for own in (tmp_path / "o" / "ompl").glob("*.log"):  # --out's own logs too
+        lines = own.read_text().splitlines()
+        assert "\x1b" not in "".join(lines) and lines.count("|>>>") == lines.count("<<<|") == 2
     converted = tmp_path / "c.db"
     proc = subprocess.run([sys.executable, "-m", "ompl.ompl_benchmark_statistics", "-d", str(converted), *files],
                           capture_output=True, text=True)
