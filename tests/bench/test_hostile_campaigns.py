@@ -1,10 +1,10 @@
-"""``cspace bench --db/--log/--scheduler/--runs`` under hostile and unlucky inputs (issue 48).
+"""``cspace bench --db/--log/--runs`` under hostile and unlucky inputs (issue 48; ``--scheduler``:
+test_hostile_scheduler.py).
 
 Each test covers a class of fault, not one case: any foreign or damaged database file is refused
 before a byte of it changes; a database that fails during the sweep keeps its stored runs and
 the command says so in one exit-2 line; a campaign holds its database alone; log names from a
-database never leave ``--log DIR``; an address that is not a Dask scheduler is refused within the
-connect timeout; a sweep's size is bounded; SIGTERM ends a sweep as Ctrl-C does.
+database never leave ``--log DIR``; a sweep's size is bounded; SIGTERM ends a sweep as Ctrl-C does.
 """
 from __future__ import annotations
 
@@ -12,18 +12,16 @@ import hashlib
 import os
 import random
 import signal
-import socket
 import sqlite3
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
 import pytest
 
 import conftest
-from planners.bench import arena_db, cluster
+from planners.bench import arena_db
 from planners.bench.pool import CAN_FORK
 from planners.cli import main
 
@@ -324,70 +322,6 @@ def test_control_characters_in_a_file_name_do_not_reach_the_log_or_terminal(tmp_
     assert runs_in(converted) == 2
 
 
-# ---------------------------------------------------------------- the scheduler's address
-
-class Server:
-    """A TCP server on 127.0.0.1 that says ``greeting`` on each connection (None: stays silent)."""
-
-    def __init__(self, greeting: bytes | None):
-        self.sock = socket.socket()
-        self.sock.bind(("127.0.0.1", 0))
-        self.sock.listen(8)
-        self.port = self.sock.getsockname()[1]
-        self.greeting, self.conns = greeting, []
-        threading.Thread(target=self.serve, daemon=True).start()
-
-    def serve(self):
-        while True:
-            try:
-                c, _ = self.sock.accept()
-            except OSError:
-                return
-            self.conns.append(c)
-            if self.greeting is not None:
-                c.sendall(self.greeting)
-
-    def close(self):
-        self.sock.close()
-        for c in self.conns:
-            c.close()
-
-
-@pytest.mark.parametrize("greeting", [b"SSH-2.0-OpenSSH_9.6\r\n", b"HTTP/1.1 400 Bad Request\r\n\r\n",
-                                      b"\x00" * 8, None, b""])
-def test_a_server_that_is_not_a_scheduler_is_refused_within_the_timeout(monkeypatch, greeting):
-    pytest.importorskip("distributed")
-    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 0.5)
-    srv = Server(greeting)
-    try:
-        if greeting == b"":  # accepts, then closes at once
-            srv.greeting = None
-            threading.Thread(target=lambda: [time.sleep(0.05), srv.close()], daemon=True).start()
-        with pytest.raises(cluster.InputError) as err:
-            cluster.connect(f"tcp://127.0.0.1:{srv.port}")
-        assert "--scheduler" in str(err.value) and "\n" not in str(err.value)
-    finally:
-        srv.close()
-
-
-@pytest.mark.parametrize("address", ["", "   ", "ucx://127.0.0.1:8786", "tls://127.0.0.1:8786",
-                                     "inproc://x", "tcp://", "tcp://host:notaport", "tcp://h:99999",
-                                     "tcp://h:1/path", "\x1b[31m://x"])
-def test_address_forms_that_cannot_work_are_refused_before_the_sweep(tmp_path, capsys, address):
-    assert bench(BASIC, *ARGS, "--out", tmp_path / "o", "--scheduler", address) == 2
-    err = one_line(capsys, "--scheduler")
-    assert "\x1b" not in err and not (tmp_path / "o").exists()
-
-
-def test_a_closed_port_is_refused(tmp_path, capsys):
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    with pytest.raises(cluster.InputError, match="cannot connect"):
-        cluster.probe("127.0.0.1", port, 2.0)
-
-
 # ---------------------------------------------------------------- size and SIGTERM
 
 @pytest.mark.parametrize("runs,times,planners", [(10**9, "0.01", "RRTConnect"), (20000, "0.01,0.02,0.03",
@@ -443,21 +377,6 @@ def test_a_refused_sweep_leaves_an_up_to_date_database_byte_for_byte(tmp_path, c
     assert bench(BASIC, *ARGS, "--out", tmp_path / "o", "--db", db) == 2
     one_line(capsys, "already holds 2 of this sweep's 2 runs")
     assert digest(db) == before
-
-
-@pytest.mark.parametrize("greeting", [b"\x01" + b"\x00" * 7, b"\x10" + b"\x00" * 7 + b"0123456789abcdef",
-                                      b"\x05" + b"\x00" * 7 + b"ab"])
-def test_a_server_that_mimics_the_handshake_s_length_is_refused_within_the_timeout(monkeypatch, greeting):
-    # a plausible length, then nothing, a wrong message, or half a message: the probe reads the
-    # whole handshake under the deadline and checks it (Dask's own connect would wait for ever)
-    pytest.importorskip("distributed")
-    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 0.5)
-    srv = Server(greeting)
-    try:
-        with pytest.raises(cluster.InputError, match="--scheduler"):
-            cluster.connect(f"tcp://127.0.0.1:{srv.port}")
-    finally:
-        srv.close()
 
 
 def test_a_database_in_a_read_only_folder_is_refused_before_the_sweep(tmp_path, capsys, good_db):
