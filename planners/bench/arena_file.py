@@ -44,7 +44,11 @@ KEY_COLUMNS = {"experiments": ("id", "name"), "plannerConfigs": ("id", "name", "
 # killed sweep never keeps the database claimed.
 _claims: set[int] = set()
 
-SPECIAL_NAMES = (":memory:",)  # names SQLite gives a meaning other than a file
+SPECIAL_NAMES = (":memory:",)
+
+# What a damaged or foreign database raises: SQLite's errors, and (Python decoding an error
+# message that quotes a damaged schema's bytes) UnicodeDecodeError.
+DB_ERRORS = (sqlite3.Error, UnicodeDecodeError)  # names SQLite gives a meaning other than a file
 
 
 def quote(name: str) -> str:
@@ -112,6 +116,9 @@ def check_contents(conn, path: str) -> None:
                                                "AND name NOT LIKE 'sqlite%'")}
     if not tables:  # an empty database: the sweep makes it a benchmark database
         return
+    for table in sorted(tables):  # a name that is not UTF-8 (read as U+FFFD): damaged bytes in the schema
+        if "\ufffd" in table or any("\ufffd" in name for name, _ in columns(conn, table)):
+            raise refuse(path, f"damaged database (a name in table {table!r} is not UTF-8): repair or remove it")
     missing = [t for t in KEY_COLUMNS if t not in tables]
     if missing:
         have = ", ".join(sorted(tables)[:5]) + (", ..." if len(tables) > 5 else "")
@@ -137,6 +144,7 @@ def open_campaign_db(path: str, make_schema) -> tuple[sqlite3.Connection, int]:
         if head and head != MAGIC:
             raise refuse(path, "not a benchmark database (not even an SQLite file)")
         conn = sqlite3.connect(path, timeout=10.0)
+        conn.text_factory = decode  # text that is not UTF-8 (a damaged or foreign value) is read, not raised
         conn.execute("PRAGMA foreign_keys = ON")
         try:
             conn.execute("BEGIN IMMEDIATE")
@@ -150,8 +158,8 @@ def open_campaign_db(path: str, make_schema) -> tuple[sqlite3.Connection, int]:
                 conn.commit()
             else:  # an up-to-date database: the probe's write is undone, the file keeps every byte
                 conn.rollback()
-        except sqlite3.Error as exc:
-            with contextlib.suppress(sqlite3.Error):
+        except DB_ERRORS as exc:
+            with contextlib.suppress(*DB_ERRORS):
                 conn.rollback()
             raise refuse(path, describe(exc)) from None
         return conn, fd
@@ -165,12 +173,23 @@ def open_campaign_db(path: str, make_schema) -> tuple[sqlite3.Connection, int]:
         raise
 
 
-def describe(exc: sqlite3.Error) -> str:
-    """A database error in words a user acts on.
+def decode(raw: bytes) -> str:
+    r"""A TEXT value as a string: UTF-8, a byte that is not replaced by U+FFFD.
+
+    >>> decode(b"ok \x80")
+    'ok \ufffd'
+    """
+    return raw.decode("utf-8", "replace")
+
+
+def describe(exc: Exception) -> str:
+    """A database error (one of :data:`DB_ERRORS`) in words a user acts on.
 
     >>> describe(sqlite3.OperationalError("attempt to write a readonly database"))
     'cannot write (attempt to write a readonly database): the file and its folder must be writable, the disk not full'
     """
+    if isinstance(exc, UnicodeDecodeError):
+        return "damaged database (SQLite answered with text that is not UTF-8): repair or remove it"
     text = str(exc)
     low = text.lower()
     if any(w in low for w in ("readonly", "unable to open", "permission", "disk i/o", "full")):

@@ -21,10 +21,10 @@ database lives in memory for the logs only.
 """
 from __future__ import annotations
 
-import sqlite3
 
 from ..errors import InputError
 from . import arena_db as adb
+from .arena_file import DB_ERRORS
 
 
 def ompl_version() -> str:
@@ -117,7 +117,7 @@ class Campaign:
                 got = None if p is None else adb.stored_run(self.conn, e, p, t["seed"])
                 if got is not None:
                     out.append(complete_row(t, got, got["wall_s"]))
-        except sqlite3.Error as exc:
+        except DB_ERRORS as exc:
             from .arena_file import describe
 
             raise InputError(self.path, "--db", describe(exc)) from None
@@ -127,7 +127,7 @@ class Campaign:
         """The tasks left to run: all (refused if some are stored), or, resuming, those not stored."""
         try:
             done = self.stored_tasks(tasks)
-        except sqlite3.Error as exc:
+        except DB_ERRORS as exc:
             from .arena_file import describe
 
             raise InputError(self.path, "--db", describe(exc)) from None
@@ -158,7 +158,7 @@ class Campaign:
             self.pending = todo + self.pending  # rolled back: stored at the next batch or at close
             self.experiments.clear()  # an experiment created in the rolled-back transaction is gone too
             self.planners.clear()
-            if not isinstance(exc, sqlite3.Error):
+            if not isinstance(exc, DB_ERRORS):
                 raise
             self.fail(exc)
 
@@ -201,7 +201,7 @@ class Campaign:
                     computeViews = None
                 if computeViews is not None:
                     computeViews(self.path, False)
-        except sqlite3.Error as exc:
+        except DB_ERRORS as exc:
             self.fail(exc)
         finally:
             self.close()

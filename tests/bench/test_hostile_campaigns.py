@@ -397,3 +397,25 @@ def test_a_database_in_a_read_only_folder_is_refused_before_the_sweep(tmp_path, 
         if immutable:
             subprocess.run(["chattr", "-i", str(folder)], capture_output=True)
         os.chmod(folder, 0o755)
+
+
+@pytest.mark.parametrize("byte", [0x80, 0xFF, 0x00])
+def test_single_damaged_bytes_in_the_schema_page_never_give_exit_3(tmp_path, capsys, good_db, byte):
+    # a byte that is not UTF-8 in the schema's SQL made SQLite's error message undecodable
+    # (UnicodeDecodeError: exit 3, found by the campaigns fuzz); any byte of page 1 past the
+    # header: exit 0 (harmless) or 2, refused unchanged
+    data = good_db.read_bytes()
+    for k, pos in enumerate(range(300, 4096, 227)):
+        bad = bytearray(data)
+        bad[pos] = byte
+        db = tmp_path / f"b{k}.db"
+        db.write_bytes(bytes(bad))
+        code = bench(BASIC, "--planners", "RRTConnect", "--times", "0.03", "--runs", 1, "--out", tmp_path / "o",
+                     "--db", db)
+        err = capsys.readouterr().err
+        assert code in (0, 2) and "internal error" not in err, (pos, err)
+        lines = [line for line in err.strip().splitlines() if line.startswith("error:")]
+        if code == 2:
+            assert len(lines) == 1, (pos, err)
+        if code == 2 and "runs were stored" not in lines[0]:  # refused: unchanged (else a later error)
+            assert db.read_bytes() == bytes(bad), (pos, err)
