@@ -43,6 +43,7 @@ def call_in_child(fn, limit: float):
     if pid == 0:  # pragma: no cover - the child
         try:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
+            signal.signal(signal.SIGTERM, signal.SIG_IGN)  # the parent ends its children (SIGTERM is its Ctrl-C)
             os.close(out_r)
             try:
                 data = pickle.dumps((True, fn()))

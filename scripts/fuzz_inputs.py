@@ -1,7 +1,10 @@
 """The large fuzz campaign of issue 36: scenario files (tests/cli/test_fuzz_cli.py) and imported
 maps and meshes (tests/io/test_fuzz_maps.py, tests/io/test_fuzz_meshes.py) under the exit-code
 contract of tests/helpers/fuzzing.py (0/1/2, never 3; exit 2 one line; inputs never written over;
-no temporaries; valid JSON).
+no temporaries; valid JSON); and, since issue 48, the campaign surfaces (tests/bench/
+test_fuzz_campaigns.py: hostile ``--db`` files and the names they hold, ``--log`` folders,
+``--scheduler`` addresses and servers, sweep sizes, page names; a refused database unchanged,
+nothing written outside the outputs).
 
 Runs the scenario fuzz and the import fuzz (its two files in one process: the last test of
 test_fuzz_meshes.py reports both) as two pytest processes (in parallel with ``--jobs 2``), each with
@@ -10,7 +13,7 @@ input kind, the exit-code histogram, exit 3 and modified-input counts, the slowe
 that breaks the contract is kept (its files and the reason) under ``OUT/kept`` and counted; the
 run goes on.
 
-Usage: python scripts/fuzz_inputs.py [--scenario N] [--imports N] [--out DIR] [--jobs 1|2]
+Usage: python scripts/fuzz_inputs.py [--scenario N] [--imports N] [--campaigns N] [--out DIR] [--jobs 1|2]
 
 The defaults (1000 and 2000 examples per test: 4 tests each) give about 12 000 cases and
 about 22 000 generated files; expect a few minutes per 1000 cases a core.
@@ -28,7 +31,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # The test files of each campaign, run in one pytest process (relative to ROOT): the imports'
 # report is the last test of test_fuzz_meshes.py, after test_fuzz_maps.py's cases.
 FILES = {"scenario": (os.path.join("tests", "cli", "test_fuzz_cli.py"),),
-         "imports": (os.path.join("tests", "io", "test_fuzz_maps.py"), os.path.join("tests", "io", "test_fuzz_meshes.py"))}
+         "imports": (os.path.join("tests", "io", "test_fuzz_maps.py"), os.path.join("tests", "io", "test_fuzz_meshes.py")),
+         "campaigns": (os.path.join("tests", "bench", "test_fuzz_campaigns.py"),)}
 
 
 def run_files(test_files: tuple, examples: int, out: str, tag: str) -> tuple[subprocess.Popen, str]:
@@ -46,13 +50,16 @@ def main(argv=None) -> int:
     ap.add_argument("--scenario", type=int, default=1000, help="examples per test of test_fuzz_cli.py (4 tests)")
     ap.add_argument("--imports", type=int, default=2000,
                     help="examples per test of test_fuzz_maps.py and test_fuzz_meshes.py (4 tests)")
+    ap.add_argument("--campaigns", type=int, default=200,
+                    help="examples per test of test_fuzz_campaigns.py (3 tests; a bench sweep or a page each)")
     ap.add_argument("--out", default="fuzz_out", help="folder for the reports, logs and kept cases")
     ap.add_argument("--jobs", type=int, choices=(1, 2), default=2)
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     out = os.path.abspath(args.out)
     t0 = time.time()
-    plan = [(FILES[tag], n, tag) for n, tag in ((args.scenario, "scenario"), (args.imports, "imports")) if n > 0]
+    plan = [(FILES[tag], n, tag) for n, tag in ((args.scenario, "scenario"), (args.imports, "imports"),
+                                                (args.campaigns, "campaigns")) if n > 0]
     reports, codes = {}, {}
     running = []
     for f, n, tag in plan:
@@ -78,7 +85,8 @@ def main(argv=None) -> int:
         for label, v in r["by_test"].items():
             name = label.split(":")[0]
             kind = "map" if name.startswith("map") else "mesh" if name.startswith("mesh") else \
-                "fixed cases" if name in ("templates", "found") else "scenario"
+                "fixed cases" if name in ("templates", "found") else \
+                name if name in ("db files", "db seed", "scheduler", "page") else "scenario"
             summary["cases_by_kind"][kind] = summary["cases_by_kind"].get(kind, 0) + v
         for k, v in r.get("files", {}).items():
             summary["files_by_kind"][k] = summary["files_by_kind"].get(k, 0) + v

@@ -32,6 +32,7 @@ import sqlite3
 import time
 
 from ..pictures.bench_figure import proven_unsolvable
+from .arena_file import columns, quote
 
 ENUM_NAME = "status"
 STATUSES = ("Unknown status", "Invalid start", "Invalid goal", "Unrecognized goal type", "Timeout",
@@ -120,51 +121,56 @@ def column(name: str) -> str:
     return "_".join(name.split())
 
 
-SCHEMA = """CREATE TABLE IF NOT EXISTS experiments
+SCHEMA = ("""CREATE TABLE IF NOT EXISTS experiments
     (id INTEGER PRIMARY KEY AUTOINCREMENT, name VARCHAR(512),
     totaltime REAL, timelimit REAL, memorylimit REAL, runcount INTEGER,
     version VARCHAR(128), hostname VARCHAR(1024), cpuinfo TEXT,
-    date DATETIME, seed VARCHAR(24), setup TEXT);
-    CREATE TABLE IF NOT EXISTS plannerConfigs
+    date DATETIME, seed VARCHAR(24), setup TEXT)""",
+          """CREATE TABLE IF NOT EXISTS plannerConfigs
     (id INTEGER PRIMARY KEY AUTOINCREMENT,
-    name VARCHAR(512) NOT NULL, settings TEXT);
-    CREATE TABLE IF NOT EXISTS enums
+    name VARCHAR(512) NOT NULL, settings TEXT)""",
+          """CREATE TABLE IF NOT EXISTS enums
     (name VARCHAR(512), value INTEGER, description TEXT,
-    PRIMARY KEY (name, value));
-    CREATE TABLE IF NOT EXISTS runs
+    PRIMARY KEY (name, value))""",
+          """CREATE TABLE IF NOT EXISTS runs
     (id INTEGER PRIMARY KEY AUTOINCREMENT, experimentid INTEGER, plannerid INTEGER,
     FOREIGN KEY (experimentid) REFERENCES experiments(id) ON DELETE CASCADE,
-    FOREIGN KEY (plannerid) REFERENCES plannerConfigs(id) ON DELETE CASCADE);
-    CREATE TABLE IF NOT EXISTS progress
+    FOREIGN KEY (plannerid) REFERENCES plannerConfigs(id) ON DELETE CASCADE)""",
+          """CREATE TABLE IF NOT EXISTS progress
     (runid INTEGER, time REAL, PRIMARY KEY (runid, time),
-    FOREIGN KEY (runid) REFERENCES runs(id) ON DELETE CASCADE)"""
+    FOREIGN KEY (runid) REFERENCES runs(id) ON DELETE CASCADE)""")
 
 
 def _add_columns(conn, table: str, props) -> None:
-    have = {c[1] for c in conn.execute(f"PRAGMA table_info({table})")}
+    have = {name for name, _ in columns(conn, table)}
     for name, kind in props:
         if column(name) not in have:
-            conn.execute(f"ALTER TABLE {table} ADD {column(name)} {kind}")
+            conn.execute(f"ALTER TABLE {quote(table)} ADD {quote(column(name))} {kind}")
 
 
-def open_db(path: str) -> sqlite3.Connection:
-    """Open (creating if needed) a benchmark database with every table and column of a sweep.
+def make_schema(conn) -> None:
+    """Create or upgrade a benchmark database's tables, columns, run-key index and status enum,
+    in the caller's transaction (one statement at a time: ``executescript`` would commit first).
 
     A run's key is unique (an index on runs (experimentid, plannerid, seed)): a run is never
-    stored twice. A file that is not an SQLite database, or one whose tables are not a
-    benchmark database's, raises sqlite3.DatabaseError.
+    stored twice.
     """
-    conn = sqlite3.connect(path, timeout=60.0)
+    for statement in SCHEMA:
+        conn.execute(statement)
+    _add_columns(conn, "experiments", EXP_PROPS)
+    _add_columns(conn, "runs", [(n, k) for n, k, _ in RUN_PROPS])
+    _add_columns(conn, "progress", PROGRESS_PROPS[1:])
+    conn.execute("CREATE UNIQUE INDEX IF NOT EXISTS cspace_run_key ON runs (experimentid, plannerid, seed)")
+    if conn.execute("SELECT 1 FROM enums WHERE name = ?", (ENUM_NAME,)).fetchone() is None:
+        conn.executemany("INSERT INTO enums VALUES (?, ?, ?)", [(ENUM_NAME, i, s) for i, s in enumerate(STATUSES)])
+
+
+def memory_db() -> sqlite3.Connection:
+    """A benchmark database in memory (``--log`` without ``--db``: the logs' source only)."""
+    conn = sqlite3.connect(":memory:")
     conn.execute("PRAGMA foreign_keys = ON")
     with conn:
-        conn.executescript(SCHEMA)
-        _add_columns(conn, "experiments", EXP_PROPS)
-        _add_columns(conn, "runs", [(n, k) for n, k, _ in RUN_PROPS])
-        _add_columns(conn, "progress", PROGRESS_PROPS[1:])
-        conn.execute("CREATE UNIQUE INDEX IF NOT EXISTS cspace_run_key ON runs (experimentid, plannerid, seed)")
-        if conn.execute("SELECT 1 FROM enums WHERE name = ?", (ENUM_NAME,)).fetchone() is None:
-            conn.executemany("INSERT INTO enums VALUES (?, ?, ?)",
-                             [(ENUM_NAME, i, s) for i, s in enumerate(STATUSES)])
+        make_schema(conn)
     return conn
 
 
@@ -221,7 +227,7 @@ def add_experiment(conn, task: dict, props: dict, version: str) -> int:
               "runcount": 0, "version": version, "hostname": socket.gethostname(), "cpuinfo": cpu,
               "date": time.strftime("%Y-%m-%d %H:%M:%S"), "seed": "0", "setup": setup, **props}
     cols = list(values)
-    cur = conn.execute(f"INSERT INTO experiments ({','.join(cols)}) VALUES ({','.join('?' * len(cols))})",
+    cur = conn.execute(f"INSERT INTO experiments ({','.join(map(quote, cols))}) VALUES ({','.join('?' * len(cols))})",
                        [values[c] for c in cols])
     return cur.lastrowid
 
@@ -244,7 +250,7 @@ def insert_run(conn, exp_id: int, plan_id: int, row: dict) -> int:
     """Insert one finished run and its progress points (inside the caller's transaction)."""
     cols = ["experimentid", "plannerid"] + [column(n) for n, _, _ in RUN_PROPS]
     vals = [exp_id, plan_id] + [f(row) for _, _, f in RUN_PROPS]
-    run_id = conn.execute(f"INSERT INTO runs ({','.join(cols)}) VALUES ({','.join('?' * len(cols))})",
+    run_id = conn.execute(f"INSERT INTO runs ({','.join(map(quote, cols))}) VALUES ({','.join('?' * len(cols))})",
                           vals).lastrowid
     seen = set()
     for t, cost in row.get("progress") or []:
@@ -264,7 +270,7 @@ def stored_run(conn, exp_id: int, plan_id: int, seed: int) -> dict | None:
     run properties of :data:`RUN_PROPS`; its progress points); None if it is not stored. The
     database keeps a run's status, not its message: a stored run says what its status says."""
     names = [n for n, _, _ in RUN_PROPS]
-    got = conn.execute(f"SELECT id, {', '.join(column(n) for n in names)} FROM runs WHERE experimentid = ? "
+    got = conn.execute(f"SELECT id, {', '.join(quote(column(n)) for n in names)} FROM runs WHERE experimentid = ? "
                        "AND plannerid = ? AND seed = ?", (exp_id, plan_id, int(seed))).fetchone()
     if got is None:
         return None

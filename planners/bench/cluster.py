@@ -111,16 +111,130 @@ def run_batch(batch: list[dict], sha: str) -> list[dict]:
     return rows
 
 
+CONNECT_TIMEOUT = 10.0  # seconds for the connection and the scheduler's first words
+
+
+DEFAULT_PORT = 8786  # a Dask scheduler's (its dashboard is 8787, and speaks HTTP)
+
+
+MAX_HANDSHAKE = 1 << 20  # bytes a scheduler's handshake may announce (a few hundred in practice)
+
+
+def scheduler_address(address: str) -> tuple[str, int]:
+    """``(host, port)`` of a ``--scheduler`` address: ``tcp://HOST:PORT``, ``HOST:PORT`` or ``HOST``
+    (port 8786). Every other form is one exit-2 line: an empty address, another protocol
+    (``tls://`` needs certificates, ``ucx://`` a UCX build, ``inproc://`` this process), a path.
+
+    >>> scheduler_address("tcp://10.0.0.5:8786"), scheduler_address("[::1]:9000"), scheduler_address("node7")
+    (('10.0.0.5', 8786), ('::1', 9000), ('node7', 8786))
+    """
+    from urllib.parse import urlsplit
+
+    from cspace.io.scenario.messages import printable
+
+    text = str(address).strip()
+    if not text:
+        raise InputError("bench", "--scheduler", "an empty address names no scheduler (tcp://HOST:8786)")
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme.lower() != "tcp":
+        raise InputError("bench", "--scheduler", f"{printable(scheme)}:// is not supported: give the scheduler's "
+                                                 "tcp://HOST:PORT address")
+    try:
+        parts = urlsplit("tcp://" + rest)
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise InputError("bench", "--scheduler", f"not an address {printable(text)!r}: {exc}") from None
+    if not host or parts.path not in ("", "/") or parts.query or parts.fragment or parts.username:
+        raise InputError("bench", "--scheduler", f"not an address {printable(text)!r} (expected tcp://HOST:PORT)")
+    return host, DEFAULT_PORT if port is None else port
+
+
+def probe(host: str, port: int, timeout: float | None = None) -> None:
+    """Connect to ``host:port`` and read the handshake a Dask scheduler sends first (an 8-byte
+    length, then that many bytes of msgpack frames naming its ``compression`` and
+    ``pickle-protocol``), all within ``timeout`` seconds; one exit-2 line if the peer is
+    unreachable, silent (an HTTP port such as Dask's own dashboard), closes, stops half-way, or
+    says something else (an SSH server's banner would read as a length of exabytes)."""
+    import socket
+    import struct
+    import time
+
+    from cspace.io.scenario.messages import printable
+
+    timeout = CONNECT_TIMEOUT if timeout is None else timeout
+    where = f"{host}:{port}"
+    deadline = time.monotonic() + timeout
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except socket.timeout:
+        raise InputError("bench", "--scheduler", f"no connection to {where} within {timeout:g} s") from None
+    except (OSError, ValueError, OverflowError) as exc:
+        raise InputError("bench", "--scheduler", f"cannot connect to {where}: "
+                                                 f"{getattr(exc, 'strerror', None) or exc}") from None
+    def read(n: int, got: bytes = b"") -> bytes:
+        while len(got) < n:
+            sock.settimeout(max(deadline - time.monotonic(), 0.001))
+            chunk = sock.recv(min(n - len(got), 1 << 16))
+            if not chunk:
+                raise InputError("bench", "--scheduler", f"{where} closed the connection "
+                                                         f"{'half-way' if got else 'without a word'}: not a Dask "
+                                                         "scheduler")
+            got += chunk
+        return got
+
+    with sock:
+        try:
+            head = read(8)
+            (size,) = struct.unpack("<Q", head)
+            if not 0 < size <= MAX_HANDSHAKE:
+                raise InputError("bench", "--scheduler", f"{where} is not a Dask scheduler (it said "
+                                                         f"{printable(head.decode('latin-1'))!r})")
+            body = read(size)
+        except socket.timeout:
+            raise InputError("bench", "--scheduler", f"{where} did not answer as a Dask scheduler within "
+                                                     f"{timeout:g} s (a scheduler listens on {DEFAULT_PORT}, its "
+                                                     "dashboard on 8787)") from None
+        except OSError as exc:
+            raise InputError("bench", "--scheduler", f"{where}: {exc.strerror or exc}") from None
+    if b"pickle-protocol" not in body and b"compression" not in body:
+        raise InputError("bench", "--scheduler", f"{where} is not a Dask scheduler (its first message is not "
+                                                 "a handshake)")
+
+
 def connect(scheduler: str):
-    """A Dask client of the scheduler at this address (exit 2 if dask or the scheduler is missing)."""
+    """A Dask client of the scheduler at this address (exit 2 if dask or the scheduler is missing,
+    or the address does not answer as one within :data:`CONNECT_TIMEOUT`)."""
+    host, port = scheduler_address(scheduler)
     try:
         from distributed import Client
     except ImportError:
         raise InputError("bench", "--scheduler", "needs dask[distributed] (pip install 'cspace[cluster]')") from None
-    try:
-        return Client(scheduler, timeout="10s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise InputError("bench", "--scheduler", f"cannot connect to {scheduler}: {exc}") from None
+    probe(host, port)
+    address = f"tcp://[{host}]:{port}" if ":" in host else f"tcp://{host}:{port}"
+    # Dask's own connection, under a deadline too: a peer that passed the probe and then stalls
+    # costs the timeout, not the run (the thread is left behind; the command ends anyway).
+    import threading
+
+    got: list = []
+
+    def make():
+        try:
+            got.append(Client(address, timeout=f"{CONNECT_TIMEOUT:g}s"))
+        except Exception as exc:  # noqa: BLE001 - whatever the handshake raised: the address does not work
+            got.append(exc)
+
+    worker = threading.Thread(target=make, name="cspace-dask-connect", daemon=True)
+    worker.start()
+    worker.join(3 * CONNECT_TIMEOUT + 5)
+    if not got:
+        raise InputError("bench", "--scheduler", f"{address} passed the handshake, then did not connect within "
+                                                 f"{3 * CONNECT_TIMEOUT + 5:g} s")
+    if isinstance(got[0], Exception):
+        raise InputError("bench", "--scheduler", f"cannot connect to {address}: {type(got[0]).__name__}: "
+                                                 f"{got[0]}")
+    return got[0]
 
 
 def sweep_on_cluster(tasks: list[dict], scheduler, on_batch, seconds: float = BATCH_SECONDS) -> None:

@@ -17,27 +17,30 @@ import socket
 import time
 
 
-def write_deferring_sigint(rows, out, meta, plot) -> bool:
-    """Write the outputs with Ctrl-C held until they are consistent; True if it came.
+def write_deferring_sigint(rows, out, meta, plot) -> int:
+    """Write the outputs with Ctrl-C (and SIGTERM, which the command line takes as Ctrl-C) held
+    until they are consistent; the signal's number if one came, else 0.
 
-    results.json is written last; if Ctrl-C came meanwhile it is written again with
+    results.json is written last; if a signal came meanwhile it is written again with
     ``"complete": false`` (a figure or a log may be missing), never ``true``.
     """
     import signal
 
-    hit = []
-    try:
-        prev = signal.signal(signal.SIGINT, lambda *_: hit.append(1))
-    except ValueError:  # not the main thread: no handler to swap
-        prev = None
+    hit: list[int] = []
+    prev = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        try:
+            prev[sig] = signal.signal(sig, lambda signum, _: hit.append(signum))
+        except ValueError:  # not the main thread: no handler to swap
+            pass
     try:
         write_outputs(rows, out, meta, plot=plot, stop=lambda: bool(hit))
         if hit:
             write_outputs(rows, out, {**meta, "complete": False}, plot=False, only_json=True)
     finally:
-        if prev is not None:
-            signal.signal(signal.SIGINT, prev)
-    return bool(hit)
+        for sig, handler in prev.items():
+            signal.signal(sig, handler)
+    return int(hit[0]) if hit else 0
 
 
 OUTPUTS = ("results.json", "results.csv", "error_vs_time.png")
@@ -150,6 +153,8 @@ def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
     """
     from importlib.metadata import PackageNotFoundError, version
 
+    from cspace.io.scenario.messages import printable
+
     try:
         ver = version("ompl")
     except PackageNotFoundError:  # pragma: no cover
@@ -167,8 +172,8 @@ def ompl_logs(rows: list[dict], meta: dict | None = None) -> dict[str, str]:
         lines = [f"OMPL version {ver}", f"Experiment {_token(scen)}_t{budget:g}",
                  "2 experiment properties", f"optimum REAL = {_val(opt)}", f"budget REAL = {budget!r}",
                  f"Running on {socket.gethostname()}", f"Starting at {date}",
-                 "<<<|", f"cspace bench: scenario {scen} ({rs[0]['file']}), budget {budget:g} s, "
-                         f"error against the exact shortest path", "|>>>",
+                 "<<<|", printable(f"cspace bench: scenario {scen} ({rs[0]['file']}), budget {budget:g} s, "
+                                   "error against the exact shortest path"), "|>>>",
                  "<<<|", "|>>>", "0 is the random seed", f"{budget!r} seconds per run", "0 MB per run",
                  f"{max(len(v) for v in planners.values())} runs per planner",
                  f"{sum(r['wall_s'] or 0.0 for r in rs)!r} seconds spent to collect the data",

@@ -32,6 +32,7 @@ import sys
 import time
 
 from ..children import CAN_FORK, kill_child  # noqa: F401  (CAN_FORK: the sweep asks here)
+from .arena_file import close_claims_in_child
 
 _TAIL = 4000  # bytes of a child's stderr kept for the crash message
 
@@ -74,6 +75,8 @@ def _spawn(task, held, run_one, life_r, life_w, limit) -> dict:
     if pid == 0:  # pragma: no cover - the child
         try:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
+            signal.signal(signal.SIGTERM, signal.SIG_IGN)  # the parent ends its children (SIGTERM is its Ctrl-C)
+            close_claims_in_child()  # the campaign's claim on its database stays the parent's
             os.close(life_w)
             os.close(out_r)
             os.close(err_r)

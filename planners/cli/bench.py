@@ -13,6 +13,7 @@ from ..bench.reference import make_tasks, reference
 from ..bench.rows import HARD_FACTOR, HARD_MARGIN
 from ..bench.sweep import summary, sweep
 from ..errors import InputError
+from . import interrupt
 
 
 DEFAULT_PLANNERS = ("RRTConnect", "RRTstar", "PRMstar", "BITstar")
@@ -24,13 +25,18 @@ DEFAULT_TIMES = (0.01, 0.03, 0.1, 0.3, 1.0)
 MAX_BUDGET = 1e6  # seconds per run (11 days); OMPL's clock overflows near 8e9 s
 
 
+MAX_RUNS = 100_000  # runs in one sweep (scenes x planners x budgets x --runs): a sweep's tasks and
+# rows are held in memory, and 10^5 runs of 0.01 s already take hours; a campaign goes in parts (--db)
+
+
 def register(sub) -> None:
     import argparse
 
     p = sub.add_parser("bench", help="error against run time for OMPL planners vs the exact shortest path",
                        description="Benchmark OMPL planners: path length error against the exact shortest "
                                    "path, per time budget. Exit 0 done, 2 bad input, 130 interrupted "
-                                   "(finished rows are written).")
+                                   "(finished rows are written), 143 "
+                                   "terminated (SIGTERM, as Ctrl-C).")
     p.add_argument("scenario", nargs="+", help="scenario TOML files")
     p.add_argument("--planners", help=f"comma-separated OMPL planners or auto (default {','.join(DEFAULT_PLANNERS)}; "
                                       "with --objective clearance or balanced, those of them that take it)")
@@ -129,20 +135,49 @@ def check_inputs_kept(files: list[str], out: str) -> None:
         check_not_input(target, "--out", inputs, st)
 
 
-def check_campaign(db: str | None, log: str | None, resume: bool, out: str) -> None:
-    """--db, --log and --resume: exit 2 on a combination or a path that cannot work."""
+def check_campaign(db: str | None, log: str | None, resume: bool, out: str, files=()) -> None:
+    """--db, --log and --resume: exit 2 on a combination or a path that cannot work: the database
+    or a log over one of ``out``'s outputs or an input, the logs in ``out``'s own ``ompl`` folder."""
     from ..output import check_folder
+    from .imports import input_files
 
     if resume and not db:
         raise InputError("bench", "--resume", "needs --db (the database of the sweep to resume)")
+    inputs = [f for src in files for f in input_files(src)]
     if db is not None:
         if not db.strip() or os.path.isdir(db):
             raise InputError("bench", "--db", f"not a file name: {db!r}")
         parent = os.path.dirname(os.path.abspath(db))
         if not os.path.isdir(parent):
             raise InputError("bench", "--db", f"folder {parent} does not exist")
+        for target in [os.path.join(out, name) for name in OUTPUTS] + [os.path.join(out, "ompl")]:
+            if _same_place(db, target) or _same_place(os.path.dirname(os.path.abspath(db)), target):
+                raise InputError(db, "--db", f"is in --out's outputs ({target}); give a path outside them")
+        if log is not None and db.endswith(".log") and _same_place(os.path.dirname(os.path.abspath(db)), log):
+            raise InputError(db, "--db", f"is named like a log in --log {log}, which would write over it")
     if log is not None:
         check_folder(log, "--log")
+        if _same_place(log, os.path.join(out, "ompl")):
+            raise InputError(log, "--log", "is --out's own ompl folder, which each sweep rewrites; give another")
+        for f in inputs:
+            if f.endswith(".log") and _same_place(os.path.dirname(os.path.abspath(f)), log):
+                raise InputError(log, "--log", f"holds the input {f}, which a log of that name would replace")
+
+
+def _same_place(a: str, b: str) -> bool:
+    """Whether two paths name one file or folder (existing: by inode; else by resolved path)."""
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
+def check_size(count: int, source: str = "bench") -> None:
+    """Refuse a sweep of more than :data:`MAX_RUNS` runs (before anything is allocated for it)."""
+    if count > MAX_RUNS:
+        raise InputError(source, "--runs", f"the sweep would make {count} runs (scenes x planners x budgets x "
+                                           f"--runs), more than the bound {MAX_RUNS}: split it (--db keeps a "
+                                           "campaign's parts together)")
 
 
 def run(args) -> int:
@@ -162,6 +197,10 @@ def run(args) -> int:
         raise InputError("bench", "--workers", f"must be at least 1, got {args.workers}")
     if args.iterations is not None and args.iterations < 1:
         raise InputError("bench", "--iterations", f"must be at least 1, got {args.iterations}")
+    if args.scheduler is not None:  # its form now (an empty one is refused, not run locally); its answer later
+        from ..bench.cluster import scheduler_address
+
+        scheduler_address(args.scheduler)
     abort_on = None
     if args.abort_on:
         name, _, seed = args.abort_on.partition(":")
@@ -169,13 +208,14 @@ def run(args) -> int:
     out = args.out
     from ..output import check_folder
 
+    check_size(len(args.scenario) * len(planners) * len(times) * args.runs)
     check_folder(out, "--out")
     check_inputs_kept(args.scenario, out)
     held: dict = {}
     if args.slabs is not None and not 4 <= args.slabs <= 4096:
         raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     db, log = getattr(args, "db", None), getattr(args, "log", None)
-    check_campaign(db, log, getattr(args, "resume", False), out)
+    check_campaign(db, log, getattr(args, "resume", False), out, args.scenario)
     scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
     check_scenarios(objective, held)
     os.makedirs(out, exist_ok=True)
@@ -185,12 +225,16 @@ def run(args) -> int:
         from ..bench.campaign import Campaign
 
         campaign = Campaign(db, tasks)
-        n, every = len(tasks), tasks
-        tasks = campaign.select(tasks, getattr(args, "resume", False))
-        if len(tasks) < n:  # resumed: the stored runs are read back, so --out describes the campaign
-            stored = campaign.stored_rows(every)
-            if not args.quiet:
-                sys.stderr.write(f"--resume: {n - len(tasks)} of {n} runs already in {db}\n")
+        try:
+            n, every = len(tasks), tasks
+            tasks = campaign.select(tasks, getattr(args, "resume", False))
+            if len(tasks) < n:  # resumed: the stored runs are read back, so --out describes the campaign
+                stored = campaign.stored_rows(every)
+                if not args.quiet:
+                    sys.stderr.write(f"--resume: {n - len(tasks)} of {n} runs already in {db}\n")
+        except BaseException:
+            campaign.close()
+            raise
     t0 = time.perf_counter()
     try:
         rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
@@ -198,7 +242,9 @@ def run(args) -> int:
                                   on_batch=campaign.add if campaign else None)
     finally:
         if campaign is not None:
-            campaign.finish(log)
+            from .imports import input_files
+
+            campaign.finish(log, [f for src in args.scenario for f in input_files(src)])
     if stored:  # in the sweep's row order, as if every run had been made now
         place = {campaign.task_key(t): i for i, t in enumerate(every)}
         for r in stored:
@@ -211,9 +257,12 @@ def run(args) -> int:
     # Never mix two sweeps in one folder: an earlier sweep's outputs go only now, so a sweep
     # killed before it writes (kill -9, a power cut) leaves the earlier results whole.
     clear_outputs(out)
-    interrupted = write_deferring_sigint(rows, out, meta, plot=not args.no_plot) or interrupted
+    late = write_deferring_sigint(rows, out, meta, plot=not args.no_plot)  # a signal while writing: its number
+    interrupted = bool(late) or interrupted
     sys.stderr.write(summary(rows, scenarios) + "\n")  # the result: printed with -q too
     if not args.quiet:
         sys.stderr.write(f"{len(rows)} rows written to {out}/ in {meta['wall_s']:.1f} s"
                          + (" (interrupted)" if interrupted else "") + "\n")
-    return 130 if interrupted else 0
+    if campaign is not None:
+        campaign.check()  # a database error during the sweep: one line, exit 2, now that --out is written
+    return (128 + late if late else interrupt.exit_code()) if interrupted else 0

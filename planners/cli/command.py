@@ -183,19 +183,19 @@ def main(argv: list[str] | None = None) -> int:
         code = 2
     except KeyboardInterrupt:
         sys.stderr.write("interrupted\n")
-        code = 130
+        code = interrupt.exit_code()
     except BrokenPipeError:  # the reader went away (`cspace ... | head`): stop quietly
         _silence_stdout()
         code = 141  # 128 + SIGPIPE, as a shell reports a process killed by it
     except Exception as exc:  # a bug, not bad input: still one line unless --verbose
         if interrupt.came():  # Ctrl-C, which a library turned into another error
             sys.stderr.write("interrupted\n")
-            return 130
+            return interrupt.exit_code()
         if getattr(args, "verbose", False):  # the traceback, and still "internal error", not "not solved"
             traceback.print_exc()
             return 3
-        sys.stderr.write(f"internal error: {type(exc).__name__}: {clip(str(exc), 240)} "
-                         "(run with --verbose for the traceback)\n")
+        hint = "run with --verbose for the traceback" if hasattr(args, "verbose") else "a bug: please report it"
+        sys.stderr.write(f"internal error: {type(exc).__name__}: {clip(str(exc), 240)} ({hint})\n")
         code = 3
     return code
 
@@ -258,7 +258,7 @@ def console() -> None:
 
 def _interrupted() -> int:
     sys.stderr.write("interrupted\n")
-    return 130
+    return interrupt.exit_code()
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -15,6 +15,10 @@ lands. Two kinds of frame cannot take it:
   delivered at the next call or return outside the hook (or when the import it came in
   returns), silently; every other unraisable error goes to the hook that was there before.
 
+SIGTERM (how batch systems and ``kill`` end a job) is taken as a Ctrl-C: the same
+KeyboardInterrupt, so a command stops as it does on Ctrl-C (``cspace bench`` writes its
+finished rows), and its exit code is 143 (128 + SIGTERM) instead of 130 (:func:`exit_code`).
+
 Delivering goes to whichever SIGINT handler is current by then (the planning routine's
 own handler stops OMPL's planners cleanly, for instance). Where the profile hook is not
 ours to use (a profiler runs), Python's own behaviour stands: a Ctrl-C raises at once,
@@ -30,7 +34,7 @@ import signal
 import sys
 
 _MODULE = globals()
-_state = {"came": False, "held": False, "previous_hook": None}
+_state = {"came": False, "held": False, "previous_hook": None, "signum": signal.SIGINT}
 
 
 def came() -> bool:
@@ -38,11 +42,21 @@ def came() -> bool:
     return _state["came"]
 
 
+def exit_code() -> int:
+    """The exit code of an interrupted command: 130 after Ctrl-C, 143 after SIGTERM.
+
+    >>> exit_code()
+    130
+    """
+    return 128 + int(_state["signum"])
+
+
 def install() -> bool:
-    """Take SIGINT (KeyboardInterrupt, held through imports) and KeyboardInterrupts lost in
-    callbacks. Returns False off the main thread, where no handler can be set."""
+    """Take SIGINT and SIGTERM (KeyboardInterrupt, held through imports) and KeyboardInterrupts
+    lost in callbacks. Returns False off the main thread, where no handler can be set."""
     try:
         signal.signal(signal.SIGINT, _on_sigint)
+        signal.signal(signal.SIGTERM, _on_sigterm)
     except ValueError:  # not the main thread
         return False
     if _state["previous_hook"] is None:
@@ -55,9 +69,15 @@ def release() -> None:
     """The exit code is known: ignore a later Ctrl-C and drop one still held."""
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
     except ValueError:
         return
     _end_hold()
+
+
+def _on_sigterm(signum, frame):
+    _state["signum"] = signal.SIGTERM
+    _on_sigint(signum, frame)
 
 
 def _on_sigint(signum, frame):

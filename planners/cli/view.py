@@ -97,7 +97,7 @@ def run(args) -> int:
         count_as_load(res, import_s)
     print(summary(res, verbose=args.verbose))
     t0 = time.perf_counter()
-    write_view(res, args.out, poses=args.poses, angles=args.angles, compress=not args.no_compress)
+    write_view(res, args.out, poses=args.poses, angles=args.angles, compress=not args.no_compress, option="--out")
     if args.verbose:
         print(f"page: {args.out} written in {time.perf_counter() - t0:.2f} s")
     return 0 if res.solved else 1

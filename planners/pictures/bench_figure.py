@@ -156,6 +156,7 @@ def figure_error_vs_time(rows: list[dict]):
     import matplotlib
 
     matplotlib.use("Agg")
+    matplotlib.rcParams["text.parse_math"] = False  # a scene's name is text, never mathtext ($...$)
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 

@@ -9,6 +9,7 @@ def plot_stability(rows: list[dict], path: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
+    matplotlib.rcParams["text.parse_math"] = False  # a scene's name is text, never mathtext ($...$)
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(max(8, 0.18 * len(rows)), 5))

@@ -43,6 +43,7 @@ STATS: dict = {"cases": 0, "exit": Counter(), "slowest_s": 0.0, "slowest": "", "
 KEEP = os.environ.get("CSPACE_FUZZ_KEEP")
 FAILURES: list = []  # (label, why, folder) of each kept case
 FILES = {"map": 0, "mesh": 0}  # imported files written per input kind
+LAST: dict = {"stderr": ""}  # the last case's stderr (for a test's own checks after check_case)
 
 
 def budget(small: int):
@@ -83,7 +84,7 @@ def check_case(argv: list, folder: str, inputs: list, label: str, json_out: str 
         signal.signal(signal.SIGALRM, old)
     dt = time.perf_counter() - t0
     _record(label, code, dt, argv)
-    text = err.getvalue()
+    text = LAST["stderr"] = err.getvalue()
     assert code in (0, 1, 2), f"exit {code} for {_short(argv)}: {text[-500:]}"
     assert "Traceback" not in text and "internal error" not in text, text[-500:]
     if code == 2:

@@ -203,3 +203,21 @@ def test_the_command_holds_a_ctrl_c_that_lands_inside_a_librarys_import(tmp_path
     out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True,
                          text=True, timeout=120)
     assert (out.returncode, out.stderr) == (130, "interrupted\n"), out.stderr[-2000:]
+
+
+def test_sigterm_is_taken_as_ctrl_c_inside_an_import_too(tmp_path):
+    # SIGTERM (how batch systems end a job) goes the same way as Ctrl-C, held through an import,
+    # and the command's exit code says which came: 143
+    out = run(tmp_path, "import os", "import slow_module", module="""
+        import os, signal, time
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(0.05)
+        DONE = True
+        """)
+    assert out.stdout.split() == ["interrupted", "True", "True"], out.stderr[-2000:]
+    code = ("from planners.cli import interrupt; import os, signal, time\n"
+            "assert interrupt.install()\n"
+            "try:\n    os.kill(os.getpid(), signal.SIGTERM); time.sleep(1)\n"
+            "except KeyboardInterrupt:\n    print(interrupt.exit_code())\n")
+    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert r.stdout.strip() == "143", r.stderr[-2000:]

@@ -7,6 +7,34 @@ unknown key names the closest known one (:func:`unknown_field_message`).
 from __future__ import annotations
 
 import difflib
+import re
+
+# Characters a terminal or a line-based log would act on rather than show: C0 and C1 controls
+# (escape sequences recolour a terminal, a newline starts a new log line) and DEL, and the
+# bidirectional overrides and isolates (they reorder what a reader sees).
+CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u200e\u200f\u202a-\u202e\u2066-\u2069]")
+_NAMED = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def printable(text: str) -> str:
+    r"""``text`` with every control character written as an escape (``\x1b``, ``\n``, ``\u202e``):
+    safe to print on a terminal and as one line of a log.
+
+    >>> printable("red \x1b[31m\nline")
+    'red \\x1b[31m\\nline'
+    """
+    return CONTROL.sub(lambda m: _NAMED.get(m.group(), m.group().encode("unicode_escape").decode("ascii")),
+                       str(text))
+
+
+def control_character(text: str) -> str | None:
+    r"""The first control character of ``text`` (see :func:`printable`) as an escape, or None.
+
+    >>> control_character("a\x1bb"), control_character("plain")
+    ('\\x1b', None)
+    """
+    m = CONTROL.search(str(text))
+    return None if m is None else printable(m.group())
 
 
 class ScenarioError(ValueError):
@@ -26,7 +54,7 @@ def clip(text: str, limit: int = 120) -> str:
     >>> clip("x" * 1000, 10)
     'xxxxxxxxxx... (990 more characters)'
     """
-    text = text.replace("\n", "\\n").replace("\r", "\\r")
+    text = printable(text)
     return text if len(text) <= limit else f"{text[:limit]}... ({len(text) - limit} more characters)"
 
 

@@ -11,7 +11,7 @@ import os
 
 from ...kernel.polygons.disk import DEFAULT_RELATIVE_ERROR
 from ...kernel.polygons.rotation import wrap_angle
-from .messages import ScenarioError, short
+from .messages import ScenarioError, control_character, printable, short
 from .probe import CollisionProbe
 from .schema import (CAR_SPACES, MAX_ROTATING_VERTICES, MAX_SLABS, MIN_EXTENT, ROTATING_SPACES, SPACES,
                      TURNING_RADIUS_RANGE, Scenario)
@@ -29,9 +29,14 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
     ``space`` and ``turning_radius``, if given, override the document's."""
     v = _Validator(path)
     v.no_extra(data, "", TOP_LEVEL_KEYS)
-    name = data.get("name", os.path.splitext(os.path.basename(path))[0])
-    if not isinstance(name, str):
+    name = data.get("name")
+    if name is None:  # the file's name: shown as it is spelt, its control characters escaped
+        name = printable(os.path.splitext(os.path.basename(path))[0])
+    elif not isinstance(name, str):
         raise v.err("name", "must be a string")
+    elif control_character(name) is not None:  # it would act on a terminal and break a log's lines
+        raise v.err("name", f"contains the control character {control_character(name)} (names are printed "
+                            "on terminals and written in logs)")
     expect = data.get("expect", "solvable")
     if expect not in ("solvable", "unsolvable"):
         raise v.err("expect", 'must be "solvable" or "unsolvable"')

@@ -4,7 +4,14 @@ slab at that angle), the path, the robot's footprint moving along it (play / pau
 over the path), the closest approach and, for a proof that no path exists, its components.
 
 Frames update only the traces they name: ``pose-I`` the moving footprint, ``slab-K`` the
-C-obstacles (and the proof's components), so the two sliders are independent.
+C-obstacles (and the proof's components), so the two sliders are independent. A pose frame
+draws the footprint with at most :data:`MOVING_VERTICES` vertices (a finely approximated disk
+would otherwise repeat its thousands of vertices in every frame), and a figure of more than
+:data:`MAX_POINTS` points is refused (exit 2) rather than written as a page no browser opens.
+
+Every text of the figure is plotly's HTML subset (``<a href>``, ``<span style>``, ``<br>``): the
+strings that reach it (the scene's name in the title, names, hover texts, labels) are escaped
+(:func:`escape_texts`), so a name is shown as it is spelt, never as markup.
 """
 from __future__ import annotations
 
@@ -19,6 +26,56 @@ from . import traces as tr
 DEFAULT_POSES = 120  # frames of the robot along the path
 DEFAULT_ANGLES = 32  # steps of the angle slider (rotating robots and cars)
 POSE_FRAME_MS = 40  # play: 25 frames a second
+MOVING_VERTICES = 240  # vertices of the footprint in a pose frame (decimated beyond)
+MAX_POINTS = 1_500_000  # points a page may draw in all (traces and frames): about 25 MB of figure
+TEXT_KEYS = frozenset({"text", "name", "hovertext", "label", "prefix", "suffix"})  # plotly markup
+
+
+def plotly_text(text: str) -> str:
+    """``text`` with plotly's markup characters escaped: shown as written, never as a tag.
+
+    >>> plotly_text('<a href="http://x">y</a> & z')
+    '&lt;a href="http://x"&gt;y&lt;/a&gt; &amp; z'
+    """
+    return str(text).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def escape_texts(node):
+    """Escape (:func:`plotly_text`) every string under a text key of a figure (dicts and lists
+    walked, coordinate arrays skipped), in place; returns ``node``.
+
+    >>> escape_texts({"layout": {"title": {"text": "<b>x</b>"}}, "data": [{"x": [1], "name": "a<b"}]})
+    {'layout': {'title': {'text': '&lt;b&gt;x&lt;/b&gt;'}}, 'data': [{'x': [1], 'name': 'a&lt;b'}]}
+    """
+    if isinstance(node, dict):
+        for key, value in node.items():
+            if key in ("x", "y"):
+                continue
+            if key in TEXT_KEYS and isinstance(value, str):
+                node[key] = plotly_text(value)
+            elif key in TEXT_KEYS and isinstance(value, list) and all(isinstance(v, str) for v in value):
+                node[key] = [plotly_text(v) for v in value]
+            else:
+                escape_texts(value)
+    elif isinstance(node, list):
+        for item in node:
+            if isinstance(item, (dict, list)):
+                escape_texts(item)
+    return node
+
+
+def points(traces) -> int:
+    """Points drawn by traces (their x arrays' lengths)."""
+    return sum(len(t.get("x") or ()) for t in traces)
+
+
+def check_size(count: int) -> None:
+    """Refuse a figure of more than :data:`MAX_POINTS` points (bad input: exit 2)."""
+    if count > MAX_POINTS:
+        from ...errors import InputError
+
+        raise InputError("page", "size", f"the page would draw {count} points, more than the bound {MAX_POINTS}: "
+                                         "lower --poses or --angles, or coarsen the scene (disk_tolerance)")
 
 
 def figure_dict(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DEFAULT_ANGLES) -> dict:
@@ -60,10 +117,12 @@ def figure_dict(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DE
 
         data += tr.gap_traces(narrowest_gap_of_paths(cs.pieces, cs.bounds,
                                                      [r.path for r in (res.queries or [res]) if r.solved]), nd)
+    check_size(points(data) + sum(points(f["data"]) for f in frames))
     if dense is not None:
         moving = len(data)
         along = pick_poses(sc, res, dense, poses)
         data += moving_traces(sc, along[0], nd)
+        check_size(points(data) + sum(points(f["data"]) for f in frames) + (len(along) - 1) * points(data[moving:]))
         frames += [{"name": f"pose-{i}", "traces": [moving, moving + 1], "data": moving_traces(sc, q, nd)}
                    for i, q in enumerate(along)]
         sliders.insert(0, pose_slider(along))
@@ -71,7 +130,7 @@ def figure_dict(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DE
     if len(sliders) == 1 and sliders[0]["name"] == "angle":  # no path: the angle slider goes up
         sliders[0]["pad"] = {"t": 50}
     layout = scene_layout(sc, res, sliders, menus)
-    return {"data": data, "layout": layout, "frames": frames}
+    return escape_texts({"data": data, "layout": layout, "frames": frames})
 
 
 def pick_poses(sc, res, dense: np.ndarray, count: int) -> np.ndarray:
@@ -95,7 +154,7 @@ def moving_traces(sc, pose, nd: int) -> list[dict]:
     >>> [t["name"] for t in moving_traces(tr.example_scene(), (1.0, 2.0), 3)]
     ['robot moving along the path', 'reference point']
     """
-    robot = tr.robot_trace("robot moving along the path", sc, pose, PATH, nd, opacity=0.55)
+    robot = tr.robot_trace("robot moving along the path", sc, pose, PATH, nd, opacity=0.55, limit=MOVING_VERTICES)
     th = f", θ = {math.degrees(float(pose[2])):.1f}°" if len(pose) > 2 else ""
     dot = {"type": "scatter", "mode": "markers", "name": "reference point",
            "x": [round(float(pose[0]), nd)], "y": [round(float(pose[1]), nd)], "showlegend": False,
@@ -124,7 +183,7 @@ def angle_frames(sc, res, nd: int, angles: int, index: int) -> tuple[list, dict 
         se2 = SE2CSpace.from_scenario(sc, slabs=sc.slabs)
     K = se2.slabs
     proof = (res.proof or {}).get("slabs") or []
-    steps, frames, seen = [], [], {}
+    steps, frames, seen, drawn = [], [], {}, 0
     for j in range(max(angles, 1)):
         th = -math.pi + (j + 0.5) * 2.0 * math.pi / max(angles, 1)
         k = slab_of(th, K) if K > 1 else 0
@@ -132,6 +191,8 @@ def angle_frames(sc, res, nd: int, angles: int, index: int) -> tuple[list, dict 
         if k not in seen:
             seen[k] = len(frames)
             frames.append({"name": name, "traces": [index, index + 1], "data": slab_traces(se2, k, proof, th, nd)})
+            drawn += points(frames[-1]["data"])
+            check_size(drawn)  # as the frames grow, not once they are all built
         a, b = slab_range(k, K) if K > 1 else (-math.pi, math.pi)
         steps.append({"label": f"{math.degrees(th):.0f}°", "method": "animate",
                       "args": [[name], {"mode": "immediate", "frame": {"duration": 0, "redraw": True},

@@ -7,7 +7,8 @@ drawn (``data-drawn-ms`` on the body: milliseconds since the navigation started)
 ``#state`` (the current frame, the sliders' positions) up to date. A URL
 hash drives the controls, for links and scripted screenshots (read at load and on every
 change): ``#pose=I`` or ``#angle=J`` moves that slider to step I (J) as a click on the step
-does, ``#play`` clicks the play button.
+does (I clamped to the slider's steps; a value that is not a number is ignored), ``#play``
+clicks the play button.
 """
 from __future__ import annotations
 
@@ -62,8 +63,9 @@ async function follow(gd, hash) {
   const args = new URLSearchParams(hash.replace(/^#/, ""));
   for (const name of ["pose", "angle"]) {
     if (!args.has(name) || sliderIndex(gd, name) < 0) continue;  // no path, or no angle: nothing to move
-    const s = gd.layout.sliders[sliderIndex(gd, name)];
-    const step = s.steps[Math.min(Number(args.get(name)), s.steps.length - 1)];
+    const s = gd.layout.sliders[sliderIndex(gd, name)], wanted = Number(args.get(name).trim() || NaN);
+    if (!Number.isFinite(wanted)) continue;  // #pose=abc: not a step, the slider stays
+    const step = s.steps[Math.max(0, Math.min(Math.round(wanted), s.steps.length - 1))];  // clamped
     await Plotly.animate(gd, step.args[0], step.args[1]);
   }
   const button = gd.querySelector(".updatemenu-button");  // none without a path
@@ -206,8 +208,9 @@ def view_html(res, scenario=None, poses: int = DEFAULT_POSES, angles: int = DEFA
 
 
 def write_view(res, out: str, scenario=None, poses: int = DEFAULT_POSES, angles: int = DEFAULT_ANGLES,
-               compress: bool = True, extra: str = "") -> None:
-    """Write :func:`view_html` to ``out``, atomically (a temporary file, then a rename).
+               compress: bool = True, extra: str = "", option: str = "--html") -> None:
+    """Write :func:`view_html` to ``out``, atomically (a temporary file, then a rename); a fault
+    (a page over the size bound, a full disk) is an error on ``option``, the option naming ``out``.
 
     >>> import os, tempfile, planners
     >>> from planners.pictures.view.traces import example_scene
@@ -216,4 +219,10 @@ def write_view(res, out: str, scenario=None, poses: int = DEFAULT_POSES, angles:
     >>> os.path.getsize(out) > 1_000_000
     True
     """
-    write_text(out, view_html(res, scenario, poses=poses, angles=angles, compress=compress, extra=extra), "--out")
+    from ...errors import InputError
+
+    try:
+        page = view_html(res, scenario, poses=poses, angles=angles, compress=compress, extra=extra)
+    except InputError as exc:  # the figure's own refusal (its size), said of the page's file
+        raise InputError(out, option, exc.message) from None
+    write_text(out, page, option)
