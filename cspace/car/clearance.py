@@ -49,13 +49,16 @@ def robot_radius(robot_pieces: list) -> float:
 
 
 def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces: list, obstacle_pieces: list,
-                       tol: float | None = None, max_samples: int = MAX_SAMPLES) -> PathClearance:
+                       tol: float | None = None, max_samples: int = MAX_SAMPLES,
+                       nearest: Nearest | None = None) -> PathClearance:
     """A certified lower bound of a car's clearance along ``path`` (module docstring).
 
     ``path`` is (N, 3) poses joined by the curves ``segments_of(q0, q1)`` returns
     ((kind, signed length) segments, :mod:`cspace.car.curves`) for the turning
     ``radius``; ``robot_pieces`` are convex, in the body frame. ``tol``: the slack aimed at
-    (default :data:`TOL` x max(radius, robot radius)).
+    (default :data:`TOL` x max(radius, robot radius)). ``nearest``: a :class:`Nearest` of
+    ``obstacle_pieces`` kept by the caller; only the pieces near the curves are searched
+    (:func:`near_curves`).
 
     >>> from cspace.car.curves import dubins_segments
     >>> box = [np.array([[-0.5, -0.25], [0.5, -0.25], [0.5, 0.25], [-0.5, 0.25]])]
@@ -66,7 +69,8 @@ def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces:
     ('lower', True)
     """
     poses = np.asarray(path, dtype=np.float64).reshape(-1, 3)
-    obs = Nearest(obstacle_pieces)
+    obs = nearest if nearest is not None else Nearest(obstacle_pieces)
+    cap = [math.inf]  # every distance measured is capped there (near_curves)
     rob = [np.asarray(p, dtype=np.float64) for p in robot_pieces] or [np.zeros((1, 2))]
     r = float(radius)
     rho = robot_radius(rob)
@@ -82,7 +86,7 @@ def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces:
             d, k, wk = obs.nearest(rotate(p, th) + (x, y), best)
             if k >= 0 and (d < best or w is None):
                 best, w = d, wk
-        return best, w
+        return min(best, cap[0]), w
 
     # The curve's segments: (motion index, pose at the segment's start, kind, signed length).
     parts = []
@@ -98,6 +102,10 @@ def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces:
     if not parts:  # one pose, or poses all equal: the robot stands still
         d, w = at(tuple(poses[0]))
         return PathClearance(float(d), tuple(float(v) for v in poses[0]), _point(w), 0, "lower")
+
+    first = at(tuple(poses[0]))[0]  # the robot at the first pose: the clearance is at most that
+    if math.isfinite(first):
+        obs, cap[0] = near_curves(obs, parts, poses, r, rho + max(joins.values(), default=0.0), first), first
 
     def pose(j: int, s: float) -> tuple:
         _, k0, kind, length = parts[j]
@@ -144,6 +152,24 @@ def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces:
     where = (x, y, wrap_angle(th))
     w = e0[1] if e0[0] <= e1[0] else e1[1]
     return PathClearance(float(lb), tuple(float(v) for v in where), _point(w), parts[j][0], "lower")
+
+
+def near_curves(obs: Nearest, parts: list, poses: np.ndarray, r: float, rho: float, first: float) -> Nearest:
+    """The obstacle pieces within ``first`` of the box that holds the robot driven along the
+    curves: the segments' start poses (``parts``' second items) and the path's poses, grown by
+    2 r (an arc stays within 2 r of its start) and ``rho`` (the robot about its reference point).
+    A piece left out is farther than ``first`` from the robot everywhere on the path, so a
+    distance measured without it is exact where it is at most ``first`` and above ``first``
+    otherwise: capped at ``first`` (the measure's caller does), it is a lower bound of the true
+    one everywhere, which is all the bound's Lipschitz argument needs.
+
+    >>> far = Nearest([np.array([[0., 2], [6, 2], [6, 3], [0, 3]]), np.array([[90., 0], [91, 0], [91, 1]])])
+    >>> len(near_curves(far, [(0, (1.0, 0.0, 0.0), "S", 4.0)], np.array([[1., 0, 0], [5, 0, 0]]), 1.0, 0.5, 1.75).pieces)
+    1
+    """
+    pts = np.vstack([np.array([p[1][:2] for p in parts], dtype=np.float64).reshape(-1, 2), poses[:, :2]])
+    grow = 2.0 * r + rho + 2.0**-30 * (r + rho + float(np.abs(pts).max()))
+    return obs.within(pts.min(axis=0) - grow, pts.max(axis=0) + grow, first)
 
 
 def _point(w) -> tuple:
