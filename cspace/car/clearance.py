@@ -11,7 +11,9 @@ places on the segment (each point of the robot moves that little), so over an in
 
     d(s) ≥ max(d0 − lip (s − s0), d1 − lip (s1 − s)) ≥ (d0 + d1 − lip (s1 − s0)) / 2.
 
-That is each interval's lower bound; the path's is the least over intervals covering every
+That is an arc's interval's lower bound. A straight's is exact at once: each convex robot
+piece translates at one heading, so over [s0, s1] it sweeps exactly the hull of its two
+placements, whose GJK distance is the interval's least (slack 0). The path's bound is the least over intervals covering every
 segment of every motion (and over the joins from a curve's end to its target pose, which a
 Dubins curve may miss by a few 1e-6 radii: the distance at the curve's end less the most a
 robot point moves over the join). Intervals are split best-first (the one of smallest bound first,
@@ -115,17 +117,30 @@ def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces:
     count = 0
     upper = math.inf  # the least distance measured: the true clearance is at most that
 
+    def straight(j: int, s0: float, s1: float) -> float:
+        """The least distance over [s0, s1] of a straight segment, exactly (up to GJK's rounding):
+        each robot piece translates at one heading, so it sweeps the hull of its two placements."""
+        (x0, y0, th), (x1, y1, _) = pose(j, s0), pose(j, s1)
+        best = math.inf
+        for p in rob:
+            q = rotate(p, th)
+            best = min(best, obs.nearest(np.vstack([q + (x0, y0), q + (x1, y1)]), best)[0])
+        return min(best, cap[0])
+
     def push(j: int, s0: float, s1: float, e0: tuple, e1: tuple) -> None:
         nonlocal count
-        lip = 1.0 if parts[j][2] == "S" else 1.0 + rho / r
-        lb = max(0.0, min(e0[0], e1[0], 0.5 * (e0[0] + e1[0] - lip * (s1 - s0))))
         count += 1
+        if parts[j][2] == "S":  # the swept hull's distance: the interval's exact least, no slack
+            heapq.heappush(heap, (max(0.0, straight(j, s0, s1)), count, j, s0, s1, 0.0, e0, e1))
+            return
+        lip = 1.0 + rho / r
+        lb = max(0.0, min(e0[0], e1[0], 0.5 * (e0[0] + e1[0] - lip * (s1 - s0))))
         heapq.heappush(heap, (lb, count, j, s0, s1, 0.5 * lip * (s1 - s0), e0, e1))
 
     for j, (_, k0, kind, length) in enumerate(parts):
         lip = 1.0 if kind == "S" else 1.0 + rho / r
         n = max(1, math.ceil(abs(length) * lip / (INITIAL * tol)))  # coarse first, refined where it matters
-        n = min(n, 64)
+        n = 1 if kind == "S" else min(n, 64)  # (a straight's bound is exact at once)
         cuts = [abs(length) * m / n for m in range(n + 1)]
         ends = [at(pose(j, s)) for s in cuts]
         upper = min([upper] + [e[0] for e in ends])
