@@ -149,7 +149,7 @@ def test_se2_clearance_near_the_path_is_the_same_bound(seed, monkeypatch):
     path = np.array([[50.0, 50.0, 0.0], [53.0, 51.0, 1.0], [55.0, 49.0, -2.0]])
     path[:, :2] += rng.uniform(-20, 20, size=2)
     near = se2_clearance.se2_path_clearance(path, robot, obstacles, nearest=Nearest(obstacles))
-    monkeypatch.setattr(se2_clearance, "near_path", lambda obs, poses, rob: obs)
+    monkeypatch.setattr(se2_clearance, "near_path", lambda obs, poses, rob: [obs] * max(1, len(poses) - 1))
     every = se2_clearance.se2_path_clearance(path, robot, obstacles)
     assert near == every
 
@@ -171,7 +171,7 @@ def test_car_clearance_near_the_curves_is_a_lower_bound_within_tol(seed, monkeyp
         return reeds_shepp_segments(a, b, r)
 
     near = car_path_clearance(path, segs, r, robot, obstacles, nearest=Nearest(obstacles))
-    monkeypatch.setattr(car_clearance, "near_curves", lambda obs, *a: obs)
+    monkeypatch.setattr(car_clearance, "near_curves", lambda obs, parts, *a: [obs] * len(parts))
     every = car_path_clearance(path, segs, r, robot, obstacles)
     tol = car_clearance.TOL * max(r, 0.4)
     assert abs(near.distance - every.distance) <= tol
@@ -187,3 +187,32 @@ def test_car_clearance_near_the_curves_is_a_lower_bound_within_tol(seed, monkeyp
                 c, s = math.cos(th), math.sin(th)
                 placed = shapely.Polygon(robot[0] @ np.array([[c, s], [-s, c]]) + (x, y))
                 assert near.distance <= placed.distance(union) + 1e-9
+
+
+@pytest.mark.parametrize("kind,length,wall_y", [("L", 1.2, 1.3), ("R", -0.9, -1.1), ("L", -2.0, 1.1), ("R", 2.5, 0.3)])
+def test_car_arc_bound_is_sound_and_tight(kind, length, wall_y):
+    """One arc beside a wall: the bound is never above the distance at 2000 placements along it,
+    and within the tolerance (plus the placements' spacing) of their least."""
+    from cspace.car.curves import advance
+    import cspace.car.clearance as car_clearance
+
+    r = 0.8
+    robot = [rect(-0.3, -0.25, 0.3, 0.25)]
+    wall = [rect(-3, wall_y, 3, wall_y + 0.5)] if wall_y > 0 else [rect(-3, wall_y - 0.5, 3, wall_y)]
+    start = (0.0, 0.0, 0.3)
+    end = advance(start, kind, length, r)
+    path = np.array([start, end])
+
+    def segs(a, b):
+        return [(kind, length)] if tuple(a) == start else []
+
+    c = car_path_clearance(path, segs, r, robot, wall)
+    union = shapely.Polygon(wall[0])
+    dense = math.inf
+    for f in np.linspace(0.0, 1.0, 2001):
+        x, y, th = advance(start, kind, f * length, r)
+        cs, sn = math.cos(th), math.sin(th)
+        dense = min(dense, shapely.Polygon(robot[0] @ np.array([[cs, sn], [-sn, cs]]) + (x, y)).distance(union))
+    lip = 1.0 + 0.4 / r
+    assert c.distance <= dense + 1e-9
+    assert dense - c.distance <= car_clearance.TOL * r + lip * abs(length) / 2000
