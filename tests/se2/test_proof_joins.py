@@ -216,3 +216,14 @@ def test_car_arc_bound_is_sound_and_tight(kind, length, wall_y):
     lip = 1.0 + 0.4 / r
     assert c.distance <= dense + 1e-9
     assert dense - c.distance <= car_clearance.TOL * r + lip * abs(length) / 2000
+
+
+def test_the_bench_warms_the_proof_for_its_forked_runs():
+    """cspace bench forks its runs from one held C-space: the proof before sampling's structures are
+    built there once (their work in a child would be lost when it exits)."""
+    from planners.bench.reference import warmed
+
+    for name in ("se2/wide_square.toml", "car/" + sorted(os.listdir(os.path.join(ROOT, "car")))[0]):
+        sc = load_scenario(os.path.join(ROOT, name))
+        cs, _ = warmed(sc)
+        assert exact_se2.proof_joins(cs, build=False)
