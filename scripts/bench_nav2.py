@@ -31,7 +31,9 @@ Targets (issue 47): preparation <= 2 s; SE(2) and Reeds-Shepp mean <= 45 ms, p95
 every query answered, 0 colliding. The machine may be shared: CPU time is the figure, wall beside.
 
 Usage: python scripts/bench_nav2.py --nav2 DIR [--pairs N] [--spaces se2,reeds-shepp,dubins] [--time S]
-       [--no-peer] [--json FILE]
+       [--no-peer] [--quick] [--json FILE]
+(``--nav2`` defaults to the environment's NAV2_DIR; with neither, nothing is run: the map is
+another project's, never bundled. ``--quick``: 10 pairs.)
 """
 from __future__ import annotations
 
@@ -214,8 +216,10 @@ def prepare_space(yaml_path: str, space: str, first):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--nav2", required=True, help="a navigation2 checkout, or the folder of 100by100_20.yaml")
+    ap.add_argument("--nav2", default=os.environ.get("NAV2_DIR"),
+                    help="a navigation2 checkout, or the folder of 100by100_20.yaml (default: $NAV2_DIR)")
     ap.add_argument("--pairs", type=int, default=100)
+    ap.add_argument("--quick", action="store_true", help="10 pairs")
     ap.add_argument("--spaces", default="se2,reeds-shepp,dubins")
     ap.add_argument("--time", type=float, default=10.0, help="time limit per query (s), every method")
     ap.add_argument("--no-peer", action="store_true", help="skip OMPL + coal")
@@ -224,6 +228,11 @@ def main(argv=None) -> int:
     spaces = [s for s in args.spaces.split(",") if s]
     if not spaces or set(spaces) - {"se2", "reeds-shepp", "dubins"}:
         ap.error(f"--spaces: se2, reeds-shepp and/or dubins, got {args.spaces!r}")
+    if not args.nav2:
+        print("Nav2's map not given (--nav2 DIR or NAV2_DIR: a navigation2 checkout): nothing run")
+        return 0
+    if args.quick:
+        args.pairs = min(args.pairs, 10)
     yaml_path = find_map(args.nav2)
     peer = not args.no_peer
     if peer:
