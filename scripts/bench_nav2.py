@@ -291,11 +291,13 @@ def main(argv=None) -> int:
         n = len(pairs)
         p = rows["plan"]
         mean, p95 = statistics.mean(p["cpu"]), pct(p["cpu"], 95)
-        met = prep["cpu"] <= 2 and mean <= 0.045 and p95 <= 0.1 and p["answered"] == n and p["colliding"] == 0
+        checks = {"preparation <= 2 s": prep["cpu"] <= 2, "mean <= 45 ms": mean <= 0.045, "p95 <= 100 ms": p95 <= 0.1,
+                  "all answered": p["answered"] == n, "0 colliding": p["colliding"] == 0}
+        met = "; ".join(f"{k} {'met' if v else 'MISSED'}" for k, v in checks.items())
         print(f"  ours, plan() (default planner): {p['answered']}/{n} answered ({p['solved']} paths); CPU mean "
               f"{mean * 1e3:.1f} ms, p95 {p95 * 1e3:.1f} ms, median {pct(p['cpu'], 50) * 1e3:.1f} ms (wall mean "
               f"{statistics.mean(p['wall']) * 1e3:.1f} ms, p95 {pct(p['wall'], 95) * 1e3:.1f} ms); colliding {p['colliding']}"
-              + ("" if car and space == "dubins" else f"; targets {'met' if met else 'MISSED'}"))
+              + ("" if space == "dubins" else f"\n  targets (CPU): {met}"))
         f = rows["first"]
         print(f"  ours, first certified path (proof + RRTConnect, unsimplified): {f['solved']}/{n}; CPU mean "
               f"{statistics.mean(f['cpu']) * 1e3:.1f} ms, p95 {pct(f['cpu'], 95) * 1e3:.1f} ms; colliding {f['colliding']}")
