@@ -108,6 +108,23 @@ class Nearest:
         """The distance from conv(pts) to the nearest piece (inf without pieces)."""
         return float(self.nearest(pts)[0])
 
+    def within(self, lo, hi, reach: float) -> "Nearest":
+        """The pieces whose boxes come within ``reach`` of the box [lo, hi], as a Nearest: every
+        other piece is farther than ``reach`` from any set inside that box (a box gap is a lower
+        bound of the distance), so a path's measure asks only its neighbourhood.
+
+        >>> near = Nearest([np.array([[4., 4], [6, 4], [6, 6], [4, 6]]), np.array([[40., 0], [41, 0], [41, 1]])])
+        >>> len(near.within((0.0, 0.0), (1.0, 1.0), 5.0).pieces), len(near.within((0.0, 0.0), (1.0, 1.0), 1.0).pieces)
+        (1, 0)
+        """
+        if not len(self.pieces):
+            return self
+        gap = np.maximum(np.maximum(self.lo - np.asarray(hi, dtype=np.float64),
+                                    np.asarray(lo, dtype=np.float64) - self.hi), 0.0)
+        # (the slack covers hypot's rounding: a piece on the edge of the reach is kept)
+        keep = np.flatnonzero(np.hypot(gap[:, 0], gap[:, 1]) <= reach * (1.0 + 2.0**-40))
+        return Nearest([self.pieces[k] for k in keep.tolist()])
+
 
 class EdgeDistance:
     """Float distance from a point or a segment to the nearest edge of convex pieces, all

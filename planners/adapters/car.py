@@ -61,9 +61,10 @@ class CarSpace(SE2Space):
         """A certified lower bound of the clearance of the ROBOT (body pieces, not inflated)
         driven along the curves of ``path`` (:func:`cspace.car.clearance.car_path_clearance`)."""
         from cspace.car.clearance import car_path_clearance
+        from .frame import obstacle_nearest
 
         return car_path_clearance(path, self.segments, self.radius, self.cspace.body_pieces,
-                                  self.cspace.obstacle_pieces)
+                                  self.cspace.obstacle_pieces, nearest=obstacle_nearest(self.cspace))
 
     # ---------------------------------------------------------------- curves
 

@@ -7,8 +7,11 @@ OMPL's base module as an argument).
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
+
+_NEAREST: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> its obstacles' Nearest
 
 
 def frame_exponent(bounds) -> int:
@@ -77,3 +80,20 @@ def path_length(path: np.ndarray) -> float:
     if len(path) < 2:
         return 0.0
     return float(np.hypot(*np.diff(path[:, :2], axis=0).T).sum())
+
+
+def obstacle_nearest(cspace):
+    """The :class:`cspace.translation.clearance.Nearest` of a C-space's obstacle pieces, made on
+    first use and kept with the C-space: the clearance measures of its many paths share it.
+
+    >>> from cspace.se2.cspace import SE2CSpace
+    >>> cs = SE2CSpace((0, 10, 0, 10), [np.array([[4., 4], [6, 4], [6, 6], [4, 6]])], [np.array([[0., 0], [1, 0], [0, 1]])])
+    >>> obstacle_nearest(cs) is obstacle_nearest(cs), len(obstacle_nearest(cs).pieces)
+    (True, 1)
+    """
+    from cspace.translation.clearance import Nearest
+
+    near = _NEAREST.get(cspace)
+    if near is None:
+        near = _NEAREST[cspace] = Nearest(cspace.obstacle_pieces)
+    return near

@@ -65,8 +65,10 @@ class SE2Space:
         """A certified lower bound of the clearance of the ROBOT (body pieces, not inflated)
         along ``path`` (:func:`cspace.se2.clearance.se2_path_clearance`)."""
         from cspace.se2.clearance import se2_path_clearance
+        from .frame import obstacle_nearest
 
-        return se2_path_clearance(path, self.cspace.body_pieces, self.cspace.obstacle_pieces)
+        return se2_path_clearance(path, self.cspace.body_pieces, self.cspace.obstacle_pieces,
+                                  nearest=obstacle_nearest(self.cspace))
 
     def state_space(self):
         from .glue import ompl

@@ -20,14 +20,20 @@ from ..errors import InputError
 def warmed(sc, slabs: int | None = None) -> tuple:
     """``(cspace, exact result or None)``: a scenario's C-space as the runs use it, its lazy parts
     filled once here rather than in every forked run (whose work is lost when it exits). A
-    rotating robot: every slab built and, in SE(2), the exact planner run on it (None for a car,
-    which cannot follow its turns in place); translation: the exact planner's C-space and result."""
+    rotating robot: every slab built, the proof before sampling's regions and their labelled
+    components (:func:`planners.core.exact_se2.prepare`: every run then answers it by lookups) and,
+    in SE(2), the exact planner run on it (None for a car, which cannot follow its turns in place);
+    translation: the exact planner's C-space and result."""
     from ..core.plan import build_cspace, plan
 
     if sc.rotates:
+        from ..core.exact_se2 import prepare
+
         cs = build_cspace(sc, slabs)
         for k in range(cs.slabs):
             cs.slab(k)
+        if cs.body_pieces:  # (a point robot does not turn: no proof before sampling)
+            prepare(cs)
         return cs, (plan(sc, planner="exact", cspace=cs) if sc.space == "se2" else None)
     res = plan(sc, planner="exact")
     return res.cspace, res

@@ -39,6 +39,10 @@ _REGIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # C-space -> 
 # That search is deterministic (the same regions, slabs and graph), so asking again answers the same;
 # a search cut short by its time budget is not remembered (a longer one might still prove).
 _NO_PROOF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+# C-space -> the POSSIBLE graphs of the proof before sampling's partitions, their components labelled
+# (cspace.se2.possible_joins): built once per map, they answer "joined at every partition" (no proof)
+# per query by lookups; only a query they separate runs the search (which writes the proof).
+_JOINS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def search(cspace, query, time_limit: float | None, *, possible_only: bool = False, refine: bool = True,
@@ -65,7 +69,8 @@ def search(cspace, query, time_limit: float | None, *, possible_only: bool = Fal
 
 
 def prepare(cspace, exact: bool = False) -> float:
-    """Build the POSSIBLE regions of the first slabs (what :func:`quick_proof` reads) for a C-space
+    """Build the POSSIBLE regions of every partition :func:`quick_proof` tries, and their graphs'
+    components (:func:`proof_joins`: a query then looks up its start and goal), for a C-space
     that will serve many queries, and with ``exact`` also their FREE regions, the meshes their
     translations search and the links between them (what :func:`exact_se2` reads first), and
     FREE of their halves (a pair through a narrow door refines there first); returns the seconds
@@ -76,8 +81,8 @@ def prepare(cspace, exact: bool = False) -> float:
     t = time.perf_counter()
     regions = _regions_of(cspace)
     part = initial_partition()
+    proof_joins(cspace)  # every partition the proof before sampling tries, labelled
     for a, b in part:
-        regions.possible(a, b)
         if exact:
             free = regions.free(a, b)
             warm(free.pieces, regions.bounds, free.components)
@@ -88,6 +93,21 @@ def prepare(cspace, exact: bool = False) -> float:
             regions.free(a, 0.5 * (a + b))
             regions.free(0.5 * (a + b), b)
     return time.perf_counter() - t
+
+
+def proof_joins(cspace, build: bool = True) -> list:
+    """The :class:`cspace.se2.possible_joins.PossibleJoins` of every partition :func:`quick_proof`'s
+    search tries (its POSSIBLE regions built where missing), made once per C-space and kept;
+    ``build=False``: those kept, or [] (nothing is built)."""
+    from cspace.se2.exact import ANGLE_NEAR, initial_partition
+    from cspace.se2.possible_joins import PossibleJoins, proof_partitions
+
+    joins = _JOINS.get(cspace)
+    if joins is None and build:
+        regions = _regions_of(cspace)
+        joins = _JOINS[cspace] = [PossibleJoins(regions, p, ANGLE_NEAR)
+                                  for p in proof_partitions(initial_partition(), QUICK_WIDTH)]
+    return joins or []
 
 
 def _regions_of(cspace, room: float = 0.0):
@@ -222,11 +242,16 @@ def quick_proof(sc, cspace, query, time_limit: float) -> PlanResult | None:
     tried = _NO_PROOF.setdefault(cspace, set())
     if key in tried:  # this search ran to its end before and found no proof: it would again
         return None
+    joins = proof_joins(cspace, build=False)
+    if joins and all(j.joined(query.start, query.goal) for j in joins):  # the search's answer, by lookups
+        tried.add(key)
+        return None
     budget = min(QUICK_SHARE * time_limit, QUICK_MAX)
     res = search(cspace, query, budget, possible_only=True, min_width=QUICK_WIDTH)
     if res.status != "unsolvable":
         if res.stats.get("reason") == NO_PROOF_FOUND:
             tried.add(key)
+            proof_joins(cspace)  # its regions and links are all built now: label them for the next query
         return None
     return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,
                       planner="", seed=0, start=tuple(query.start), goal=tuple(query.goal),
