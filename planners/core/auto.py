@@ -1,22 +1,25 @@
 """``auto``: the planner that always answers, the default for a rotating robot and a car.
 
 It runs the project's planners as stages of one budget, each only when the ones before it have
-not answered, cheapest first:
+not answered, cheapest first (a rotating robot or a Reeds–Shepp car):
 
+0. **sampling**, a slice -- RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
+   :data:`SLICE_SHARE` of the limit): an open scene, or a query on a large map, is answered here
+   in milliseconds, before any region of the slab graph is built;
 1. **slab graph** -- the slab graph's search at its first 8 slabs, no refinement (a few
    milliseconds on the bundled scenes): a certified path where FREE joins start and goal at
    once (a Reeds–Shepp car's SE(2) path, asked to keep some room, turned into certified curves:
    :func:`cspace.car.laumond.to_reeds_shepp`), else a proof where POSSIBLE separates them;
 2. **proof** -- the proof before sampling (a rotating robot: those slabs refined once,
-   :func:`planners.core.exact_se2.quick_proof`; a translating one: start and goal in different
-   free components, :func:`planners.core.exact.separated_proof`);
+   :func:`planners.core.exact_se2.quick_proof`; a translating one, where it comes first: start
+   and goal in different free components, :func:`planners.core.exact.separated_proof`);
 3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`; all of it for a
-   Dubins car, which has no complete method here);
+   Dubins car, which has no complete method here and starts at the proof);
 4. **refinement** -- the exact planner with the rest: the slab graph refined where FREE and
-   POSSIBLE disagree (SE(2); a Reeds–Shepp car's path converted as in 2, then sampling again with
-   whatever is left), the exact shortest path (translation).
+   POSSIBLE disagree (SE(2); a Reeds–Shepp car's path converted as in 1), then sampling again
+   with whatever is left; for a translating robot the exact shortest path.
 
-The slab regions are kept with the C-space, so stage 4 starts where stage 2 stopped. The result
+The slab regions are kept with the C-space, so stage 4 starts where stage 1 stopped. The result
 says which stage answered (``PlanResult.answered_by``) and the seconds of each stage
 (``timings``: ``proof``, ``slab graph``, ``sampling``, ``refinement``). Every path is certified
 by the stage that found it and verified again by the adapter; a "proven unsolvable" carries its
@@ -32,6 +35,8 @@ import numpy as np
 from .result import PlanResult
 
 SAMPLER = "RRTConnect"
+SLICE_ITERATIONS = 1000  # the first slice of sampling (a rotating robot, a Reeds–Shepp car): deterministic
+SLICE_SHARE = 0.1        # and within this share of the time limit
 SLAB_SHARE = 0.2    # of the time limit, at most, for the slab graph's first FREE search
 SAMPLE_SHARE = 0.1  # of what is left after it, at most, for sampling where a refinement follows (SE(2), cars)
 SAMPLE_MIN = 0.05   # seconds: sampling's turn before the refinement, at least
@@ -40,7 +45,7 @@ TRANSLATION_SAMPLE_SHARE = 0.5
 # reference point), the largest its start and goal allow first.
 ROOMS = (0.05, 0.01, 0.002)
 BOUNDED_PAST = 32  # poses: a car's path longer than this gets the bounded shortening only  # a translating robot: sampling, then the exact shortest path
-STAGES = ("slab graph", "proof", "sampling", "refinement")
+STAGES = ("sampling", "slab graph", "proof", "refinement")
 
 
 def _now() -> float:
@@ -78,7 +83,13 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     turns = sc.rotates and bool(cspace.body_pieces)  # a point robot does not turn: nothing to prove
     if tuple(query.start) == tuple(query.goal):
         return _answer(run_planner(adapter, SAMPLER, [pair], time_limit, seed, scenario=sc.name)[0], "sampling", clock, seed)
-    if turns and kind != "dubins":  # FREE at the first slabs, and POSSIBLE there where FREE does not join
+    if turns and kind != "dubins":  # a slice of sampling: an open scene is answered here, a large map too
+        cap = min(SLICE_SHARE * time_limit, clock.left())
+        r = clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], cap, seed, iterations=SLICE_ITERATIONS,
+                                                        simplify=simplify, scenario=sc.name)[0])
+        if r.solved:
+            return _answer(r, "sampling", clock, seed)
+        # FREE at the first slabs, and POSSIBLE there where FREE does not join
         r = clock.run("slab graph", lambda: _slab_graph(sc, cspace, adapter, query, source,
                                                        min(SLAB_SHARE * time_limit, clock.left()), simplify,
                                                        refine=False))
