@@ -86,8 +86,10 @@ def _regions_of(cspace):
 
     regions = _REGIONS.get(cspace)
     if regions is None:
-        regions = _REGIONS[cspace] = slab_regions(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds,
-                                                  cspace.margin or None)
+        regions = _REGIONS[cspace] = slab_regions(
+            cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, cspace.margin or None,
+            inner_obstacles=getattr(cspace, "inner_obstacle_pieces", None),
+            inner_robot=getattr(cspace, "inner_body_pieces", None))
     return regions
 
 
@@ -137,10 +139,11 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     if not ok:  # the slab graph certifies its path; this re-check is the second opinion
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
                           message=f"the slab graph's path failed the certified re-check ({why}): not solved", **base)
-    path, note = raw, "OMPL not installed: not shortened"
+    path, note = raw, "not shortened (--no-simplify)"
     if simplify:
         t2 = time.perf_counter()
-        path, note = shorten(adapter, raw, query)
+        left = None if time_limit is None else max(0.0, float(time_limit) - (t2 - t0))
+        path, note = shorten(adapter, raw, query, time_limit=left)
         timings["simplify"] = time.perf_counter() - t2
         base["stages"] = ["slab graph", "verify", "simplify"]
     length, raw_len = adapter.length(path), adapter.length(raw)
@@ -149,16 +152,27 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
                       length_unsimplified=raw_len, first_path_cpu=found_cpu, **base)
 
 
-def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:
+def shorten(adapter, path: np.ndarray, query, time_limit: float | None = None) -> tuple[np.ndarray, str]:
     """``path`` shortened by OMPL's simplifier under the adapter's certified motion validator,
-    and verified again; the original path where OMPL is missing or the result is not better.
-    Deterministic: OMPL's random stream is seeded with 0 (:func:`make_setup`)."""
+    and verified again; the original path where OMPL is missing, the result is not better, or
+    ``time_limit`` (seconds) runs out: the simplifier stops at it (its termination condition,
+    and every motion check asked after it answers "not free" at once, so OMPL keeps what it has),
+    and a shortening that ended past it is dropped for the certified path (its re-check would
+    take more time). Deterministic within its time: OMPL's random stream is seeded with 0."""
     from ..adapters.glue import make_setup, ompl, ompl_available
 
-    if not ompl_available() or len(path) < 3:
-        return path, "OMPL not installed: not shortened" if len(path) >= 3 else "nothing to shorten"
-    og = ompl()[1]
-    ss, _space, _checker, _validator = make_setup(adapter, "RRTConnect", 0)
+    if len(path) < 3:
+        return path, "nothing to shorten"
+    if not ompl_available():
+        return path, "OMPL not installed: not shortened"
+    if time_limit is not None and time_limit <= 0.0:
+        return path, "no time left to shorten it"
+    ob, og = ompl()[:2]
+    ss, _space, _checker, validator = make_setup(adapter, "RRTConnect", 0)
+    deadline = None if time_limit is None else time.perf_counter() + float(time_limit)
+    if deadline is not None and hasattr(validator, "motion_free"):
+        check = validator.motion_free
+        validator.motion_free = lambda q0, q1: time.perf_counter() < deadline and check(q0, q1)
     ss.setup()
     si = ss.getSpaceInformation()
     p = og.PathGeometric(si)
@@ -166,7 +180,12 @@ def shorten(adapter, path: np.ndarray, query) -> tuple[np.ndarray, str]:
         s = si.allocState()
         adapter.set_state(s, pose)
         p.append(s)
-    og.PathSimplifier(si).simplifyMax(p)
+    if deadline is None:
+        og.PathSimplifier(si).simplifyMax(p)
+    else:
+        og.PathSimplifier(si).simplify(p, ob.timedPlannerTerminationCondition(deadline - time.perf_counter()), False)
+        if time.perf_counter() >= deadline:
+            return path, "the time limit stopped the shortening: the certified path is kept as found"
     out = adapter.path_array(p)
     out[0], out[-1] = path[0], path[-1]  # the exact ends (the states' round trip may round x, y)
     ok, _ = adapter.verify(out, query.start, query.goal)
