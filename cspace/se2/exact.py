@@ -25,8 +25,9 @@ polygons with holes, and their connected components.
   nodes or links FREE does not yet reproduce ("FREE breaks there"), else those anywhere in
   the start's POSSIBLE component where it breaks, else all. The search stops at ``min_width``
   (no slab is cut below it) or at ``time_limit`` (checked before every region is built):
-  "undecided", with the resolution D = r·Δmax (no path with clearance above D exists, since
-  such a path would lie in FREE; note section 4).
+  "undecided", with the resolution D = r·Δmax + the margin's reach + the disks' polygon error
+  (no path with clearance above D exists, since such a path would lie in FREE; note section 4,
+  :mod:`cspace.se2.exact_report`).
 
 Angles are OMPL's, wrapped to [−π, π); a pose on the boundary ±π belongs to the first and
 the last slab. Nothing depends on randomness or on the iteration order of a set.
@@ -43,9 +44,10 @@ from ..kernel.slabs.slab import slab_range
 from ..kernel.polygons.rotation import TWO_PI, wrap_angle
 from .slab_graph import SlabRegions, point_free
 from .exact_path import AssemblyError, assemble, holding
+from .exact_report import PROOF_FORMAT, disk_excess, margin_reach, proof_json, resolution  # noqa: F401
+from ..kernel.slabs.slab import ANGLE_SLACK
 from .walks import G_NODE, S_NODE, cheapest_walk, labels, reach, shortest_walk
 
-PROOF_FORMAT = "cspace-se2-proof/1"
 # A proof's start and goal join the POSSIBLE components of every slab within this many radians of
 # their angle (more nodes: a weaker claim), 10 x the independent checker's angle tolerance.
 ANGLE_NEAR = 1e-8
@@ -76,7 +78,7 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
                      time_limit: float | None = None, min_width: float = TWO_PI / 2048, initial_slabs: int = 8,
                      margin: list | None = None, possible_only: bool = False, refine: bool = True,
                      regions: SlabRegions | None = None, inner_obstacles: list | None = None,
-                     inner_robot: list | None = None) -> SE2ExactResult:
+                     inner_robot: list | None = None, excess: float = 0.0) -> SE2ExactResult:
     """Plan for a robot of convex ``robot_pieces`` (body frame) among convex ``obstacle_pieces``:
     a certified path, a proof that none exists, or "undecided" at the resolution reached.
 
@@ -90,7 +92,8 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
     ``inner_obstacles``, ``inner_robot``: convex pieces INSIDE the scene's shapes as written
     (a disk's inscribed polygon where ``obstacle_pieces`` / ``robot_pieces`` hold its
     circumscribed one): POSSIBLE and the proof are built of them, so that a proof holds for the
-    disks themselves (None: the same pieces, polygons only).
+    disks themselves (None: the same pieces, polygons only); ``excess``: their polygons' error,
+    for the resolution statement.
 
     >>> wall = [np.array([[4., 0], [5, 0], [5, 4], [4, 4]]), np.array([[4., 6], [5, 6], [5, 10], [4, 10]])]
     >>> bar = [np.array([[-1.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-1.5, 0.2]])]
@@ -109,7 +112,7 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
         raise ValueError("exact_se2_search: needs a robot of at least one convex piece (a point robot does not turn)")
     if regions is None:
         regions = slab_regions(obstacle_pieces, robot, bounds, margin, inner_obstacles=inner_obstacles,
-                               inner_robot=inner_robot)
+                               inner_robot=inner_robot, excess=excess)
     search = _Search(regions, start, goal, time_limit, float(min_width), initial_slabs)
     search.possible_only, search.refine = bool(possible_only), bool(refine)
     return search.run()
@@ -130,18 +133,22 @@ def initial_partition(n: int = 8) -> list[tuple[float, float]]:
 
 
 def slab_regions(obstacle_pieces: list, robot_pieces: list, bounds, margin: list | None = None, *,
-                 inner_obstacles: list | None = None, inner_robot: list | None = None) -> SlabRegions:
+                 inner_obstacles: list | None = None, inner_robot: list | None = None,
+                 excess: float = 0.0) -> SlabRegions:
     """The :class:`SlabRegions` :func:`exact_se2_search` works on (FREE with the robot inflated by
     ``margin``, POSSIBLE with the body, of the ``inner_*`` pieces if given), to keep and pass to
-    several searches."""
+    several searches. ``excess``: the disks' circumscribed-polygon error (robot's + obstacles'),
+    which the resolution statement adds (:func:`cspace.se2.exact_report.disk_excess`)."""
     robot = [np.asarray(p, dtype=np.float64) for p in robot_pieces]
     hull = None
     if margin:
         from ..translation.build import inflated
 
         hull = inflated(robot, [np.asarray(m, dtype=np.float64) for m in margin])
-    return SlabRegions(obstacle_pieces, robot, bounds, hull_pieces=hull, inner_obstacles=inner_obstacles,
-                       inner_robot=inner_robot)
+    out = SlabRegions(obstacle_pieces, robot, bounds, hull_pieces=hull, inner_obstacles=inner_obstacles,
+                      inner_robot=inner_robot)
+    out.margin_reach, out.excess = margin_reach(margin), float(excess)
+    return out
 
 
 def from_scenario(scenario, query_index: int = 0, **kwargs) -> SE2ExactResult:
@@ -170,6 +177,7 @@ def from_scenario(scenario, query_index: int = 0, **kwargs) -> SE2ExactResult:
     kwargs.setdefault("margin", sc.margins() or None)
     if sc.has_disks and "regions" not in kwargs:
         kwargs["inner_obstacles"], kwargs["inner_robot"] = inner_pieces(sc)
+        kwargs.setdefault("excess", disk_excess(sc))
     return exact_se2_search(obstacles, robot, sc.bounds, q.start, q.goal, **kwargs)
 
 
@@ -411,19 +419,11 @@ class _Search:
     # -- results -------------------------------------------------------------------------
 
     def _proof(self, preg, s_p, g_p, edges) -> dict:
-        slabs = []
-        for (a, b), reg in zip(self.part, preg):
-            slabs.append({"a": float(a), "b": float(b), "cores": [c.tolist() if len(c) else [] for c in reg.cores],
-                          "components": [_component_json(c) for c in reg.components]})
-        xmin, xmax, ymin, ymax = self.R.bounds
-        return {"format": PROOF_FORMAT, "start": list(self.start), "goal": list(self.goal),
-                "bounds": [xmin, xmax, ymin, ymax], "robot_pieces": [p.tolist() for p in self.R.core_robot],
-                "slabs": slabs, "start_nodes": [list(n) for n in sorted(s_p)],
-                "goal_nodes": [list(n) for n in sorted(g_p)], "edges": sorted(edges)}
+        return proof_json(self.part, preg, self.R, self.start, self.goal, s_p, g_p, edges)
 
     def _result(self, status: str, path=None, proof=None, **extra) -> SE2ExactResult:
         widest = max(b - a for a, b in self.part)
-        D = self.R.radius * widest
+        D, words = resolution(self.R, widest, ANGLE_SLACK)
         stats = {"slabs": len(self.part), "refinements": self.refinements, "regions_built": dict(self.R.counts),
                  "repairs": len(self.repairs),
                  "graphs": dict(self.graph_sizes), "seconds": dict(self.times),
@@ -432,8 +432,7 @@ class _Search:
                  **extra}
         out = SE2ExactResult(status, resolution=D, stats=stats, proof=proof)
         if status == "undecided":
-            stats["statement"] = (f"no path with clearance above {D:.6g} (robot radius {self.R.radius:.6g} x widest "
-                                  f"slab {widest:.6g} rad) exists; a tighter one was not decided")
+            stats["statement"] = words
         if path is not None:
             out.path = path
             d = np.diff(path, axis=0)
@@ -442,8 +441,3 @@ class _Search:
             out.rotation = float(turn.sum())
         return out
 
-
-def _component_json(poly) -> dict:
-    """A component as the proof stores it: shell CCW, holes CW, no closing repeat."""
-    return {"shell": [list(p) for p in poly.exterior.coords[:-1]],
-            "holes": [[list(p) for p in r.coords[:-1]] for r in poly.interiors]}

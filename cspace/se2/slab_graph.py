@@ -134,6 +134,9 @@ class SlabRegions:
         self._possible: dict = {}
         self._links: dict = {}
         self.counts = {"free_built": 0, "possible_built": 0, "links_built": 0}
+        # what the resolution statement adds to r·Δ (cspace.se2.exact_report): the margin's reach
+        # and the disks' polygon error (set by cspace.se2.exact.slab_regions)
+        self.margin_reach, self.excess = 0.0, 0.0
 
     # -- regions -----------------------------------------------------------------------
 
@@ -216,7 +219,9 @@ class SlabRegions:
 
     def free_links(self, r1: Region, r2: Region) -> list[tuple[int, int, tuple[float, float]]]:
         """(i, j, point): FREE components i of r1 and j of r2 whose intersection has an
-        interior, with a point deep inside it (more than ``tol`` from its boundary)."""
+        interior, with a point deep inside it (more than ``tol`` from its boundary), or, where
+        the overlap is thinner than that (bounds of any thinness: a rail), a point inside it
+        (the path's assembly re-checks every link point exactly against both slabs)."""
         key = ("free", r1.a, r1.b, r2.a, r2.b)
         if key not in self._links:
             import shapely
@@ -225,6 +230,8 @@ class SlabRegions:
             for i, j in _box_pairs(r1.boxes, r2.boxes, 0.0):
                 inter = shapely.intersection(r1.components[i], r2.components[j])
                 pt = deep_point(inter, self.tol)
+                if pt is None:
+                    pt = inner_point(inter)
                 if pt is not None:
                     out.append((i, j, pt))
             self._links[key] = out
@@ -340,6 +347,24 @@ def deep_point(geom, depth: float) -> tuple[float, float] | None:
         if p.boundary.distance(shapely.Point(cx, cy)) > depth and shapely.intersects_xy(p, cx, cy):
             return float(cx), float(cy)
     return None
+
+
+def inner_point(geom) -> tuple[float, float] | None:
+    """A point inside ``geom`` (shapely, polygonal) of positive area, however thin: the
+    representative point of its largest part; None if it has no area.
+
+    >>> import shapely
+    >>> x, y = inner_point(shapely.box(0, 5, 3, 5 + 1e-9))
+    >>> 0 < x < 3 and 5 < y < 5 + 1e-9, inner_point(shapely.LineString([(0, 0), (1, 1)]))
+    (True, None)
+    """
+    import shapely
+
+    parts = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and p.area > 0.0]
+    if not parts:
+        return None
+    pt = max(parts, key=lambda q: q.area).representative_point()
+    return float(pt.x), float(pt.y)
 
 
 def _box_pairs(b1: np.ndarray, b2: np.ndarray, grow: float) -> list[tuple[int, int]]:

@@ -10,7 +10,8 @@ exists, or the resolution it reached (:mod:`cspace.se2.exact`), as a PlanResult.
   exists at any resolution; the proof (``PlanResult.proof``) can be written out and re-checked
   by ``cspace check-proof``.
 - *not decided*: refinement reached its floor or the time limit: no path keeps more than D
-  from the obstacles (D = r·Δ, the note's resolution statement).
+  from the obstacles (D = r·Δ + the margin's reach + the disks' polygon error, the note's
+  resolution statement: :mod:`cspace.se2.exact_report`).
 
 A car moves along SE(2) paths, so the POSSIBLE graph's proof holds for it too; a car cannot
 turn in place, so its ``exact`` answers only with a proof. :func:`quick_proof` is the cheap end
@@ -82,14 +83,15 @@ def prepare(cspace, exact: bool = False) -> float:
 
 def _regions_of(cspace):
     """The C-space's :class:`cspace.se2.slab_graph.SlabRegions`, made on first use and kept."""
-    from cspace.se2.exact import slab_regions
+    from cspace.se2.exact import disk_excess, slab_regions
 
     regions = _REGIONS.get(cspace)
     if regions is None:
         regions = _REGIONS[cspace] = slab_regions(
             cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, cspace.margin or None,
             inner_obstacles=getattr(cspace, "inner_obstacle_pieces", None),
-            inner_robot=getattr(cspace, "inner_body_pieces", None))
+            inner_robot=getattr(cspace, "inner_body_pieces", None),
+            excess=disk_excess(cspace.scenario) if getattr(cspace, "scenario", None) is not None else 0.0)
     return regions
 
 

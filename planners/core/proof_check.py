@@ -27,7 +27,8 @@ has the table); each errs toward refusing a proof:
 - regions: obstacles as written (a disk by a polygon inside it, checked exactly); the union of the
   convex sums eroded by 16 u and the bounds box grown by it; a proof component matches a recomputed one when
   their symmetric difference is at most 1e-9 of the bounds' area + 256 u (both perimeters); a
-  proof component may match none (the planner's POSSIBLE is the larger: a sliver only it has);
+  proof component may match none (the planner's POSSIBLE is the larger: a sliver only it has), and a
+  recomputed one that lies in a listed one (which the checker's smaller POSSIBLE split) takes its node;
   unlisted recomputed components must be under that area and then join the search as the
   checker's own nodes with their own edges; regions are built and matched slab by slab;
 - nodes, edges: closures within 512 u of the point or of each other count as touching;
@@ -41,18 +42,20 @@ Past a limit: a one-line refusal (``cspace check-proof``: exit 2).
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from collections import deque
 from dataclasses import dataclass
 from fractions import Fraction
 
+import numpy as np
 import shapely
 
 from cspace.io.scenario.files import read_input, utf8_text
 from cspace.io.load import ScenarioError, load_scenario  # noqa: F401  (re-exported)
 from ..errors import InputError
-from .proof_geometry import (MATCH_UNITS, SHRINK_UNITS, TOUCH_UNITS, Piece, convex_obstacles,  # noqa: F401
+from .proof_geometry import (MATCH_UNITS, SHRINK_UNITS, TOUCH_UNITS, Obstacles, Piece, convex_obstacles,  # noqa: F401
                              core_inside, in_arc, in_disk, orient, possible_components, scene_unit,
                              strictly_convex_ccw)  # (orient: re-exported for the tests and callers)
 
@@ -101,9 +104,6 @@ def need(ok, step: str, detail: str):
         raise Refused(step, detail)
 
 
-
-
-
 def num(x, what: str) -> float:
     """A JSON number that is a finite double (an integer only if a double holds it exactly)."""
     need(isinstance(x, (int, float)) and not isinstance(x, bool), "format", f"{what}: not a number")
@@ -115,14 +115,28 @@ def num(x, what: str) -> float:
 def ring(pts, what: str, allow_empty: bool = False) -> list:
     """A list of >= 3 points [x, y] (a repeated closing point dropped); [] if allowed."""
     need(isinstance(pts, list) and (pts or allow_empty), "format", f"{what}: not a non-empty list of points")
-    out = []
-    for i, p in enumerate(pts):
+    out = _plain_ring(pts)
+    for i, p in enumerate(pts if out is None else ()):  # one number at a time: to name the fault
+        if i == 0:
+            out = []
         need(isinstance(p, list) and len(p) == 2, "format", f"{what}[{i}]: not a point [x, y]")
         out.append((num(p[0], f"{what}[{i}]"), num(p[1], f"{what}[{i}]")))
+    out = out or []
     if len(out) > 1 and out[0] == out[-1]:
         out.pop()
     need(not out or len(out) >= 3, "format", f"{what}: fewer than 3 distinct points")
     return out
+
+
+def _plain_ring(pts) -> list | None:
+    """The points as float pairs when every one is a list of two finite floats (the JSON a
+    planner writes), read in a few passes at C speed; None for anything else (then read one by one)."""
+    if not pts or set(map(type, pts)) != {list} or set(map(len, pts)) != {2}:
+        return None
+    flat = list(itertools.chain.from_iterable(pts))
+    if set(map(type, flat)) != {float} or not np.isfinite(np.array(flat)).all():
+        return None
+    return list(map(tuple, pts))
 
 
 def index_list(items, what: str, width: int, sizes) -> list:
@@ -253,10 +267,11 @@ def match(k, slab, comps, tol_area, band) -> list:
     n_given = sum(len(sh) + sum(map(len, hs)) for sh, hs in slab["components"])
     if n_given > 4 * n_mine + 1024:
         raise TooBig(f"slab {k}: components of {n_given} vertices where the scene's have {n_mine}")
-    owner, tree = [None] * len(comps), shapely.STRtree(comps)
+    owner, tree, polys = [None] * len(comps), shapely.STRtree(comps), []
     for c, (shell, holes) in enumerate(slab["components"]):
-        poly = shapely.Polygon(shell, holes)
+        poly = shapely.polygons(shapely.linearrings(shell), [shapely.linearrings(h) for h in holes] or None)
         need(poly.is_valid, "regions", f"slab {k} component {c} is not a valid polygon")
+        polys.append(poly)
         hits = [int(r) for r in tree.query(poly, predicate="intersects")
                 if poly.area + comps[r].area - 2 * poly.intersection(comps[r]).area
                 <= tol_area + band * (poly.length + comps[r].length)]
@@ -267,11 +282,20 @@ def match(k, slab, comps, tol_area, band) -> list:
             continue
         need(owner[hits[0]] is None, "regions", f"slab {k} components {owner[hits[0]]} and {c} are the same")
         owner[hits[0]] = c
+    ptree = shapely.STRtree(polys) if polys else None
     for r, c in enumerate(owner):
-        if c is None and comps[r].area > tol_area:
-            pt = comps[r].representative_point()
-            raise Refused("regions", f"slab {k}: the component at ({pt.x:.6g}, {pt.y:.6g}) of area "
-                                     f"{comps[r].area:.3g} is not listed")
+        if c is not None or comps[r].area <= tol_area:
+            continue
+        # a piece of a listed component that the checker's smaller POSSIBLE cut off: it joins that
+        # component's node (more links, never fewer: the search can only find more paths)
+        inside = [int(i) for i in (ptree.query(comps[r], predicate="intersects") if ptree else [])
+                  if comps[r].area - polys[i].intersection(comps[r]).area <= tol_area + band * comps[r].length]
+        if inside:
+            owner[r] = min(inside)
+            continue
+        pt = comps[r].representative_point()
+        raise Refused("regions", f"slab {k}: the component at ({pt.x:.6g}, {pt.y:.6g}) of area "
+                                 f"{comps[r].area:.3g} is not listed")
     return owner
 
 
@@ -317,7 +341,7 @@ def regions(scenario, p, q, unit):
     """Steps "regions", "nodes" and "edges": each slab's POSSIBLE recomputed, matched and linked to
     the previous slab's (then dropped); the graph for the separation step."""
     xmin, xmax, ymin, ymax = (float(v) for v in scenario.bounds)
-    parts = convex_obstacles(scenario)
+    parts = Obstacles(convex_obstacles(scenario))
     shrink = SHRINK_UNITS * unit
     box = shapely.box(xmin - shrink, ymin - shrink, xmax + shrink, ymax + shrink)
     tol_area = MATCH_REL * (xmax - xmin) * (ymax - ymin)

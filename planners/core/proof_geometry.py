@@ -53,16 +53,30 @@ def orient(a, b, c) -> int:
 
 def strictly_convex_ccw(pts) -> bool:
     """Whether the ring ``pts`` (not closed) is a strictly convex CCW polygon, decided exactly:
-    every turn strictly left and the edge directions going round exactly once."""
+    every turn strictly left (a float filter over all turns at once, :func:`orient` where it is
+    unsure) and the edge directions going round exactly once.
+
+    >>> strictly_convex_ccw([(0, 0), (1, 0), (0, 1)]), strictly_convex_ccw([(0, 0), (0, 1), (1, 0)])
+    (True, False)
+    """
     n = len(pts)
-    if n < 3 or any(orient(pts[i], pts[(i + 1) % n], pts[(i + 2) % n]) <= 0 for i in range(n)):
+    if n < 3:
         return False
-
-    def half(i):  # the sign of a float difference is exact
-        dx, dy = pts[(i + 1) % n][0] - pts[i][0], pts[(i + 1) % n][1] - pts[i][1]
-        return 0 if dy > 0 or (dy == 0 and dx > 0) else 1
-
-    return sum(half(i) == 1 and half((i + 1) % n) == 0 for i in range(n)) == 1
+    p = np.asarray(pts, dtype=np.float64)
+    a, b, c = p, np.roll(p, -1, axis=0), np.roll(p, -2, axis=0)
+    with np.errstate(all="ignore"):
+        dl = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
+        dr = (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+        det, total = dl - dr, np.abs(dl) + np.abs(dr)
+    sure = np.isfinite(total) & (total > 1e-250) & (np.abs(det) > ERRBOUND * total)
+    if np.any(sure & (det <= 0)):
+        return False
+    for i in np.flatnonzero(~sure).tolist():
+        if orient(pts[i], pts[(i + 1) % n], pts[(i + 2) % n]) <= 0:
+            return False
+    d = b - a  # the sign of a float difference is exact
+    half = np.where((d[:, 1] > 0) | ((d[:, 1] == 0) & (d[:, 0] > 0)), 0, 1)
+    return int(np.sum((half == 1) & (np.roll(half, -1) == 0))) == 1
 
 
 def in_arc(t: float, a: float, b: float, slack: float) -> bool:
@@ -146,23 +160,83 @@ def convex_obstacles(scenario) -> list:
     return parts
 
 
+def _lowest_ccw(p: np.ndarray) -> np.ndarray:
+    """The convex polygon's vertices CCW from its lowest (then leftmost) one."""
+    q = p - p[0]  # the shoelace about a vertex: no cancellation far from the origin
+    if q[:, 0] @ np.roll(q[:, 1], -1) - q[:, 1] @ np.roll(q[:, 0], -1) < 0:
+        p = p[::-1]
+    return np.roll(p, -int(np.lexsort((p[:, 0], p[:, 1]))[0]), axis=0)
+
+
+def convex_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Vertices of a ⊕ b for convex a, b (either orientation) in O(n + m): the two edge sequences
+    merged by angle, each vertex a_i + b_j computed directly (one rounding: a point of the true
+    sum, so the hull of the result lies in it however close edges were ordered).
+
+    >>> convex_sum(np.array([[0., 0], [1, 0], [0, 1]]), np.array([[0., 0], [2, 0], [2, 2], [0, 2]])).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [3.0, 0.0], [3.0, 2.0], [2.0, 3.0], [0.0, 3.0], [0.0, 2.0]]
+    """
+    a, b = _lowest_ccw(a), _lowest_ccw(b)
+    ea, eb = np.roll(a, -1, axis=0) - a, np.roll(b, -1, axis=0) - b
+    ta = np.mod(np.arctan2(ea[:, 1], ea[:, 0]), TWO_PI)
+    tb = np.mod(np.arctan2(eb[:, 1], eb[:, 0]), TWO_PI)
+    order = np.argsort(np.concatenate([ta, tb]), kind="stable")
+    from_a = order < len(a)
+    i = np.concatenate([[0], np.cumsum(from_a)[:-1]]) % len(a)
+    j = np.concatenate([[0], np.cumsum(~from_a)[:-1]]) % len(b)
+    return a[i] + b[j]
+
+
+class Obstacles:
+    """The obstacles' convex parts prepared once for every slab's sums: each CCW from its lowest
+    vertex, with its edge angles (increasing in [0, 2π)), all parts side by side."""
+
+    def __init__(self, parts):
+        parts = [_lowest_ccw(np.asarray(o, dtype=np.float64)) for o in parts if len(o) >= 3]
+        self.count = len(parts)
+        self.sizes = np.array([len(o) for o in parts], dtype=np.int64)
+        self.starts = np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
+        self.v = np.concatenate(parts) if parts else np.zeros((0, 2))
+        e = np.concatenate([np.roll(o, -1, axis=0) - o for o in parts]) if parts else np.zeros((0, 2))
+        self.t = np.mod(np.arctan2(e[:, 1], e[:, 0]), TWO_PI)
+        self.part = np.repeat(np.arange(self.count), self.sizes)
+
+    def sums(self, core) -> np.ndarray:
+        """The convex sums O_p ⊕ (−core) of every part at once, as shapely polygons: the merge of
+        :func:`convex_sum` vectorised over the parts (8 × 2π separates the parts' angle ranges)."""
+        b = _lowest_ccw(-np.asarray(core, dtype=np.float64))
+        eb = np.roll(b, -1, axis=0) - b
+        tb = np.mod(np.arctan2(eb[:, 1], eb[:, 0]), TWO_PI)
+        m, P = len(b), self.count
+        shift = 8.0 * TWO_PI * self.part
+        # a-edge i starts at A_i + B_j, j = the b-edges strictly before it; b-edge j at A_i + B_j,
+        # i = the part's a-edges at or before it (ties: a first, as a stable merge)
+        jb = np.searchsorted(tb, self.t, side="left") % m
+        qa = (tb[None, :] + 8.0 * TWO_PI * np.arange(P)[:, None]).ravel()
+        ia = np.searchsorted(self.t + shift, qa, side="right") - np.repeat(self.starts, m)
+        ia = (ia % np.repeat(self.sizes, m)) + np.repeat(self.starts, m)
+        pts = np.concatenate([self.v + b[jb], self.v[ia] + np.tile(b, (P, 1))])
+        key = np.concatenate([self.t, np.tile(tb, P)])
+        owner = np.concatenate([self.part, np.repeat(np.arange(P), m)])
+        tie = np.concatenate([np.zeros(len(self.t)), np.ones(P * m)])
+        order = np.lexsort((tie, key, owner))
+        sizes = self.sizes + m
+        # the merged ring is the convex sum up to one rounding per vertex (no hull needed: every
+        # vertex is a point of the sum, so the polygon lies in it)
+        return shapely.polygons(shapely.linearrings(pts[order], indices=owner[order])) if len(sizes) else np.array([])
+
+
 def possible_components(cores, parts, box, shrink) -> list:
     """The components of POSSIBLE for a slab's ``cores``: the box minus the union of the convex
-    sums O ⊕ (−C), that union eroded by ``shrink`` (a smaller obstacle: rounding never closes a
+    sums O ⊕ (−C) (:meth:`Obstacles.sums`, their hulls: each vertex a point of the true sum up to
+    one rounding), that union eroded by ``shrink`` (a smaller obstacle: rounding never closes a
     passage). Eroding the union, not each sum, opens no crack between the sums of one obstacle's
-    triangles where a core is thinner than 2 ``shrink``."""
-    coords, index = [], []
-    for core in cores:
-        if core:
-            c = np.asarray(core)
-            for o in parts:
-                coords.append((o[:, None, :] - c[None, :, :]).reshape(-1, 2))
-                index.append(len(coords[-1]))
-    if not coords:
+    triangles where a core is thinner than 2 ``shrink``. ``parts``: an :class:`Obstacles`."""
+    parts = parts if isinstance(parts, Obstacles) else Obstacles(parts)
+    sums = [parts.sums(core) for core in cores if core and parts.count]
+    if not sums:
         return [box]
-    points = shapely.multipoints(np.concatenate(coords), indices=np.repeat(np.arange(len(index)), index))
-    sums = shapely.convex_hull(points)
-    blocked = shapely.buffer(shapely.union_all(sums), -shrink, join_style="mitre")
+    blocked = shapely.buffer(shapely.union_all(np.concatenate(sums)), -shrink, join_style="mitre")
     rest = shapely.difference(box, blocked)
     return [g for g in shapely.get_parts(rest) if g.geom_type == "Polygon" and g.area > 0]
 

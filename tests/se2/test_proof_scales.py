@@ -54,6 +54,7 @@ def closed_room(offset, size, extent, gap, disk=False):
        st.sampled_from([1.0, 30.0, 1000.0]), st.floats(0.3, 0.8), st.booleans())
 @example(3e5, 0.01, 1000.0, 0.5, False)  # the issue's: coordinates ~3e5, features 0.01 of the scene
 @example(1e6, 1e-3, 1000.0, 0.5, True)
+@example(3e5, 1e-3, 1.0, 0.60546875, True)  # the checker splits a planner component in two
 def test_every_printed_proof_passes_the_checker(offset, size, extent, gap, disk):
     sc = closed_room((offset, -offset / 3), size, extent, gap, disk)
     r = from_scenario(sc, time_limit=60.0, possible_only=True, min_width=2 * math.pi / 64)
