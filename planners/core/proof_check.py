@@ -74,7 +74,11 @@ MATCH_REL = 1e-9
 # pieces than the robot has vertices, cores of at most 3 n + 4 vertices (three half-planes per
 # edge of an n-gon piece, clipped from a box; 3 n + 1024 allowed, for cores built otherwise); a slab's components have at most 4x the vertices
 # of the recomputed ones + 1024; a file at most 2 million lists and 6 million values.
-LIMITS = {"slabs": 4096, "piece_vertices": 256, "file_lists": 2_000_000, "file_values": 6_000_000}
+# The regions' work: slabs x (obstacle vertices + the slab's core vertices + 64, its fixed cost),
+# at most 600 000 (about 7 s of one core: 4096 slabs of a small scene, 420 slabs of 800-gon
+# cores, or 500 slabs of a 1 000-vertex scene).
+LIMITS = {"slabs": 4096, "piece_vertices": 256, "file_lists": 2_000_000, "file_values": 6_000_000,
+          "work": 600_000}
 
 
 class TooBig(Exception):
@@ -367,13 +371,18 @@ def check_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
     step = "format"
     try:
         p = parse(proof)
+        obstacles = convex_obstacles(scenario)
+        work = sum(sum(map(len, obstacles)) + sum(map(len, s["cores"])) + 64 for s in p["slabs"])
+        if work > LIMITS["work"]:
+            raise TooBig(f"{len(p['slabs'])} slabs over {sum(map(len, obstacles))} obstacle vertices: {work} units "
+                         f"of work (at most {LIMITS['work']})")
         step = "query"
         q = check_query(scenario, p, query_index)
         step = "robot"
         check_robot(scenario, p["pieces"])
         step = "cover"
         check_cover(p["slabs"])
-        unit = scene_unit(scenario.bounds, convex_obstacles(scenario), p["pieces"])
+        unit = scene_unit(scenario.bounds, obstacles, p["pieces"])
         step = "cores"
         check_cores(p["slabs"], p["pieces"], unit)
         step = "regions"
