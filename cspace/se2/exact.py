@@ -25,6 +25,8 @@ polygons with holes, and their connected components.
   nodes or links FREE does not yet reproduce ("FREE breaks there"), else those anywhere in
   the start's POSSIBLE component where it breaks, else all. The search stops at ``min_width``
   (no slab is cut below it) or at ``time_limit`` (checked before every region is built):
+  After the first round, zero-width slabs at the critical angles (a robot edge parallel to an
+  obstacle edge: :mod:`cspace.se2.critical`) join the partition (a door just wider than the robot).
   "undecided", with the resolution D = r·Δmax + the margin's reach + the disks' polygon error
   (no path with clearance above D exists, since such a path would lie in FREE; note section 4,
   :mod:`cspace.se2.exact_report`).
@@ -44,6 +46,7 @@ from ..kernel.slabs.slab import slab_range
 from ..kernel.polygons.rotation import TWO_PI, wrap_angle
 from .slab_graph import SlabRegions, point_free
 from .exact_path import AssemblyError, assemble, holding
+from .critical import critical_angles, with_zero_slabs
 from .exact_report import PROOF_FORMAT, disk_excess, margin_reach, proof_json, resolution  # noqa: F401
 from ..kernel.slabs.slab import ANGLE_SLACK
 from .walks import G_NODE, S_NODE, cheapest_walk, labels, reach, shortest_walk
@@ -243,6 +246,8 @@ class _Search:
                 self.times["graphs"] += time.perf_counter() - t
                 if not self._split(split):
                     return self._result("undecided", reason="minimum slab width reached")
+                if self.refinements == 1:  # after the first round: zero-width slabs at the critical angles
+                    self.part = with_zero_slabs(self.part, critical_angles(self.R.hull_robot, self.R.obstacles))
         except _Timeout:
             return self._result("undecided", reason="time limit")
 
@@ -283,7 +288,7 @@ class _Search:
         self.refinements += 1
         new = []
         for k, (a, b) in enumerate(self.part):
-            new += [(a, 0.5 * (a + b)), (0.5 * (a + b), b)] if k in split else [(a, b)]
+            new += [(a, 0.5 * (a + b)), (0.5 * (a + b), b)] if k in split and a < b else [(a, b)]
         self.part = new
         return True
 

@@ -240,11 +240,12 @@ def check_robot(scenario, pieces):
 
 
 def check_cover(slabs):
-    """Step "cover": consecutive slabs of width in (0, pi/2] going once round the circle."""
+    """Step "cover": consecutive slabs of width in [0, pi/2] going once round the circle (a zero-width
+    slab [phi, phi] is a single angle: a path crossing phi is in it and in both its neighbours)."""
     for k, s in enumerate(slabs):
         a, b = s["a"], s["b"]
         need(abs(a) <= MAX_ANGLE and abs(b) <= MAX_ANGLE, "cover", f"slab {k}: an angle beyond +-{MAX_ANGLE}")
-        need(a < b and Fraction(b) - Fraction(a) <= HALF_PI_LO, "cover", f"slab {k}: width {b - a} is not in (0, pi/2]")
+        need(a <= b and Fraction(b) - Fraction(a) <= HALF_PI_LO, "cover", f"slab {k}: width {b - a} is not in [0, pi/2]")
         need(k + 1 == len(slabs) or b == slabs[k + 1]["a"], "cover",
              f"slab {k} ends at {b}, the next does not start there")
     a0, b0, al, bl = (Fraction(v) for v in (slabs[0]["a"], slabs[0]["b"], slabs[-1]["a"], slabs[-1]["b"]))
