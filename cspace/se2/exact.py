@@ -414,7 +414,8 @@ class _Search:
                     pick.add(n[0])
             if (u, v) not in good_edge:
                 pick |= {n[0] for n in (u, v) if n[0] >= 0}
-        pick &= wide
+        # along the cheapest walk slabs go below the floor (to 2^-6 of it): as narrow as the room there
+        pick = {k for k in pick if 0.5 * (self.part[k][1] - self.part[k][0]) >= self.min_width / 64}
         if not pick:
             pick = {n[0] for n in bad_node if n in reached} & wide
         if not pick:

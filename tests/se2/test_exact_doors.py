@@ -63,3 +63,21 @@ def test_proofs_with_zero_width_slabs_check(gap):
     assert r.status == "unsolvable" and any(s["a"] == s["b"] for s in r.proof["slabs"])
     v = check_proof(sc, r.proof)
     assert v.valid, v
+
+
+def test_a_corridor_across_the_seam_is_solved():
+    """A bar in a corridor 0.5 % wider than it, pointing just below π at the start and just above −π
+    at the goal: the one way is to turn through ±π and slide; the zero-width slab at π holds it."""
+    L, W, spare, eps = 2.0, 0.4, 0.005, 2e-4
+    d = W * (1 + spare)
+    sc = scenario_from_dict({
+        "space": "se2", "bounds": {"xmin": 1.5, "xmax": 8.5, "ymin": 0.0, "ymax": 0.0 + 1e-3},
+        "robot": {"polygon": [[-L / 2, -W / 2], [L / 2, -W / 2], [L / 2, W / 2], [-L / 2, W / 2]]},
+        "start": {"x": 2.0, "y": 0.0, "theta": math.pi - eps}, "goal": {"x": 8.0, "y": 0.0, "theta": -math.pi + eps},
+        "obstacles": [{"polygon": [[0, -3], [10, -3], [10, -d / 2], [0, -d / 2]]},
+                      {"polygon": [[0, d / 2], [10, d / 2], [10, 3], [0, 3]]}]}, "seam.toml")
+    r = from_scenario(sc)
+    assert r.status == "solved", r.stats.get("statement")
+    assert r.rotation < 0.01  # through the seam, not the long way round
+    j = oracle.sweep_check(sc, r.path)
+    assert not j["collides"] and not j["out_of_bounds"]
