@@ -118,7 +118,7 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     if res.status == "unsolvable":
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
                           message=f"proven unsolvable: no collision-free path exists at any resolution (the "
-                                  f"slab graph's POSSIBLE regions separate start and goal; {graph})",
+                                  f"slab graph's POSSIBLE regions separate start and goal; {graph}){_too_big(sc, res.proof)}",
                           proof=res.proof, **base)
     if car:
         from ..adapters.glue import ompl_available
@@ -152,6 +152,15 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     return PlanResult(solved=True, exact=True, path=path, length=length, timings=timings,
                       message=f"certified path from the slab graph ({graph}; length {raw_len:.6g}, {note})",
                       length_unsimplified=raw_len, first_path_cpu=found_cpu, **base)
+
+
+def _too_big(sc, proof) -> str:
+    """A note when the proof asks ``check-proof`` for more work than it takes (it would refuse it)."""
+    from .proof_check import LIMITS, convex_obstacles, proof_work
+
+    work = proof_work(convex_obstacles(sc), proof["slabs"])
+    return "" if work <= LIMITS["work"] else (f"; the proof is past check-proof's work limit ({work} > "
+                                              f"{LIMITS['work']}): it cannot be re-checked")
 
 
 def shorten(adapter, path: np.ndarray, query, time_limit: float | None = None) -> tuple[np.ndarray, str]:

@@ -55,7 +55,8 @@ import shapely
 from cspace.io.scenario.files import read_input, utf8_text
 from cspace.io.load import ScenarioError, load_scenario  # noqa: F401  (re-exported)
 from ..errors import InputError
-from .proof_geometry import (MATCH_UNITS, SHRINK_UNITS, TOUCH_UNITS, Obstacles, Piece, convex_obstacles,  # noqa: F401
+from .proof_geometry import (ANGLE_SLACK, MATCH_UNITS, SHRINK_UNITS, TOUCH_UNITS, Graph, Obstacles, Piece,
+                             convex_obstacles,  # noqa: F401
                              core_inside, in_arc, in_disk, orient, possible_components, scene_unit,
                              strictly_convex_ccw)  # (orient: re-exported for the tests and callers)
 
@@ -67,7 +68,6 @@ TWO_PI_HI = Fraction("6.2831853071795864769252867665590058")  # > 2 pi
 TWO_PI = 2.0 * math.pi
 MAX_ANGLE = 64.0
 QUERY_ANGLE_REL = 1e-12
-ANGLE_SLACK = 1e-9
 MATCH_REL = 1e-9
 # What the planner can write (cspace.se2.exact): at most 4096 slabs (its floor keeps fewer), robot
 # pieces of at most 256 vertices (cspace.io.scenario.schema.MAX_ROTATING_VERTICES) and no more
@@ -304,43 +304,6 @@ def match(k, slab, comps, tol_area, band) -> list:
     return owner
 
 
-class Graph:
-    """The checker's graph, built slab by slab as the regions are matched (two slabs' regions
-    kept at a time, and the first for the wrap-around): the proof's nodes, the checker's own for
-    unlisted slivers, the links it finds and the proof's edges; the first missing end node or edge."""
-
-    def __init__(self, p, q, touch):
-        self.p, self.q, self.touch = p, q, touch
-        self.ends = {"start": set(), "goal": set()}
-        self.extra, self.faults = [], {}  # step -> the first fault of that step
-        self.given = set(p["edges"])
-
-    def slab(self, k, comps, owners):
-        s = self.p["slabs"][k]
-        node = (lambda r: (k, owners[r]) if owners[r] is not None else ("own", k, r))
-        for key, pose in (("start", self.q.start), ("goal", self.q.goal)):
-            if in_arc(pose[2], s["a"], s["b"], ANGLE_SLACK):
-                point = shapely.Point(pose[0], pose[1])
-                found = {node(r) for r, g in enumerate(comps) if shapely.dwithin(g, point, self.touch)}
-                listed = set(self.p[f"{key}_nodes"])
-                missing = sorted(n for n in found if n[0] != "own" and n not in listed)
-                if missing:
-                    self.faults.setdefault("nodes", f"{key}_nodes lacks {list(missing[0])}, a component holding "
-                                                    f"the {key}")
-                self.ends[key] |= found
-        return node
-
-    def link(self, k, comps, node, k2, comps2, node2):
-        """Pairs of components of slab k and k2 (k2 = k: the same slab) whose closures touch."""
-        if not comps or not comps2:
-            return
-        left, right = shapely.STRtree(comps2).query(comps, predicate="dwithin", distance=self.touch)
-        for u, v in ((node(r), node2(r2)) for r, r2 in zip(left.tolist(), right.tolist())):
-            if k2 == k or "own" in (u[0], v[0]):
-                self.extra.append((u, v))
-            elif (*u, *v) not in self.given:
-                self.faults.setdefault("edges", f"edges lacks {[*u, *v]}: the components touch")
-
 
 def regions(scenario, p, q, unit):
     """Steps "regions", "nodes" and "edges": each slab's POSSIBLE recomputed, matched and linked to
@@ -365,6 +328,16 @@ def regions(scenario, p, q, unit):
     return graph
 
 
+def proof_work(obstacles, slabs) -> int:
+    """The regions' work a proof asks for: slabs x (obstacle vertices + the slab's core vertices + 64).
+
+    >>> proof_work([[(0, 0), (1, 0), (0, 1)]], [{"cores": [[(0, 0)] * 5]}] * 2)
+    144
+    """
+    n = sum(map(len, obstacles))
+    return sum(n + sum(map(len, s["cores"])) + 64 for s in slabs)
+
+
 def check_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
     """Check a proof that no path joins query ``query_index`` of ``scenario`` (a loaded
     :class:`cspace.io.load.Scenario`): the first failing step, or ``valid`` (step ``"ok"``).
@@ -373,7 +346,7 @@ def check_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
     try:
         p = parse(proof)
         obstacles = convex_obstacles(scenario)
-        work = sum(sum(map(len, obstacles)) + sum(map(len, s["cores"])) + 64 for s in p["slabs"])
+        work = proof_work(obstacles, p["slabs"])
         if work > LIMITS["work"]:
             raise TooBig(f"{len(p['slabs'])} slabs over {sum(map(len, obstacles))} obstacle vertices: {work} units "
                          f"of work (at most {LIMITS['work']})")

@@ -32,6 +32,7 @@ SHRINK_UNITS = 16.0
 TOUCH_UNITS = 512.0
 MATCH_UNITS = 256.0
 PEAK_SLACK = 1e-9
+ANGLE_SLACK = 1e-9  # a slab holds the start's or goal's angle within this
 ERRBOUND = 3.3306690738754716e-16  # Shewchuk's ccwerrboundA
 
 
@@ -370,3 +371,40 @@ def core_inside(core, piece: Piece, a: float, b: float, unit: float):
     ok &= ~(trough - rho < unit)
     bad = np.flatnonzero(~ok)
     return int(bad[0]) if len(bad) else None
+
+class Graph:
+    """The checker's graph, built slab by slab as the regions are matched (two slabs' regions
+    kept at a time, and the first for the wrap-around): the proof's nodes, the checker's own for
+    unlisted slivers, the links it finds and the proof's edges; the first missing end node or edge."""
+
+    def __init__(self, p, q, touch):
+        self.p, self.q, self.touch = p, q, touch
+        self.ends = {"start": set(), "goal": set()}
+        self.extra, self.faults = [], {}  # step -> the first fault of that step
+        self.given = set(p["edges"])
+
+    def slab(self, k, comps, owners):
+        s = self.p["slabs"][k]
+        node = (lambda r: (k, owners[r]) if owners[r] is not None else ("own", k, r))
+        for key, pose in (("start", self.q.start), ("goal", self.q.goal)):
+            if in_arc(pose[2], s["a"], s["b"], ANGLE_SLACK):
+                point = shapely.Point(pose[0], pose[1])
+                found = {node(r) for r, g in enumerate(comps) if shapely.dwithin(g, point, self.touch)}
+                listed = set(self.p[f"{key}_nodes"])
+                missing = sorted(n for n in found if n[0] != "own" and n not in listed)
+                if missing:
+                    self.faults.setdefault("nodes", f"{key}_nodes lacks {list(missing[0])}, a component holding "
+                                                    f"the {key}")
+                self.ends[key] |= found
+        return node
+
+    def link(self, k, comps, node, k2, comps2, node2):
+        """Pairs of components of slab k and k2 (k2 = k: the same slab) whose closures touch."""
+        if not comps or not comps2:
+            return
+        left, right = shapely.STRtree(comps2).query(comps, predicate="dwithin", distance=self.touch)
+        for u, v in ((node(r), node2(r2)) for r, r2 in zip(left.tolist(), right.tolist())):
+            if k2 == k or "own" in (u[0], v[0]):
+                self.extra.append((u, v))
+            elif (*u, *v) not in self.given:
+                self.faults.setdefault("edges", f"edges lacks {[*u, *v]}: the components touch")

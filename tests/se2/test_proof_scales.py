@@ -165,3 +165,19 @@ def test_a_core_test_costs_n_plus_m_log_not_n_times_m():
     finally:
         proof_geometry.Piece._edge_dist = real
     assert sum(calls) <= 8 * 1024  # 3 edges a point, 2 ends (n x m would be 262 144)
+
+
+def test_a_proof_past_the_checkers_work_limit_is_said_so(monkeypatch):
+    """The planner says when its proof asks check-proof for more work than it takes (it would be
+    refused): measured with the checker's own count, at a limit lowered to force it."""
+    import os
+
+    import planners
+    from conftest import SCENARIOS
+    from planners.core import proof_check
+
+    path = os.path.join(SCENARIOS, "se2", "wide_square.toml")
+    assert "work limit" not in planners.plan(path, planner="exact").message
+    monkeypatch.setitem(proof_check.LIMITS, "work", 10)
+    r = planners.plan(path, planner="exact")
+    assert r.proof is not None and "past check-proof's work limit" in r.message
