@@ -25,7 +25,7 @@ polygons with holes, and their connected components.
   nodes or links FREE does not yet reproduce ("FREE breaks there"), else those anywhere in
   the start's POSSIBLE component where it breaks, else all. The search stops at ``min_width``
   (no slab is cut below it) or at ``time_limit`` (checked before every region is built):
-  After the first round, zero-width slabs at the critical angles (a robot edge parallel to an
+  After two rounds, zero-width slabs at the critical angles (a robot edge parallel to an
   obstacle edge: :mod:`cspace.se2.critical`) join the partition (a door just wider than the robot).
   "undecided", with the resolution D = r·Δmax + the margin's reach + the disks' polygon error
   (no path with clearance above D exists, since such a path would lie in FREE; note section 4,
@@ -246,7 +246,7 @@ class _Search:
                 self.times["graphs"] += time.perf_counter() - t
                 if not self._split(split):
                     return self._result("undecided", reason="minimum slab width reached")
-                if self.refinements == 1:  # after the first round: zero-width slabs at the critical angles
+                if self.refinements == 2:  # after two rounds: zero-width slabs at the critical angles
                     self.part = with_zero_slabs(self.part, critical_angles(self.R.hull_robot, self.R.obstacles))
         except _Timeout:
             return self._result("undecided", reason="time limit")
