@@ -6,7 +6,8 @@ FREE to hold the passage (a 0.1 % door: about 10⁴ slabs round the circle). At 
 the zero-width slab [φ, φ] (FREE: the exact translation C-space of the turned robot, shrunk by
 δ) holds it at once. The critical angles are φ = ω − ρ (mod π): ω an obstacle edge's direction,
 ρ a robot edge's; each is weighed by the obstacle edges' length at it, and the heaviest few are
-inserted (4: the two senses of two perpendicular walls for a box) into the partition of the search (:mod:`cspace.se2.exact`) after its second round.
+inserted (4: the two senses of two perpendicular walls for a box) into the partition of the
+search (:mod:`cspace.se2.exact`) after its second round.
 """
 from __future__ import annotations
 
