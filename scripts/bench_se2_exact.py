@@ -32,7 +32,15 @@ path <= RRTConnect's median time to a first solution on at least half of the sce
 solves; here, on at least half of the solvable bundled scenes (printed too: on at least half of
 those RRTConnect solves at every seed).
 
-Usage: python scripts/bench_se2_exact.py [--seeds N] [--time T] [--scenes a,b] [--json FILE]
+Families (issue 49, ``--families N``: N scenes each, no bundled scenes): doors in a wall just
+wider than a box robot (0.3 % and 0.1 % of its width to spare, random sizes, door heights, start
+and goal poses), and a box between two round pillars with 1 % to spare (disks: never "proven
+unsolvable"). Per family: scenes decided by exact, solved, median CPU of exact's plan() against
+RRTConnect's at the same limit (one seed a scene, interleaved), colliding paths (the sweep
+oracle), and proofs refused by ``check-proof``. Targets: doors at 0.3 % all solved, median
+<= 1 s CPU; 0.1 %: all decided, median <= 3 s; 0 false "proven unsolvable", 0 refused proofs.
+
+Usage: python scripts/bench_se2_exact.py [--seeds N] [--time T] [--scenes a,b] [--json FILE] [--families N]
 """
 from __future__ import annotations
 
@@ -104,13 +112,97 @@ def run_scene(path: str, seeds: int, limit: float) -> dict:
     return row
 
 
+def door(seed: int, spare: float):
+    """A wall at x = 0 with a door (1 + spare) x the box robot's width, random sizes and poses."""
+    import math
+    import random
+
+    from cspace.io.load import scenario_from_dict
+
+    rng = random.Random(seed)
+    L, W = rng.uniform(1.2, 2.5), rng.uniform(0.3, 0.7)
+    d, y0 = (1 + spare) * W, rng.uniform(-1.5, 1.5)
+    return scenario_from_dict({
+        "space": "se2", "name": f"door{seed}", "bounds": {"xmin": -4, "xmax": 4, "ymin": -3, "ymax": 3},
+        "robot": {"polygon": [[-L / 2, -W / 2], [L / 2, -W / 2], [L / 2, W / 2], [-L / 2, W / 2]]},
+        "start": {"x": -2.5, "y": rng.uniform(-1, 1), "theta": rng.uniform(-math.pi, math.pi)},
+        "goal": {"x": 2.5, "y": rng.uniform(-1, 1), "theta": rng.uniform(-math.pi, math.pi)},
+        "obstacles": [{"polygon": [[-0.1, -5], [0.1, -5], [0.1, y0 - d / 2], [-0.1, y0 - d / 2]]},
+                      {"polygon": [[-0.1, y0 + d / 2], [0.1, y0 + d / 2], [0.1, 5], [-0.1, 5]]}]}, "door.toml")
+
+
+def pillars(seed: int, spare: float = 0.01):
+    """A box between two round pillars (disks of radius R), ``spare`` x its half-height to spare."""
+    import random
+
+    from cspace.io.load import scenario_from_dict
+
+    rng = random.Random(seed)
+    R, h, w = rng.uniform(2, 20), rng.uniform(0.1, 0.5), rng.uniform(0.5, 1.0)
+    c = R + h * (1 + spare)
+    return scenario_from_dict({
+        "space": "se2", "name": f"pillars{seed}", "bounds": {"xmin": -R - 4, "xmax": R + 4, "ymin": -R / 2, "ymax": R / 2},
+        "robot": {"polygon": [[-w, -h], [w, -h], [w, h], [-w, h]]},
+        "start": {"x": -R - 3, "y": 0.0, "theta": 0.0}, "goal": {"x": R + 3, "y": 0.0, "theta": 0.0},
+        "obstacles": [{"center": [0.0, c], "radius": R}, {"center": [0.0, -c], "radius": R}]}, "pillars.toml")
+
+
+def run_family(name: str, make, n: int, limit: float) -> dict:
+    from planners.core.proof_check import check_proof
+
+    ex_t, rr_t, decided, solved, rr_solved, bad, refused, proven = [], [], 0, 0, 0, 0, 0, 0
+    for seed in range(n):  # interleaved: exact, then RRTConnect, on the same scene
+        sc = make(seed)
+        ex, t_ex = cpu(lambda: planners.plan(sc, planner="exact", time=limit))
+        rr, t_rr = cpu(lambda: planners.plan(sc, planner="RRTConnect", time=limit, seed=seed))
+        ex_t.append(t_ex if ex.solved or ex.proof is not None else float("inf"))
+        rr_t.append(t_rr if rr.solved else float("inf"))
+        decided += ex.solved or ex.proof is not None
+        solved += ex.solved
+        rr_solved += rr.solved
+        proven += ex.proof is not None
+        bad += collides(sc, ex) + collides(sc, rr)
+        refused += ex.proof is not None and not check_proof(sc, ex.proof).valid
+    med = statistics.median
+    row = {"family": name, "scenes": n, "decided": decided, "solved": solved, "proven": proven,
+           "exact_median_cpu_s": med(ex_t), "rrt_solved": rr_solved, "rrt_median_cpu_s": med(rr_t),
+           "colliding": bad, "proofs_refused": refused}
+    print(f"{name:<16} decided {decided:>3}/{n:<3} solved {solved:>3} proven {proven:>3}  exact median "
+          f"{row['exact_median_cpu_s']:7.3f} s   RRTConnect {rr_solved:>3}/{n} median {row['rrt_median_cpu_s']:7.3f} s   "
+          f"ratio {row['exact_median_cpu_s'] / row['rrt_median_cpu_s']:.3g}   colliding {bad}   proofs refused {refused}",
+          flush=True)
+    return row
+
+
+def families(n: int, limit: float) -> list:
+    rows = [run_family("doors 0.3 %", lambda s: door(s, 0.003), n, limit),
+            run_family("doors 0.1 %", lambda s: door(1000 + s, 0.001), n, limit),
+            run_family("disk pillars 1 %", pillars, n, limit)]
+    d3, d1, pl = rows
+    print("targets:")
+    print(f"  doors 0.3 %: solved {d3['solved']}/{n}, median {d3['exact_median_cpu_s']:.3f} s CPU (all, <= 1 s): "
+          f"{'met' if d3['solved'] == n and d3['exact_median_cpu_s'] <= 1 else 'MISSED'}")
+    print(f"  doors 0.1 %: decided {d1['decided']}/{n}, median {d1['exact_median_cpu_s']:.3f} s CPU (all, <= 3 s): "
+          f"{'met' if d1['decided'] == n and d1['exact_median_cpu_s'] <= 3 else 'MISSED'}")
+    print(f"  disks: proven unsolvable {pl['proven']} (0), proofs refused {sum(r['proofs_refused'] for r in rows)} (0), "
+          f"colliding {sum(r['colliding'] for r in rows)} (0)")
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10, help="RRTConnect seeds (and exact repetitions) per scene")
     ap.add_argument("--time", type=float, default=30.0, help="RRTConnect's time limit per seed (s)")
     ap.add_argument("--scenes", help="comma-separated scene names (default: every scenarios/se2/*.toml)")
     ap.add_argument("--json", help="write the rows as JSON")
+    ap.add_argument("--families", type=int, help="run the issue-49 families of N scenes each instead of the bundled scenes")
     args = ap.parse_args(argv)
+    if args.families:
+        rows = families(args.families, args.time)
+        if args.json:
+            with open(args.json, "w") as fh:
+                json.dump(rows, fh, indent=1)
+        return 0
     paths = sorted(glob.glob(os.path.join(ROOT, "scenarios", "se2", "*.toml")))
     if args.scenes:
         want = set(args.scenes.split(","))

@@ -78,6 +78,9 @@ class SE2CSpace(SE2Motions):
         # its polygon, which the slab hulls cover); a point robot becomes the margin itself.
         self.margin = [np.asarray(m, dtype=np.float64) for m in (margin or [])]
         self.body_pieces = self.robot_pieces  # the robot itself, for clearance measures
+        # Pieces INSIDE the shapes as written (a disk's inscribed polygon): what a proof that no
+        # path exists is made of (from_scenario sets them for disks; polygons: the same pieces).
+        self.inner_obstacle_pieces, self.inner_body_pieces = self.obstacle_pieces, self.body_pieces
         if self.margin:
             self.robot_pieces = inflated(self.robot_pieces, self.margin)
         check_pieces(self.robot_pieces, MAX_ROTATING_VERTICES)
@@ -145,6 +148,10 @@ class SE2CSpace(SE2Motions):
                  obstacle_holes=[o.holes for o in sc.obstacles], robot_is_disk=sc.robot_kind == "disk",
                  slabs=slabs, grid_cells=grid_cells, margin=sc.margins())
         cs.scenario = sc
+        if sc.has_disks:
+            from ..translation.build import inner_pieces
+
+            cs.inner_obstacle_pieces, cs.inner_body_pieces = inner_pieces(sc)
         return cs
 
     # -- slabs -------------------------------------------------------------------------

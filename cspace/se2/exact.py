@@ -25,8 +25,11 @@ polygons with holes, and their connected components.
   nodes or links FREE does not yet reproduce ("FREE breaks there"), else those anywhere in
   the start's POSSIBLE component where it breaks, else all. The search stops at ``min_width``
   (no slab is cut below it) or at ``time_limit`` (checked before every region is built):
-  "undecided", with the resolution D = r·Δmax (no path with clearance above D exists, since
-  such a path would lie in FREE; note section 4).
+  After two rounds, zero-width slabs at the critical angles (a robot edge parallel to an
+  obstacle edge: :mod:`cspace.se2.critical`) join the partition (a door just wider than the robot).
+  "undecided", with the resolution D = r·Δmax + the margin's reach + the disks' polygon error
+  (no path with clearance above D exists, since such a path would lie in FREE; note section 4,
+  :mod:`cspace.se2.exact_report`).
 
 Angles are OMPL's, wrapped to [−π, π); a pose on the boundary ±π belongs to the first and
 the last slab. Nothing depends on randomness or on the iteration order of a set.
@@ -43,9 +46,11 @@ from ..kernel.slabs.slab import slab_range
 from ..kernel.polygons.rotation import TWO_PI, wrap_angle
 from .slab_graph import SlabRegions, point_free
 from .exact_path import AssemblyError, assemble, holding
+from .critical import critical_angles, with_zero_slabs
+from .exact_report import PROOF_FORMAT, disk_excess, margin_reach, proof_json, resolution  # noqa: F401
+from ..kernel.slabs.slab import ANGLE_SLACK
 from .walks import G_NODE, S_NODE, cheapest_walk, labels, reach, shortest_walk
 
-PROOF_FORMAT = "cspace-se2-proof/1"
 # A proof's start and goal join the POSSIBLE components of every slab within this many radians of
 # their angle (more nodes: a weaker claim), 10 x the independent checker's angle tolerance.
 ANGLE_NEAR = 1e-8
@@ -75,7 +80,8 @@ class _Timeout(Exception):
 def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, goal, *,
                      time_limit: float | None = None, min_width: float = TWO_PI / 2048, initial_slabs: int = 8,
                      margin: list | None = None, possible_only: bool = False, refine: bool = True,
-                     regions: SlabRegions | None = None) -> SE2ExactResult:
+                     regions: SlabRegions | None = None, inner_obstacles: list | None = None,
+                     inner_robot: list | None = None, excess: float = 0.0) -> SE2ExactResult:
     """Plan for a robot of convex ``robot_pieces`` (body frame) among convex ``obstacle_pieces``:
     a certified path, a proof that none exists, or "undecided" at the resolution reached.
 
@@ -86,6 +92,11 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
     bisects every slab; ``refine=False`` stops after the first partition ("undecided").
     ``regions``: a :class:`SlabRegions` of the same pieces, bounds and margin from an earlier
     search (its regions and links are cached: queries on one scene share them).
+    ``inner_obstacles``, ``inner_robot``: convex pieces INSIDE the scene's shapes as written
+    (a disk's inscribed polygon where ``obstacle_pieces`` / ``robot_pieces`` hold its
+    circumscribed one): POSSIBLE and the proof are built of them, so that a proof holds for the
+    disks themselves (None: the same pieces, polygons only); ``excess``: their polygons' error,
+    for the resolution statement.
 
     >>> wall = [np.array([[4., 0], [5, 0], [5, 4], [4, 4]]), np.array([[4., 6], [5, 6], [5, 10], [4, 10]])]
     >>> bar = [np.array([[-1.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-1.5, 0.2]])]
@@ -103,7 +114,8 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
     if not robot:
         raise ValueError("exact_se2_search: needs a robot of at least one convex piece (a point robot does not turn)")
     if regions is None:
-        regions = slab_regions(obstacle_pieces, robot, bounds, margin)
+        regions = slab_regions(obstacle_pieces, robot, bounds, margin, inner_obstacles=inner_obstacles,
+                               inner_robot=inner_robot, excess=excess)
     search = _Search(regions, start, goal, time_limit, float(min_width), initial_slabs)
     search.possible_only, search.refine = bool(possible_only), bool(refine)
     return search.run()
@@ -123,16 +135,23 @@ def initial_partition(n: int = 8) -> list[tuple[float, float]]:
     return part
 
 
-def slab_regions(obstacle_pieces: list, robot_pieces: list, bounds, margin: list | None = None) -> SlabRegions:
+def slab_regions(obstacle_pieces: list, robot_pieces: list, bounds, margin: list | None = None, *,
+                 inner_obstacles: list | None = None, inner_robot: list | None = None,
+                 excess: float = 0.0) -> SlabRegions:
     """The :class:`SlabRegions` :func:`exact_se2_search` works on (FREE with the robot inflated by
-    ``margin``, POSSIBLE with the body), to keep and pass to several searches."""
+    ``margin``, POSSIBLE with the body, of the ``inner_*`` pieces if given), to keep and pass to
+    several searches. ``excess``: the disks' circumscribed-polygon error (robot's + obstacles'),
+    which the resolution statement adds (:func:`cspace.se2.exact_report.disk_excess`)."""
     robot = [np.asarray(p, dtype=np.float64) for p in robot_pieces]
     hull = None
     if margin:
         from ..translation.build import inflated
 
         hull = inflated(robot, [np.asarray(m, dtype=np.float64) for m in margin])
-    return SlabRegions(obstacle_pieces, robot, bounds, hull_pieces=hull)
+    out = SlabRegions(obstacle_pieces, robot, bounds, hull_pieces=hull, inner_obstacles=inner_obstacles,
+                      inner_robot=inner_robot)
+    out.margin_reach, out.excess = margin_reach(margin), float(excess)
+    return out
 
 
 def from_scenario(scenario, query_index: int = 0, **kwargs) -> SE2ExactResult:
@@ -149,7 +168,7 @@ def from_scenario(scenario, query_index: int = 0, **kwargs) -> SE2ExactResult:
     """
     from ..io.load import load_scenario
     from ..io.scenario.schema import Scenario
-    from ..translation.build import decompose_obstacles, decompose_robot
+    from ..translation.build import decompose_obstacles, decompose_robot, inner_pieces
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(str(scenario))
     if not sc.rotates:
@@ -159,6 +178,9 @@ def from_scenario(scenario, query_index: int = 0, **kwargs) -> SE2ExactResult:
     robot, _ = decompose_robot([r.polygon for r in sc.robot], sc.robot_kind == "disk")
     q = sc.all_queries()[query_index]
     kwargs.setdefault("margin", sc.margins() or None)
+    if sc.has_disks and "regions" not in kwargs:
+        kwargs["inner_obstacles"], kwargs["inner_robot"] = inner_pieces(sc)
+        kwargs.setdefault("excess", disk_excess(sc))
     return exact_se2_search(obstacles, robot, sc.bounds, q.start, q.goal, **kwargs)
 
 
@@ -177,6 +199,9 @@ class _Search:
         self.possible_only, self.refine = False, True
         self.refinements = 0
         self.graph_sizes: dict = {}
+        self.banned: set = set()  # FREE links a failed assembly ruled out (by _key)
+        self.force: set = set()  # slabs (a, b) to bisect at the next refinement
+        self.repairs: list = []
 
     # -- the loop ------------------------------------------------------------------------
 
@@ -201,7 +226,8 @@ class _Search:
                             path = assemble(walk, self.part, freg, self.R, self.start, self.goal)
                         except AssemblyError as exc:  # a certified walk whose exact re-check failed
                             self.times["path"] += time.perf_counter() - t
-                            return self._result("undecided", error=str(exc))
+                            self._repair(walk, exc)
+                            continue
                         self.times["path"] += time.perf_counter() - t
                         return self._result("solved", path=path)
                 preg = self._regions("possible")
@@ -216,12 +242,40 @@ class _Search:
                         return self._result("undecided", reason=NO_PROOF_FOUND)
                     continue
                 t = time.perf_counter()
-                split = self._select(preg, freg, padj, fadj, reached)
+                split = self._select(preg, freg, padj, fadj, reached) | self._forced()
                 self.times["graphs"] += time.perf_counter() - t
                 if not self._split(split):
                     return self._result("undecided", reason="minimum slab width reached")
+                if self.refinements == 2:  # after two rounds: zero-width slabs at the critical angles
+                    self.part = with_zero_slabs(self.part, critical_angles(self.R.hull_robot, self.R.obstacles))
         except _Timeout:
             return self._result("undecided", reason="time limit")
+
+    def _key(self, n):
+        """A FREE node by its slab's angles (stable across refinements), S and G as they are."""
+        return n if n[0] < 0 else (*self.part[n[0]], n[1])
+
+    def _repair(self, walk: list, exc: AssemblyError) -> None:
+        """A walk whose exact re-check failed at node i (a rounding of the overlay at a vertex, a
+        turn point on a boundary): its links into and out of node i are dropped from the FREE
+        graph (the next walk goes round them, or through other link points), and node i's slab
+        is marked to be bisected at the next refinement (its halves' regions differ), even below
+        the floor (down to 2^-10 of it). Never an "undecided" while time is left."""
+        nodes = [n for n, _ in walk]
+        i = min(max(exc.index, 0), len(nodes) - 1)
+        for j in (i - 1, i):
+            if 0 <= j < len(nodes) - 1:
+                self.banned.add(frozenset((self._key(nodes[j]), self._key(nodes[j + 1]))))
+        self.repairs.append(str(exc)[:200])
+        if nodes[i][0] >= 0:
+            self.force.add(self.part[nodes[i][0]])
+
+    def _forced(self) -> set:
+        """The slabs marked by :meth:`_repair` still in the partition and wider than 2^-10 × the floor."""
+        out = {k for k, ab in enumerate(self.part) if ab in self.force
+               and 0.5 * (ab[1] - ab[0]) >= self.min_width / 1024}
+        self.force.clear()
+        return out
 
     def _wide(self) -> set:
         """The slabs that may still be bisected (half as wide stays above the floor)."""
@@ -234,7 +288,7 @@ class _Search:
         self.refinements += 1
         new = []
         for k, (a, b) in enumerate(self.part):
-            new += [(a, 0.5 * (a + b)), (0.5 * (a + b), b)] if k in split else [(a, b)]
+            new += [(a, 0.5 * (a + b)), (0.5 * (a + b), b)] if k in split and a < b else [(a, b)]
         self.part = new
         return True
 
@@ -318,6 +372,10 @@ class _Search:
                         n_edges += 1
         if same and ends[S_NODE] is not None and ends[S_NODE] == ends[G_NODE]:
             adj[S_NODE].append((G_NODE, None))  # one translation at the common angle
+        if self.banned:
+            for n in adj:
+                kn = self._key(n)
+                adj[n] = [e for e in adj[n] if frozenset((kn, self._key(e[0]))) not in self.banned]
         for n in adj:
             adj[n].sort(key=lambda e: e[0])
         self.graph_sizes["free"] = {"nodes": len(adj) - 2, "edges": n_edges}
@@ -356,7 +414,8 @@ class _Search:
                     pick.add(n[0])
             if (u, v) not in good_edge:
                 pick |= {n[0] for n in (u, v) if n[0] >= 0}
-        pick &= wide
+        # along the cheapest walk slabs go below the floor (to 2^-6 of it): as narrow as the room there
+        pick = {k for k in pick if 0.5 * (self.part[k][1] - self.part[k][0]) >= self.min_width / 64}
         if not pick:
             pick = {n[0] for n in bad_node if n in reached} & wide
         if not pick:
@@ -366,28 +425,20 @@ class _Search:
     # -- results -------------------------------------------------------------------------
 
     def _proof(self, preg, s_p, g_p, edges) -> dict:
-        slabs = []
-        for (a, b), reg in zip(self.part, preg):
-            slabs.append({"a": float(a), "b": float(b), "cores": [c.tolist() if len(c) else [] for c in reg.cores],
-                          "components": [_component_json(c) for c in reg.components]})
-        xmin, xmax, ymin, ymax = self.R.bounds
-        return {"format": PROOF_FORMAT, "start": list(self.start), "goal": list(self.goal),
-                "bounds": [xmin, xmax, ymin, ymax], "robot_pieces": [p.tolist() for p in self.R.robot],
-                "slabs": slabs, "start_nodes": [list(n) for n in sorted(s_p)],
-                "goal_nodes": [list(n) for n in sorted(g_p)], "edges": sorted(edges)}
+        return proof_json(self.part, preg, self.R, self.start, self.goal, s_p, g_p, edges)
 
     def _result(self, status: str, path=None, proof=None, **extra) -> SE2ExactResult:
         widest = max(b - a for a, b in self.part)
-        D = self.R.radius * widest
+        D, words = resolution(self.R, widest, ANGLE_SLACK)
         stats = {"slabs": len(self.part), "refinements": self.refinements, "regions_built": dict(self.R.counts),
+                 "repairs": len(self.repairs),
                  "graphs": dict(self.graph_sizes), "seconds": dict(self.times),
                  "wall_seconds": time.perf_counter() - self.t0, "cpu_seconds": time.process_time() - self.c0,
                  "partition": [[float(a), float(b)] for a, b in self.part], "widest_slab": widest, "resolution": D,
                  **extra}
         out = SE2ExactResult(status, resolution=D, stats=stats, proof=proof)
         if status == "undecided":
-            stats["statement"] = (f"no path with clearance above {D:.6g} (robot radius {self.R.radius:.6g} x widest "
-                                  f"slab {widest:.6g} rad) exists; a tighter one was not decided")
+            stats["statement"] = words
         if path is not None:
             out.path = path
             d = np.diff(path, axis=0)
@@ -396,8 +447,3 @@ class _Search:
             out.rotation = float(turn.sum())
         return out
 
-
-def _component_json(poly) -> dict:
-    """A component as the proof stores it: shell CCW, holes CW, no closing repeat."""
-    return {"shell": [list(p) for p in poly.exterior.coords[:-1]],
-            "holes": [[list(p) for p in r.coords[:-1]] for r in poly.interiors]}

@@ -35,7 +35,11 @@ from .slab_graph import point_free
 
 
 class AssemblyError(RuntimeError):
-    """A walk of the FREE graph whose exact re-check failed (a translation or a turn point)."""
+    """A walk of the FREE graph whose exact re-check failed (a translation or a turn point).
+    ``index``: the walk's node where it failed (0 the start's, the last the goal's), set by
+    :func:`assemble`, so that the search can route round it or refine its slab."""
+
+    index: int = -1
 
 
 def in_slab(theta: float, a: float, b: float) -> float | None:
@@ -82,6 +86,15 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
     >>> assemble(walk, [], [], sr, (1, 1, 0.0), (5, 1, 0.0)).tolist()
     [[1.0, 1.0, 0.0], [5.0, 1.0, 0.0]]
     """
+    at = [0]
+    try:
+        return _assemble(walk, part, freg, regions, start, goal, at)
+    except AssemblyError as exc:
+        exc.index = at[0]
+        raise
+
+
+def _assemble(walk, part, freg, regions, start, goal, at: list) -> np.ndarray:
     bounds = regions.bounds
     xs, ys, ts = (float(v) for v in start)
     xg, yg, tg = (float(v) for v in goal)
@@ -96,6 +109,7 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
     if tuple(pts[0]) != (xs, ys):  # (an end joined its slab directly: nothing to translate at its angle)
         _translate(poses, regions.free_at(ts), bounds, (xs, ys), pts[0], ts)
     for i in range(1, m):
+        at[0] = i
         k = nodes[i][0]
         a, b = part[k]
         pieces = freg[k].pieces
@@ -118,6 +132,7 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
                 _turn(poses, p_out, a)
             else:
                 raise AssemblyError(f"slabs {k} and {nxt} are not adjacent")
+    at[0] = m
     if tuple(pts[-1]) != (xg, yg):
         _translate(poses, regions.free_at(tg), bounds, pts[-1], (xg, yg), tg)
     return np.array(poses, dtype=np.float64)

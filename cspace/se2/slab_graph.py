@@ -24,15 +24,18 @@ Erring toward MORE possible space (what a proof of "no path" needs). The core C_
 already padded inward by ``slab_inner`` (4 pads per edge, for the float rotation and
 clipping). POSSIBLE is then computed with the core shrunk by a further ε (every edge moved
 inward by ε: the erosion of C_i by the disk of radius ε, up to rounding far below ε):
-ε = 2^-34 · S', S' = max coordinate magnitude of the bounds and obstacles + r√2 (r the robot
-radius), i.e. 64 × the checked tolerance of the GEOS union (:mod:`cspace.kernel.minkowski.union`,
-2^-40 of the coordinates, or the snap-rounding grid 2^-42). The union of O ⊕ (−(C ⊖ ε))
+ε = 64 u, u = 2^-40 · S, S = max coordinate magnitude of the bounds and the proof's obstacles +
+r√2 (r the proof's robot radius), i.e. 64 × the checked tolerance of the GEOS union
+(:mod:`cspace.kernel.minkowski.union`, 2^-40 of the coordinates, or the snap-rounding grid 2^-42).
+S and u are the independent checker's too (:mod:`planners.core.proof_geometry` has the table:
+its cores need ≥ u, its sums shrink by 16 u, it links within 512 u), so every proof the planner
+writes is one the checker accepts, at any offset and feature size. The union of O ⊕ (−(C ⊖ ε))
 grown by ε lies inside the union of O ⊕ (−C), so as long as GEOS moves no boundary by
 more than ε (its checked tolerance is 64 × smaller) the computed obstacle union lies
 inside the true one and the computed POSSIBLE contains the true POSSIBLE of the cores C_i.
 The proof stores the un-shrunk cores C_i (the checker's cores), so its components cover
 the POSSIBLE the checker derives from them. Links between POSSIBLE components err
-toward more links: closures within ``tol`` = 2^-30 · S' count as meeting.
+toward more links: closures within ``proof_tol`` = 1024 u count as meeting.
 
 FREE only needs to be a subset up to rounding: every point the planner uses is certified
 again exactly (:func:`point_free`; translations by :func:`cspace.paths.shortest.shortest_path`,
@@ -56,18 +59,19 @@ from ..kernel.polygons.rotation import rotate_piece
 from ..translation.build import pair_sums
 from ..paths.shortest import free_space
 
-EPS_REL = 2.0**-34  # POSSIBLE's extra shrink of the cores, relative to S'
+UNIT_REL = 2.0**-40  # the proof side's unit u, relative to S (see SlabRegions)
+EPS_UNITS = 64.0  # POSSIBLE's extra shrink of the cores (the checker's sums: 16 u)
+TOL_UNITS = 1024.0  # POSSIBLE links and end nodes within this (the checker's: 512 u)
 # A core is computed over [a - CORE_SLACK, b + CORE_SLACK]: inside the robot at every angle of the
 # wider interval, so inside it on the slab (a smaller core: more POSSIBLE, the proof's side), and
 # still inside where an independent check unsure of an angle's last bits looks just past a slab's
 # end (planners.core.proof_check counts a sinusoid's peak within 1e-9 rad of the slab: a core
 # vertex touching the robot's edge at the slab's end, inside by the pads only, failed it there).
 CORE_SLACK = 1e-8
-# ... and with its edges moved in by ε / 16 more than the slab pad (2^-38 S', a 64th of ε at
-# 4 pads per edge): far above the independent check's margin (1e-12 relative to the edge's and
-# the vertex's magnitudes), which a core at its pads alone met only just (a short end edge).
+# ... and with its edges moved in by ε / 16 more than the slab pad (16 u at 4 pads per edge): far
+# above the independent check's margin (u), which a core at its pads alone met only just.
 CORE_PAD = 1.0 / 16.0
-TOL_REL = 2.0**-30  # link / membership tolerance, and the depth of a certified link point
+TOL_REL = 2.0**-30  # FREE: the depth of a certified link point (relative to S' of FREE's pieces)
 
 
 @dataclass
@@ -98,9 +102,16 @@ class SlabRegions:
     (2, 2, True)
     """
 
-    def __init__(self, obstacle_pieces: list, robot_pieces: list, bounds, *, hull_pieces: list | None = None):
+    def __init__(self, obstacle_pieces: list, robot_pieces: list, bounds, *, hull_pieces: list | None = None,
+                 inner_obstacles: list | None = None, inner_robot: list | None = None):
         self.obstacles = [np.asarray(o, dtype=np.float64) for o in obstacle_pieces]
         self.robot = [np.asarray(r, dtype=np.float64) for r in robot_pieces]
+        # POSSIBLE (the proof's side) is built of shapes INSIDE the scene as written: for a disk,
+        # the polygon inscribed in it, not the circumscribed one FREE keeps clear of (a proof must
+        # hold for the disk itself). Polygons are the same pieces either way.
+        self.core_obstacles = self.obstacles if inner_obstacles is None else \
+            [np.asarray(o, dtype=np.float64) for o in inner_obstacles]
+        self.core_robot = self.robot if inner_robot is None else [np.asarray(r, dtype=np.float64) for r in inner_robot]
         # The pieces FREE's hulls are built from (the robot inflated by a margin, if any):
         # FREE shrinks and POSSIBLE, built from the body itself, only grows: FREE ⊆ POSSIBLE.
         self.hull_robot = self.robot if hull_pieces is None else [np.asarray(r, dtype=np.float64) for r in hull_pieces]
@@ -108,14 +119,24 @@ class SlabRegions:
         self.radius = max(robot_radius(self.robot), robot_radius(self.hull_robot))
         self.scale = max([abs(v) for v in self.bounds] + [float(np.abs(o).max()) for o in self.obstacles if len(o)])
         s2 = self.scale + self.radius * math.sqrt(2.0)
-        self.pad = slab_pad(s2)  # slab_inner's pad, as SE2CSpace's
         self.hull_pad = slab_pad(max(self.radius * math.sqrt(2.0), self.scale))
-        self.eps = EPS_REL * s2
-        self.tol = TOL_REL * s2
+        self.tol = TOL_REL * s2  # FREE's link depth
+        # The proof side's numbers, from the one quantity the independent checker derives too
+        # (planners.core.proof_geometry.scene_unit): S = the largest coordinate of the bounds and
+        # the proof's obstacles + √2 × the proof's robot radius; u = 2^-40 S.
+        ps = max([abs(v) for v in self.bounds] + [float(np.abs(o).max()) for o in self.core_obstacles if len(o)]) \
+            + robot_radius(self.core_robot) * math.sqrt(2.0)
+        self.unit = UNIT_REL * ps
+        self.pad = slab_pad(ps)  # slab_inner's pad (u / 16)
+        self.eps = EPS_UNITS * self.unit
+        self.proof_tol = TOL_UNITS * self.unit
         self._free: dict = {}
         self._possible: dict = {}
         self._links: dict = {}
         self.counts = {"free_built": 0, "possible_built": 0, "links_built": 0}
+        # what the resolution statement adds to r·Δ (cspace.se2.exact_report): the margin's reach
+        # and the disks' polygon error (set by cspace.se2.exact.slab_regions)
+        self.margin_reach, self.excess = 0.0, 0.0
 
     # -- regions -----------------------------------------------------------------------
 
@@ -166,7 +187,7 @@ class SlabRegions:
             a, b = key
             cores, used = [], []
             lo, hi, pad = a - CORE_SLACK, b + CORE_SLACK, self.pad + CORE_PAD * self.eps
-            for p in self.robot:
+            for p in self.core_robot:
                 c = slab_inner(p, lo, hi, pad)
                 cores.append(c if len(c) >= 3 else np.zeros((0, 2)))
                 if len(c) >= 3:
@@ -174,14 +195,16 @@ class SlabRegions:
                     s = slab_inner(p, lo, hi, pad + 0.25 * self.eps)
                     if len(s) >= 3:
                         used.append(s)
-            self._possible[key] = self._region(a, b, "possible", used, cores, t)
+            self._possible[key] = self._region(a, b, "possible", used, cores, t, self.core_obstacles)
             self.counts["possible_built"] += 1
         return self._possible[key]
 
-    def _region(self, a: float, b: float, kind: str, robot_side: list, cores: list, t: float) -> Region:
+    def _region(self, a: float, b: float, kind: str, robot_side: list, cores: list, t: float,
+                obstacles: list | None = None) -> Region:
         import shapely
 
-        pieces = pair_sums(self.obstacles, [reflect(h) for h in robot_side]) if robot_side and self.obstacles else []
+        obstacles = self.obstacles if obstacles is None else obstacles
+        pieces = pair_sums(obstacles, [reflect(h) for h in robot_side]) if robot_side and obstacles else []
         F = free_space(pieces, self.bounds)
         comps = [p for p in shapely.get_parts(F) if p.geom_type == "Polygon" and not p.is_empty]
         boxes = np.array([p.bounds for p in comps], dtype=np.float64).reshape(-1, 4)
@@ -196,7 +219,9 @@ class SlabRegions:
 
     def free_links(self, r1: Region, r2: Region) -> list[tuple[int, int, tuple[float, float]]]:
         """(i, j, point): FREE components i of r1 and j of r2 whose intersection has an
-        interior, with a point deep inside it (more than ``tol`` from its boundary)."""
+        interior, with a point deep inside it (more than ``tol`` from its boundary), or, where
+        the overlap is thinner than that (bounds of any thinness: a rail), a point inside it
+        (the path's assembly re-checks every link point exactly against both slabs)."""
         key = ("free", r1.a, r1.b, r2.a, r2.b)
         if key not in self._links:
             import shapely
@@ -205,6 +230,8 @@ class SlabRegions:
             for i, j in _box_pairs(r1.boxes, r2.boxes, 0.0):
                 inter = shapely.intersection(r1.components[i], r2.components[j])
                 pt = deep_point(inter, self.tol)
+                if pt is None:
+                    pt = inner_point(inter)
                 if pt is not None:
                     out.append((i, j, pt))
             self._links[key] = out
@@ -212,22 +239,22 @@ class SlabRegions:
         return self._links[key]
 
     def possible_links(self, r1: Region, r2: Region) -> list[tuple[int, int]]:
-        """(i, j): POSSIBLE components of r1 and r2 whose closures meet or come within ``tol``."""
+        """(i, j): POSSIBLE components of r1 and r2 whose closures meet or come within ``proof_tol``."""
         key = ("possible", r1.a, r1.b, r2.a, r2.b)
         if key not in self._links:
             import shapely
 
             # (components that overlap, the usual case between neighbouring slabs, are at distance
             # 0: the prepared intersects test answers them without measuring)
-            out = [(i, j) for i, j in _box_pairs(r1.boxes, r2.boxes, self.tol)
+            out = [(i, j) for i, j in _box_pairs(r1.boxes, r2.boxes, self.proof_tol)
                    if shapely.intersects(r1.components[i], r2.components[j])
-                   or shapely.distance(r1.components[i], r2.components[j]) <= self.tol]
+                   or shapely.distance(r1.components[i], r2.components[j]) <= self.proof_tol]
             self._links[key] = out
             self.counts["links_built"] += 1
         return self._links[key]
 
     def near(self, region: Region, x: float, y: float) -> list[int]:
-        """Components of ``region`` whose closure is within ``tol`` of (x, y).
+        """Components of ``region`` whose closure is within ``proof_tol`` of (x, y).
 
         >>> sr = SlabRegions([np.array([[4., 0], [5, 0], [5, 10], [4, 10]])], [np.array([[0., 0], [1, 0], [0, 1]])],
         ...                  (0, 10, 0, 10))
@@ -238,9 +265,9 @@ class SlabRegions:
 
         pt = shapely.Point(float(x), float(y))
         return [i for i in range(len(region.components))
-                if _box_near(region.boxes[i], x, y, self.tol)
+                if _box_near(region.boxes[i], x, y, self.proof_tol)
                 and (shapely.intersects_xy(region.components[i], float(x), float(y))
-                     or shapely.distance(region.components[i], pt) <= self.tol)]
+                     or shapely.distance(region.components[i], pt) <= self.proof_tol)]
 
     def containing(self, region: Region, x: float, y: float) -> int | None:
         """The component of ``region`` that covers (x, y), or None.
@@ -320,6 +347,24 @@ def deep_point(geom, depth: float) -> tuple[float, float] | None:
         if p.boundary.distance(shapely.Point(cx, cy)) > depth and shapely.intersects_xy(p, cx, cy):
             return float(cx), float(cy)
     return None
+
+
+def inner_point(geom) -> tuple[float, float] | None:
+    """A point inside ``geom`` (shapely, polygonal) of positive area, however thin: the
+    representative point of its largest part; None if it has no area.
+
+    >>> import shapely
+    >>> x, y = inner_point(shapely.box(0, 5, 3, 5 + 1e-9))
+    >>> 0 < x < 3 and 5 < y < 5 + 1e-9, inner_point(shapely.LineString([(0, 0), (1, 1)]))
+    (True, None)
+    """
+    import shapely
+
+    parts = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and p.area > 0.0]
+    if not parts:
+        return None
+    pt = max(parts, key=lambda q: q.area).representative_point()
+    return float(pt.x), float(pt.y)
 
 
 def _box_pairs(b1: np.ndarray, b2: np.ndarray, grow: float) -> list[tuple[int, int]]:

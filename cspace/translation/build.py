@@ -255,3 +255,31 @@ def inflated(robot_pieces: list[np.ndarray], margin: list[np.ndarray]) -> list[n
     if len(margin) == 1 and robot_pieces:
         return pair_sums([np.asarray(r, dtype=np.float64) for r in robot_pieces], [np.asarray(margin[0], dtype=np.float64)])
     return inflated_pieces(robot_pieces, margin)
+
+
+def inner_pieces(sc) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Convex pieces (obstacles, robot) INSIDE a scenario's shapes as written: its polygons, and
+    for each disk the polygon inscribed in it (:meth:`cspace.io.scenario.schema.Shape.inner_polygon`)
+    instead of the circumscribed one the C-space is built of. A proof that no path exists made
+    of these holds for the disks themselves (less obstacle, a smaller robot); a disk too small
+    to hold a polygon drops out (a point robot then).
+
+    >>> from cspace.io.scenario.schema import Scenario, Shape
+    >>> from cspace.kernel.polygons.disk import disk_polygon
+    >>> sc = Scenario("d", (0, 4, 0, 4), [], [Shape(disk_polygon((2, 2), 1.0, sides=8), disk=(2.0, 2.0, 1.0),
+    ...               convex=True)], (0, 0), (4, 4))
+    >>> obs, rob = inner_pieces(sc)
+    >>> len(obs), bool(np.hypot(obs[0][:, 0] - 2, obs[0][:, 1] - 2).max() < 1.0), rob
+    (1, True, [])
+    """
+    obstacles, holes, convex = [], [], []
+    for o in sc.obstacles:
+        p = o.inner_polygon()
+        if len(p) >= 3:
+            obstacles.append(p)
+            holes.append(o.holes)
+            convex.append(o.convex)
+    pieces, _, _ = decompose_obstacles(obstacles, holes, convex=convex)
+    robot = [r.inner_polygon() for r in sc.robot]
+    rpieces, _ = decompose_robot([p for p in robot if len(p) >= 3], sc.robot_kind == "disk")
+    return pieces, rpieces

@@ -196,7 +196,8 @@ def _reeds_shepp(sc, cspace, adapter, query, se2_path, budget: float, simplify: 
     path, note = poses, "not shortened"
     t2 = _now()
     if simplify:  # bounded: a long wriggle of short curves costs OMPL's full simplifier seconds
-        path, note = shorten(adapter, poses, query, bounded=len(poses) > BOUNDED_PAST)
+        path, note = shorten(adapter, poses, query, time_limit=max(end - _now(), 0.0),
+                             bounded=len(poses) > BOUNDED_PAST)
     return PlanResult(scenario=sc.name, solved=True, exact=True, path=path, length=adapter.length(path),
                       planner="auto", seed=0, start=tuple(query.start), goal=tuple(query.goal),
                       timings={"solve": search_s + convert_s, "simplify": _now() - t2},

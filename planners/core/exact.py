@@ -49,8 +49,12 @@ def exact_plan(sc, cspace, query, time_limit: float | None = None, progress: boo
     elif sp.solved:
         message = ("exact shortest path: the limit of free paths, it touches C-obstacle boundaries where it "
                    "bends (set a clearance to drive it)")
-    elif sp.proven_unsolvable:
-        message = "proven unsolvable (start and goal are in different free components)"
+    elif sp.proven_unsolvable and separated_as_written(sc, cspace, query):
+        message = "proven unsolvable (start and goal are in different free components" + _kept(sc) + ")"
+    elif sp.proven_unsolvable:  # only the disks' circumscribed polygons close the way: not a proof
+        message = ("no path found: start and goal are in different free components of the C-space built of "
+                   "the disks' circumscribed polygons, but not of their inscribed ones (raise the disks' "
+                   "precision, disk_tolerance, or use a sampling planner)")
     else:
         message = f"no path found ({sp.stats.get('reason', 'search exhausted')})"
     return PlanResult(
@@ -81,8 +85,44 @@ def separated_proof(sc, cspace, query, time_limit: float | None = None) -> PlanR
 
     if not separated(cspace.pieces, cspace.bounds, query.start, query.goal):
         return None
+    if not separated_as_written(sc, cspace, query):
+        return None
     return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 2)), length=math.inf,
                       planner="", seed=0, start=tuple(query.start), goal=tuple(query.goal), timings={},
                       checks={}, stages=["free components"],
                       message="proven unsolvable before sampling: start and goal are in different free "
-                              "components (no collision-free path exists)")
+                              "components (no collision-free path exists" + _kept(sc) + ")")
+
+
+def _kept(sc) -> str:
+    """What "no path" is about: with a clearance or a margin, paths keeping it."""
+    d = getattr(sc, "clearance", 0.0)
+    if d > 0 or getattr(sc, "margin", None) is not None:
+        return f" keeping clearance {d:g}" if getattr(sc, "margin", None) is None else " keeping the margin"
+    return ""
+
+
+def separated_as_written(sc, cspace, query) -> bool:
+    """Given that start and goal are in different components of the C-space (built of each disk's
+    circumscribed polygon), are they also in that of the shapes INSIDE the scene as written (each
+    disk, robot's, obstacle's and the clearance's, by its inscribed polygon)? Only then is "no
+    path exists" true for the disks themselves. Scenes of polygons only: True, nothing built.
+
+    >>> import os
+    >>> from cspace import CSpace
+    >>> from cspace.io.load import load_scenario
+    >>> sc = load_scenario(os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "narrow_closed.toml"))
+    >>> separated_as_written(sc, CSpace.from_scenario(sc), sc.all_queries()[0])
+    True
+    """
+    if not sc.has_disks and not getattr(sc, "clearance", 0.0) > 0:
+        return True
+    from cspace import CSpace
+    from cspace.paths.shortest import separated
+
+    obs = [(o.inner_polygon(), o.holes) for o in sc.obstacles]
+    obs = [(p, h) for p, h in obs if len(p) >= 3]
+    robot = [p for p in (r.inner_polygon() for r in sc.robot) if len(p) >= 3]
+    inner = CSpace(cspace.bounds, [p for p, _ in obs], robot, obstacle_holes=[h for _, h in obs],
+                   robot_is_disk=sc.robot_kind == "disk", normalized=True, margin=sc.margins(inner=True))
+    return separated(inner.pieces, inner.bounds, query.start, query.goal)

@@ -10,7 +10,8 @@ exists, or the resolution it reached (:mod:`cspace.se2.exact`), as a PlanResult.
   exists at any resolution; the proof (``PlanResult.proof``) can be written out and re-checked
   by ``cspace check-proof``.
 - *not decided*: refinement reached its floor or the time limit: no path keeps more than D
-  from the obstacles (D = r·Δ, the note's resolution statement).
+  from the obstacles (D = r·Δ + the margin's reach + the disks' polygon error, the note's
+  resolution statement: :mod:`cspace.se2.exact_report`).
 
 A car moves along SE(2) paths, so the POSSIBLE graph's proof holds for it too; a car cannot
 turn in place, so its ``exact`` answers only with a proof. :func:`quick_proof` is the cheap end
@@ -113,7 +114,7 @@ def proof_joins(cspace, build: bool = True) -> list:
 def _regions_of(cspace, room: float = 0.0):
     """The C-space's :class:`cspace.se2.slab_graph.SlabRegions` (with the extra clearance
     ``room``, see :func:`search`), made on first use and kept."""
-    from cspace.se2.exact import slab_regions
+    from cspace.se2.exact import disk_excess, slab_regions
 
     kept = _REGIONS.setdefault(cspace, {})
     if room not in kept:
@@ -122,7 +123,11 @@ def _regions_of(cspace, room: float = 0.0):
             from cspace.kernel.minkowski.margin import margin_shapes
 
             margin += margin_shapes(room)
-        kept[room] = slab_regions(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, margin or None)
+        kept[room] = slab_regions(
+            cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, margin or None,
+            inner_obstacles=getattr(cspace, "inner_obstacle_pieces", None),
+            inner_robot=getattr(cspace, "inner_body_pieces", None),
+            excess=disk_excess(cspace.scenario) if getattr(cspace, "scenario", None) is not None else 0.0)
     return kept[room]
 
 
@@ -165,10 +170,11 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     if not ok:  # the slab graph certifies its path; this re-check is the second opinion
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
                           message=f"the slab graph's path failed the certified re-check ({why}): not solved", **base)
-    path, note = raw, "OMPL not installed: not shortened"
+    path, note = raw, "not shortened (--no-simplify)"
     if simplify:
         t2 = time.perf_counter()
-        path, note = shorten(adapter, raw, query)
+        left = None if time_limit is None else max(0.0, float(time_limit) - (t2 - t0))
+        path, note = shorten(adapter, raw, query, time_limit=left)
         timings["simplify"] = time.perf_counter() - t2
         base["stages"] = ["slab graph", "verify", "simplify"]
     length, raw_len = adapter.length(path), adapter.length(raw)
@@ -196,22 +202,43 @@ def from_search(sc, query, res, search_s: float) -> PlanResult:
     graph = f"{res.stats['slabs']} slabs, {res.stats['refinements']} refinements"
     return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
                       message=f"proven unsolvable: no collision-free path exists at any resolution (the "
-                              f"slab graph's POSSIBLE regions separate start and goal; {graph})",
+                              f"slab graph's POSSIBLE regions separate start and goal; {graph}){_too_big(sc, res.proof)}",
                       proof=res.proof, **base)
 
 
-def shorten(adapter, path: np.ndarray, query, bounded: bool = False) -> tuple[np.ndarray, str]:
+def _too_big(sc, proof) -> str:
+    """A note when the proof asks ``check-proof`` for more work than it takes (it would refuse it)."""
+    from .proof_check import LIMITS, convex_obstacles, proof_work
+
+    work = proof_work(convex_obstacles(sc), proof["slabs"])
+    return "" if work <= LIMITS["work"] else (f"; the proof is past check-proof's work limit ({work} > "
+                                              f"{LIMITS['work']}): it cannot be re-checked")
+
+
+def shorten(adapter, path: np.ndarray, query, time_limit: float | None = None,
+            bounded: bool = False) -> tuple[np.ndarray, str]:
     """``path`` shortened by OMPL's simplifier under the adapter's certified motion validator,
-    and verified again; the original path where OMPL is missing or the result is not better.
-    Deterministic: OMPL's random stream is seeded with 0 (:func:`make_setup`). ``bounded``: only
-    OMPL's vertex reduction, a number of tries bounded by the path's size (the whole simplifier's
-    rounds are not bounded: seconds on a car's path of hundreds of short curves)."""
+    and verified again; the original path where OMPL is missing, the result is not better, or
+    ``time_limit`` (seconds) runs out: the simplifier stops at it (its termination condition,
+    and every motion check asked after it answers "not free" at once, so OMPL keeps what it has),
+    and a shortening that ended past it is dropped for the certified path (its re-check would
+    take more time). Deterministic within its time: OMPL's random stream is seeded with 0.
+    ``bounded``: only OMPL's vertex reduction, a number of tries bounded by the path's size (the
+    whole simplifier's rounds are not bounded: seconds on a car's path of hundreds of short curves)."""
     from ..adapters.glue import make_setup, ompl, ompl_available
 
-    if not ompl_available() or len(path) < 3:
-        return path, "OMPL not installed: not shortened" if len(path) >= 3 else "nothing to shorten"
-    og = ompl()[1]
-    ss, _space, _checker, _validator = make_setup(adapter, "RRTConnect", 0)
+    if len(path) < 3:
+        return path, "nothing to shorten"
+    if not ompl_available():
+        return path, "OMPL not installed: not shortened"
+    if time_limit is not None and time_limit <= 0.0:
+        return path, "no time left to shorten it"
+    ob, og = ompl()[:2]
+    ss, _space, _checker, validator = make_setup(adapter, "RRTConnect", 0)
+    deadline = None if time_limit is None else time.perf_counter() + float(time_limit)
+    if deadline is not None and hasattr(validator, "motion_free"):
+        check = validator.motion_free
+        validator.motion_free = lambda q0, q1: time.perf_counter() < deadline and check(q0, q1)
     ss.setup()
     si = ss.getSpaceInformation()
     p = og.PathGeometric(si)
@@ -219,10 +246,14 @@ def shorten(adapter, path: np.ndarray, query, bounded: bool = False) -> tuple[np
         s = si.allocState()
         adapter.set_state(s, pose)
         p.append(s)
-    if not bounded:
-        og.PathSimplifier(si).simplifyMax(p)
-    else:  # shortcuts between random vertices, a bounded number of tries (OMPL's rounds are not)
+    if bounded:  # shortcuts between random vertices, a bounded number of tries (OMPL's rounds are not)
         og.PathSimplifier(si).reduceVertices(p, max(SHORTCUT_TRIES, 4 * len(path)))
+    elif deadline is None:
+        og.PathSimplifier(si).simplifyMax(p)
+    else:
+        og.PathSimplifier(si).simplify(p, ob.timedPlannerTerminationCondition(deadline - time.perf_counter()), False)
+    if deadline is not None and time.perf_counter() >= deadline:
+        return path, "the time limit stopped the shortening: the certified path is kept as found"
     out = adapter.path_array(p)
     out[0], out[-1] = path[0], path[-1]  # the exact ends (the states' round trip may round x, y)
     ok, _ = adapter.verify(out, query.start, query.goal)

@@ -13,30 +13,36 @@ regions, nodes, edges, separation (see :func:`check_proof`).
 Soundness does not rest on the proof's component polygons: they only name the checker's own
 components (a one-to-one match); nodes, edges and the search use the recomputed geometry.
 
-Tolerances (each errs toward refusing a proof):
+Tolerances: one unit u = 2^-40 S shared with the planner (:mod:`planners.core.proof_geometry`
+has the table); each errs toward refusing a proof:
 
 - angles of start/goal equal the scenario's modulo 2 pi within 1e-12 (1 + |theta|); node look-up
   then uses the scenario's angle, and a slab holds it if within ANGLE_SLACK = 1e-9 rad of it;
 - cover: exact rational comparisons with bounds of pi: width <= a number below pi/2, last b - first
   a >= a number above 2 pi, and the wrap-around stays below 2 pi (a_{K-1} - a_0, b_{K-1} - b_0);
   all slab angles within +-64 rad;
-- cores: each vertex must stay inside each edge half-plane with a margin of CORE_MARGIN = 1e-12
-  (|e| |c| + |p| |q|) (e the edge q - p, c the vertex), far above the float error of the sums
-  (about 1e-15 of that); the minimum of the sinusoid counts its trough when within 1e-9 rad of the
-  slab; anything not finite fails;
-- regions: every convex sum is shrunk by SHRINK = 1e-10 M (M the largest coordinate magnitude of
-  bounds, obstacles and cores) and the bounds box grown by it, so rounding of the sums and of
-  shapely's overlay (snapping works at about 1e-12 of the extent) never closes a passage: the
-  recomputed POSSIBLE only grows. Triangles of a non-convex obstacle that the obstacle does not
-  cover are dropped (smaller obstacles). A proof component matches a recomputed one when their
-  symmetric difference is at most 1e-9 of the bounds' area + 4 SHRINK (both perimeters);
+- robot: pieces covered by the robot's polygons, or strictly inside one of its TRUE disks (exact);
+- cores: each vertex at least u inside the piece turned by every angle of its slab
+  (:func:`planners.core.proof_geometry.core_inside`, O((n + m) log(n + m)));
+- regions: obstacles as written (a disk by a polygon inside it, checked exactly); the union of the
+  convex sums eroded by 16 u and the bounds box grown by it; a proof component matches a recomputed one when
+  their symmetric difference is at most 1e-9 of the bounds' area + 256 u (both perimeters); a
+  proof component may match none (the planner's POSSIBLE is the larger: a sliver only it has), and a
+  recomputed one that lies in a listed one (which the checker's smaller POSSIBLE split) takes its node;
   unlisted recomputed components must be under that area and then join the search as the
-  checker's own nodes with their own edges;
-- nodes, edges: closures within TOUCH = 1e-9 M of the point or of each other count as touching;
+  checker's own nodes with their own edges; regions are built and matched slab by slab;
+- nodes, edges: closures within 512 u of the point or of each other count as touching;
   components of one slab that touch are linked too (the proof's graph only gets more edges).
+
+Work is bounded before it is done (:data:`LIMITS`, what the planner can write): slabs, robot
+pieces and their vertices, core vertices, component vertices per slab against the recomputed
+ones, edges against the components (adjacent slabs' components form a planar bipartite graph:
+fewer than 2 edges a component); a file's lists and numbers are counted before JSON is parsed.
+Past a limit: a one-line refusal (``cspace check-proof``: exit 2).
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from collections import deque
@@ -47,8 +53,12 @@ import numpy as np
 import shapely
 
 from cspace.io.scenario.files import read_input, utf8_text
-from cspace.io.load import ScenarioError, load_scenario
+from cspace.io.load import ScenarioError, load_scenario  # noqa: F401  (re-exported)
 from ..errors import InputError
+from .proof_geometry import (ANGLE_SLACK, MATCH_UNITS, SHRINK_UNITS, TOUCH_UNITS, Graph, Obstacles, Piece,
+                             convex_obstacles,  # noqa: F401
+                             core_inside, in_arc, in_disk, orient, possible_components, scene_unit,
+                             strictly_convex_ccw)  # (orient: re-exported for the tests and callers)
 
 FORMAT = "cspace-se2-proof/1"
 KEYS = ("format", "start", "goal", "bounds", "robot_pieces", "slabs", "start_nodes", "goal_nodes", "edges")
@@ -58,13 +68,21 @@ TWO_PI_HI = Fraction("6.2831853071795864769252867665590058")  # > 2 pi
 TWO_PI = 2.0 * math.pi
 MAX_ANGLE = 64.0
 QUERY_ANGLE_REL = 1e-12
-ANGLE_SLACK = 1e-9
-PEAK_SLACK = 1e-9
-CORE_MARGIN = 1e-12
-SHRINK_REL = 1e-10
-TOUCH_REL = 1e-9
 MATCH_REL = 1e-9
-ERRBOUND = 3.3306690738754716e-16  # Shewchuk's ccwerrboundA
+# What the planner can write (cspace.se2.exact): at most 4096 slabs (its floor keeps fewer), robot
+# pieces of at most 256 vertices (cspace.io.scenario.schema.MAX_ROTATING_VERTICES) and no more
+# pieces than the robot has vertices, cores of at most 3 n + 4 vertices (three half-planes per
+# edge of an n-gon piece, clipped from a box; 3 n + 1024 allowed, for cores built otherwise); a slab's components have at most 4x the vertices
+# of the recomputed ones + 1024; a file at most 2 million lists and 6 million values.
+# The regions' work: slabs x (obstacle vertices + the slab's core vertices + 64, its fixed cost),
+# at most 600 000 (about 7 s of one core: 4096 slabs of a small scene, 420 slabs of 800-gon
+# cores, or 500 slabs of a 1 000-vertex scene).
+LIMITS = {"slabs": 4096, "piece_vertices": 256, "file_lists": 2_000_000, "file_values": 6_000_000,
+          "work": 600_000}
+
+
+class TooBig(Exception):
+    """A proof asking for more work than any the planner writes (one line; exit 2)."""
 
 
 @dataclass(frozen=True)
@@ -90,67 +108,6 @@ def need(ok, step: str, detail: str):
         raise Refused(step, detail)
 
 
-def orient(a, b, c) -> int:
-    """The exact sign of the turn a -> b -> c (1 left, -1 right, 0 collinear) of float points.
-
-    >>> orient((0, 0), (1, 0), (0, 1)), orient((0.1, 0.1), (0.2, 0.2), (0.3, 0.3))
-    (1, 0)
-    """
-    dl = (b[0] - a[0]) * (c[1] - a[1])
-    dr = (b[1] - a[1]) * (c[0] - a[0])
-    det, total = dl - dr, abs(dl) + abs(dr)
-    if math.isfinite(total) and total > 1e-250 and abs(det) > ERRBOUND * total:
-        return 1 if det > 0 else -1
-    f = [Fraction(v) for v in (*a, *b, *c)]
-    d = (f[2] - f[0]) * (f[5] - f[1]) - (f[3] - f[1]) * (f[4] - f[0])
-    return (d > 0) - (d < 0)
-
-
-def strictly_convex_ccw(pts) -> bool:
-    """Whether the ring ``pts`` (not closed) is a strictly convex CCW polygon, decided exactly:
-    every turn strictly left and the edge directions going round exactly once."""
-    n = len(pts)
-    if n < 3 or any(orient(pts[i], pts[(i + 1) % n], pts[(i + 2) % n]) <= 0 for i in range(n)):
-        return False
-
-    def half(i):  # the sign of a float difference is exact
-        dx, dy = pts[(i + 1) % n][0] - pts[i][0], pts[(i + 1) % n][1] - pts[i][1]
-        return 0 if dy > 0 or (dy == 0 and dx > 0) else 1
-
-    return sum(half(i) == 1 and half((i + 1) % n) == 0 for i in range(n)) == 1
-
-
-def in_arc(t: float, a: float, b: float, slack: float) -> bool:
-    """Whether the angle t (modulo 2 pi) lies in [a - slack, b + slack]."""
-    d = math.fmod(t - a, TWO_PI)
-    d = d + TWO_PI if d < 0 else d
-    return d <= (b - a) + slack or d >= TWO_PI - slack
-
-
-def core_inside(core, piece, a: float, b: float):
-    """None if every vertex c of ``core`` satisfies R_(-theta) c in ``piece`` (convex, CCW) for
-    all theta in [a, b], with the safety margin; else ``(vertex index, edge index)`` of a failure.
-
-    Edge p -> q holds w inside when cross(e, w) + cross(p, q) >= 0 (e = q - p); with w = R_(-theta) c,
-    cross(e, w) = |e| |c| sin(gamma - theta - beta), smallest at an end of [a, b] or at its trough."""
-    ends = [(math.cos(t), math.sin(t)) for t in (a, b)]
-    n = len(piece)
-    for j in range(n):
-        p, q = piece[j], piece[(j + 1) % n]
-        ex, ey = q[0] - p[0], q[1] - p[1]
-        pq = p[0] * q[1] - p[1] * q[0]
-        ne, beta = math.hypot(ex, ey), math.atan2(ey, ex)
-        for i, (cx, cy) in enumerate(core):
-            nc = math.hypot(cx, cy)
-            low = min(ex * (-cx * s + cy * co) - ey * (cx * co + cy * s) for co, s in ends)
-            if nc > 0 and in_arc(math.atan2(cy, cx) - beta + math.pi / 2, a, b, PEAK_SLACK):
-                low = min(low, -ne * nc)
-            value, margin = low + pq, CORE_MARGIN * (ne * nc + math.hypot(*p) * math.hypot(*q))
-            if not (math.isfinite(value) and math.isfinite(margin) and value >= margin):
-                return i, j
-    return None
-
-
 def num(x, what: str) -> float:
     """A JSON number that is a finite double (an integer only if a double holds it exactly)."""
     need(isinstance(x, (int, float)) and not isinstance(x, bool), "format", f"{what}: not a number")
@@ -162,14 +119,28 @@ def num(x, what: str) -> float:
 def ring(pts, what: str, allow_empty: bool = False) -> list:
     """A list of >= 3 points [x, y] (a repeated closing point dropped); [] if allowed."""
     need(isinstance(pts, list) and (pts or allow_empty), "format", f"{what}: not a non-empty list of points")
-    out = []
-    for i, p in enumerate(pts):
+    out = _plain_ring(pts)
+    for i, p in enumerate(pts if out is None else ()):  # one number at a time: to name the fault
+        if i == 0:
+            out = []
         need(isinstance(p, list) and len(p) == 2, "format", f"{what}[{i}]: not a point [x, y]")
         out.append((num(p[0], f"{what}[{i}]"), num(p[1], f"{what}[{i}]")))
+    out = out or []
     if len(out) > 1 and out[0] == out[-1]:
         out.pop()
     need(not out or len(out) >= 3, "format", f"{what}: fewer than 3 distinct points")
     return out
+
+
+def _plain_ring(pts) -> list | None:
+    """The points as float pairs when every one is a list of two finite floats (the JSON a
+    planner writes), read in a few passes at C speed; None for anything else (then read one by one)."""
+    if not pts or set(map(type, pts)) != {list} or set(map(len, pts)) != {2}:
+        return None
+    flat = list(itertools.chain.from_iterable(pts))
+    if set(map(type, flat)) != {float} or not np.isfinite(np.array(flat)).all():
+        return None
+    return list(map(tuple, pts))
 
 
 def index_list(items, what: str, width: int, sizes) -> list:
@@ -196,7 +167,12 @@ def parse(proof) -> dict:
     pieces = proof["robot_pieces"]
     need(isinstance(pieces, list) and pieces, "format", "robot_pieces: not a non-empty list")
     out["pieces"] = [ring(p, f"robot_pieces[{i}]") for i, p in enumerate(pieces)]
+    big = max(len(p) for p in out["pieces"])
+    if big > LIMITS["piece_vertices"]:
+        raise TooBig(f"a robot piece of {big} vertices (the planner's have at most {LIMITS['piece_vertices']})")
     need(isinstance(proof["slabs"], list) and proof["slabs"], "format", "slabs: not a non-empty list")
+    if len(proof["slabs"]) > LIMITS["slabs"]:
+        raise TooBig(f"{len(proof['slabs'])} slabs (the planner writes at most {LIMITS['slabs']})")
     out["slabs"] = []
     for k, s in enumerate(proof["slabs"]):
         w = f"slabs[{k}]"
@@ -211,9 +187,18 @@ def parse(proof) -> dict:
                  "format", f"{w}.components[{c}]: not an object of shell and holes")
             comps.append((ring(comp["shell"], f"{w}.components[{c}].shell"),
                           [ring(h, f"{w}.components[{c}].holes[{i}]") for i, h in enumerate(comp["holes"])]))
+        cores = [ring(c, f"{w}.cores[{i}]", True) for i, c in enumerate(s["cores"])]
+        for i, c in enumerate(cores):
+            if len(c) > 3 * len(out["pieces"][i]) + 1024:
+                raise TooBig(f"{w}.cores[{i}] has {len(c)} vertices (the planner's core of a "
+                             f"{len(out['pieces'][i])}-gon has at most {3 * len(out['pieces'][i]) + 4}; "
+                             f"allowed: {3 * len(out['pieces'][i]) + 1024})")
         out["slabs"].append({"a": num(s["a"], f"{w}.a"), "b": num(s["b"], f"{w}.b"), "components": comps,
-                             "cores": [ring(c, f"{w}.cores[{i}]", True) for i, c in enumerate(s["cores"])]})
+                             "cores": cores})
     sizes = [len(s["components"]) for s in out["slabs"]]
+    for key in ("edges", "start_nodes", "goal_nodes"):  # a planar graph has fewer than 2 edges a node
+        if isinstance(proof[key], list) and len(proof[key]) > 2 * sum(sizes) + 8:
+            raise TooBig(f"{len(proof[key])} {key} for {sum(sizes)} components (at most {2 * sum(sizes) + 8})")
     out["start_nodes"] = index_list(proof["start_nodes"], "start_nodes", 2, sizes)
     out["goal_nodes"] = index_list(proof["goal_nodes"], "goal_nodes", 2, sizes)
     out["edges"] = index_list(proof["edges"], "edges", 4, sizes)
@@ -237,22 +222,30 @@ def check_query(scenario, p: dict, query_index: int):
 
 
 def check_robot(scenario, pieces):
-    """Step "robot": each piece strictly convex CCW and covered by the scenario's robot."""
+    """Step "robot": each piece strictly convex CCW and inside the scenario's robot as written:
+    covered by its polygon parts, or strictly inside one of its disks (the true disk, decided
+    exactly: a disk part's polygon circumscribes it)."""
     need(scenario.robot, "robot", "the scenario's robot is a point")
-    parts = [s.to_shapely() for s in scenario.robot]
+    most = sum(len(s.polygon) for s in scenario.robot)
+    if len(pieces) > most:
+        raise TooBig(f"{len(pieces)} robot pieces (the robot has {most} vertices: at most as many convex pieces)")
+    polys = [s.to_shapely() for s in scenario.robot if s.disk is None]
+    disks = [s.disk for s in scenario.robot if s.disk is not None]
     for i, piece in enumerate(pieces):
         need(strictly_convex_ccw(piece), "robot", f"robot_pieces[{i}] is not strictly convex and counter-clockwise")
         poly = shapely.Polygon(piece)  # inside one part needs no constructed union
-        need(any(part.covers(poly) for part in parts) or shapely.union_all(parts).covers(poly), "robot",
+        need(any(in_disk(piece, d) for d in disks) or any(part.covers(poly) for part in polys)
+             or (len(polys) > 1 and shapely.union_all(polys).covers(poly)), "robot",
              f"robot_pieces[{i}] is not inside the scenario's robot")
 
 
 def check_cover(slabs):
-    """Step "cover": consecutive slabs of width in (0, pi/2] going once round the circle."""
+    """Step "cover": consecutive slabs of width in [0, pi/2] going once round the circle (a zero-width
+    slab [phi, phi] is a single angle: a path crossing phi is in it and in both its neighbours)."""
     for k, s in enumerate(slabs):
         a, b = s["a"], s["b"]
         need(abs(a) <= MAX_ANGLE and abs(b) <= MAX_ANGLE, "cover", f"slab {k}: an angle beyond +-{MAX_ANGLE}")
-        need(a < b and Fraction(b) - Fraction(a) <= HALF_PI_LO, "cover", f"slab {k}: width {b - a} is not in (0, pi/2]")
+        need(a <= b and Fraction(b) - Fraction(a) <= HALF_PI_LO, "cover", f"slab {k}: width {b - a} is not in [0, pi/2]")
         need(k + 1 == len(slabs) or b == slabs[k + 1]["a"], "cover",
              f"slab {k} ends at {b}, the next does not start there")
     a0, b0, al, bl = (Fraction(v) for v in (slabs[0]["a"], slabs[0]["b"], slabs[-1]["a"], slabs[-1]["b"]))
@@ -260,141 +253,141 @@ def check_cover(slabs):
     need(al - a0 <= TWO_PI_LO and bl - b0 <= TWO_PI_LO, "cover", "the slabs wrap round the circle more than once")
 
 
-def check_cores(slabs, pieces):
-    """Step "cores": every core strictly convex CCW and inside its turned piece on its slab."""
+def check_cores(slabs, pieces, unit: float):
+    """Step "cores": every core strictly convex CCW and at least ``unit`` inside its turned piece
+    on its slab (:func:`planners.core.proof_geometry.core_inside`)."""
+    prepared = [Piece(p) for p in pieces]
     for k, s in enumerate(slabs):
         for i, core in enumerate(s["cores"]):
             need(not core or strictly_convex_ccw(core), "cores",
                  f"slab {k} piece {i}: the core is not strictly convex and counter-clockwise")
-            bad = core_inside(core, pieces[i], s["a"], s["b"]) if core else None
-            need(bad is None, "cores", f"slab {k} piece {i}: core vertex {bad and bad[0]} leaves edge "
-                                       f"{bad and bad[1]} of the piece turned by some angle in [{s['a']}, {s['b']}]")
+            bad = core_inside(core, prepared[i], s["a"], s["b"], unit) if core else None
+            need(bad is None, "cores", f"slab {k} piece {i}: core vertex {bad} leaves the piece turned by some "
+                                       f"angle in [{s['a']}, {s['b']}] (or comes within {unit:.3g} of its edges)")
 
 
-def convex_obstacles(scenario) -> list:
-    """The obstacles as convex parts (vertex arrays): convex ones as they are, others triangulated."""
-    parts = []
-    for ob in scenario.obstacles:
-        pts = [(float(x), float(y)) for x, y in np.asarray(ob.polygon, dtype=float)]
-        if len(pts) > 1 and pts[0] == pts[-1]:
-            pts.pop()
-        if not len(ob.holes) and (strictly_convex_ccw(pts) or strictly_convex_ccw(pts[::-1])):
-            parts.append(np.array(pts))
-            continue
-        poly = shapely.Polygon(ob.polygon, [h for h in ob.holes])
-        tris = shapely.get_parts(shapely.constrained_delaunay_triangles(poly))
-        for t in tris[shapely.covers(poly, tris) & (shapely.area(tris) > 0)]:
-            parts.append(np.asarray(t.exterior.coords)[:-1])
-    return parts
-
-
-def possible_components(slab, parts, box, shrink) -> list:
-    """The components of POSSIBLE for a slab, each sum shrunk by ``shrink``, the box grown by it."""
-    coords, index = [], []
-    for core in slab["cores"]:
-        if core:
-            c = np.asarray(core)
-            for o in parts:
-                coords.append((o[:, None, :] - c[None, :, :]).reshape(-1, 2))
-                index.append(len(coords[-1]))
-    if not coords:
-        return [box]
-    points = shapely.multipoints(np.concatenate(coords), indices=np.repeat(np.arange(len(index)), index))
-    sums = shapely.buffer(shapely.convex_hull(points), -shrink, join_style="mitre")
-    rest = shapely.difference(box, shapely.union_all(sums[~shapely.is_empty(sums)]))
-    return [g for g in shapely.get_parts(rest) if g.geom_type == "Polygon" and g.area > 0]
-
-
-def match(k, slab, comps, tol_area, shrink) -> list:
+def match(k, slab, comps, tol_area, band) -> list:
     """Step "regions" for a slab: for each recomputed component, the proof's index or None."""
-    owner, tree = [None] * len(comps), shapely.STRtree(comps)
+    n_mine = sum(len(g.exterior.coords) + sum(len(r.coords) for r in g.interiors) for g in comps)
+    n_given = sum(len(sh) + sum(map(len, hs)) for sh, hs in slab["components"])
+    if n_given > 4 * n_mine + 1024:
+        raise TooBig(f"slab {k}: components of {n_given} vertices where the scene's have {n_mine}")
+    owner, tree, polys = [None] * len(comps), shapely.STRtree(comps), []
     for c, (shell, holes) in enumerate(slab["components"]):
-        poly = shapely.Polygon(shell, holes)
+        poly = shapely.polygons(shapely.linearrings(shell), [shapely.linearrings(h) for h in holes] or None)
         need(poly.is_valid, "regions", f"slab {k} component {c} is not a valid polygon")
+        polys.append(poly)
         hits = [int(r) for r in tree.query(poly, predicate="intersects")
                 if poly.area + comps[r].area - 2 * poly.intersection(comps[r]).area
-                <= tol_area + 4 * shrink * (poly.length + comps[r].length)]
-        need(len(hits) == 1, "regions", f"slab {k} component {c} matches {len(hits)} recomputed components")
+                <= tol_area + band * (poly.length + comps[r].length)]
+        # none: a component the planner's larger POSSIBLE has (cores shrunk by 64 u, not 16) and
+        # the checker's has not: a node no recomputed component needs (the search ignores it)
+        need(len(hits) <= 1, "regions", f"slab {k} component {c} matches {len(hits)} recomputed components")
+        if not hits:
+            continue
         need(owner[hits[0]] is None, "regions", f"slab {k} components {owner[hits[0]]} and {c} are the same")
         owner[hits[0]] = c
+    ptree = shapely.STRtree(polys) if polys else None
     for r, c in enumerate(owner):
-        if c is None and comps[r].area > tol_area:
-            pt = comps[r].representative_point()
-            raise Refused("regions", f"slab {k}: the component at ({pt.x:.6g}, {pt.y:.6g}) of area "
-                                     f"{comps[r].area:.3g} is not listed")
+        if c is not None or comps[r].area <= tol_area:
+            continue
+        # a piece of a listed component that the checker's smaller POSSIBLE cut off: it joins that
+        # component's node (more links, never fewer: the search can only find more paths)
+        inside = [int(i) for i in (ptree.query(comps[r], predicate="intersects") if ptree else [])
+                  if comps[r].area - polys[i].intersection(comps[r]).area <= tol_area + band * comps[r].length]
+        if inside:
+            owner[r] = min(inside)
+            continue
+        pt = comps[r].representative_point()
+        raise Refused("regions", f"slab {k}: the component at ({pt.x:.6g}, {pt.y:.6g}) of area "
+                                 f"{comps[r].area:.3g} is not listed")
     return owner
 
 
-def regions(scenario, p):
-    """Step "regions": the recomputed components per slab, the proof's index of each, the touch distance."""
+
+def regions(scenario, p, q, unit):
+    """Steps "regions", "nodes" and "edges": each slab's POSSIBLE recomputed, matched and linked to
+    the previous slab's (then dropped); the graph for the separation step."""
     xmin, xmax, ymin, ymax = (float(v) for v in scenario.bounds)
-    parts = convex_obstacles(scenario)
-    scale = max([abs(v) for v in scenario.bounds] + [float(np.abs(o).max()) for o in parts] +
-                [abs(v) for s in p["slabs"] for c in s["cores"] for pt in c for v in pt])
-    shrink = SHRINK_REL * scale
+    parts = Obstacles(convex_obstacles(scenario))
+    shrink = SHRINK_UNITS * unit
     box = shapely.box(xmin - shrink, ymin - shrink, xmax + shrink, ymax + shrink)
-    comps = [possible_components(s, parts, box, shrink) for s in p["slabs"]]
     tol_area = MATCH_REL * (xmax - xmin) * (ymax - ymin)
-    return comps, [match(k, s, comps[k], tol_area, shrink) for k, s in enumerate(p["slabs"])], TOUCH_REL * scale
+    graph, K = Graph(p, q, TOUCH_UNITS * unit), len(p["slabs"])
+    first = prev = None
+    for k, s in enumerate(p["slabs"]):
+        comps = possible_components(s["cores"], parts, box, shrink)
+        node = graph.slab(k, comps, match(k, s, comps, tol_area, MATCH_UNITS * unit))
+        graph.link(k, comps, node, k, comps, node)
+        if prev is not None:
+            graph.link(k - 1, prev[0], prev[1], k, comps, node)
+        prev = (comps, node)
+        first = first or prev
+    if K > 1:
+        graph.link(K - 1, prev[0], prev[1], 0, first[0], first[1])
+    return graph
+
+
+def proof_work(obstacles, slabs) -> int:
+    """The regions' work a proof asks for: slabs x (obstacle vertices + the slab's core vertices + 64).
+
+    >>> proof_work([[(0, 0), (1, 0), (0, 1)]], [{"cores": [[(0, 0)] * 5]}] * 2)
+    144
+    """
+    n = sum(map(len, obstacles))
+    return sum(n + sum(map(len, s["cores"])) + 64 for s in slabs)
 
 
 def check_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
     """Check a proof that no path joins query ``query_index`` of ``scenario`` (a loaded
-    :class:`cspace.io.load.Scenario`): the first failing step, or ``valid`` (step ``"ok"``)."""
+    :class:`cspace.io.load.Scenario`): the first failing step, or ``valid`` (step ``"ok"``).
+    A proof asking for more work than the planner's can (:data:`LIMITS`) raises :class:`TooBig`."""
     step = "format"
     try:
         p = parse(proof)
+        obstacles = convex_obstacles(scenario)
+        work = proof_work(obstacles, p["slabs"])
+        if work > LIMITS["work"]:
+            raise TooBig(f"{len(p['slabs'])} slabs over {sum(map(len, obstacles))} obstacle vertices: {work} units "
+                         f"of work (at most {LIMITS['work']})")
         step = "query"
         q = check_query(scenario, p, query_index)
         step = "robot"
         check_robot(scenario, p["pieces"])
         step = "cover"
         check_cover(p["slabs"])
+        unit = scene_unit(scenario.bounds, obstacles, p["pieces"])
         step = "cores"
-        check_cores(p["slabs"], p["pieces"])
+        check_cores(p["slabs"], p["pieces"], unit)
         step = "regions"
-        comps, owners, touch = regions(scenario, p)
-
-        def node(k, r):  # the proof's node, or the checker's own for an unlisted sliver
-            return (k, owners[k][r]) if owners[k][r] is not None else ("own", k, r)
-
-        step, ends, graph = "nodes", {}, {}
-        for key, pose, listed in (("start", q.start, p["start_nodes"]), ("goal", q.goal, p["goal_nodes"])):
-            point, found = shapely.Point(pose[0], pose[1]), set()
-            for k, s in enumerate(p["slabs"]):
-                if in_arc(pose[2], s["a"], s["b"], ANGLE_SLACK):
-                    found |= {node(k, r) for r, g in enumerate(comps[k]) if shapely.dwithin(g, point, touch)}
-            need(found, "nodes", f"the {key} lies in no component of POSSIBLE")
-            missing = sorted(n for n in found if n[0] != "own" and n not in set(listed))
-            need(not missing, "nodes",
-                 f"{key}_nodes lacks {list(missing[0]) if missing else ''}, a component holding the {key}")
-            ends[key] = set(listed) | found
-        step, given, extra = "edges", set(p["edges"]), []
-        for k in range(len(comps)):
-            for k2 in (k, (k + 1) % len(comps)):  # the same slab (the checker's own links), the next one
-                if comps[k] and comps[k2]:
-                    left, right = shapely.STRtree(comps[k2]).query(comps[k], predicate="dwithin", distance=touch)
-                    for u, v in ((node(k, r), node(k2, r2)) for r, r2 in zip(left.tolist(), right.tolist())):
-                        if k2 == k or "own" in (u[0], v[0]):
-                            extra.append((u, v))
-                        else:
-                            need((*u, *v) in given, "edges", f"edges lacks {[*u, *v]}: the components touch")
-        step = "separation"
-        for u, v in extra + [((k, c), (k2, c2)) for k, c, k2, c2 in given]:
-            graph.setdefault(u, set()).add(v)
-            graph.setdefault(v, set()).add(u)
+        graph = regions(scenario, p, q, unit)
+        step = "nodes"
+        for key in ("start", "goal"):
+            need(graph.ends[key], "nodes", f"the {key} lies in no component of POSSIBLE")
+        for step in ("nodes", "edges"):
+            need(step not in graph.faults, step, graph.faults.get(step, ""))
+        ends = {key: set(p[f"{key}_nodes"]) | graph.ends[key] for key in ("start", "goal")}
+        step, adj = "separation", {}
+        for u, v in graph.extra + [((k, c), (k2, c2)) for k, c, k2, c2 in graph.given]:
+            adj.setdefault(u, set()).add(v)
+            adj.setdefault(v, set()).add(u)
         seen, todo = set(ends["start"]), deque(ends["start"])
         while todo:
-            for v in graph.get(todo.popleft(), ()):
+            for v in adj.get(todo.popleft(), ()):
                 if v not in seen:
                     seen.add(v)
                     todo.append(v)
         hit = sorted(seen & ends["goal"], key=repr)
         need(not hit, "separation", f"goal node {list(hit[0]) if hit else ''} is reachable from the start")
-        return CheckResult(True, "ok", f"{len(comps)} slabs, {sum(map(len, comps))} components, {len(given)} "
+        n_comps = sum(len(s["components"]) for s in p["slabs"])
+        return CheckResult(True, "ok", f"{len(p['slabs'])} slabs, {n_comps} components, {len(graph.given)} "
                                        "edges; no start node reaches a goal node")
+    except TooBig:
+        raise
     except Refused as r:
         return CheckResult(False, r.step, r.detail)
+    except MemoryError:
+        raise TooBig("more memory than the machine has") from None
     except Exception as exc:  # a checker never accepts what it could not check
         return CheckResult(False, step, f"could not be checked ({type(exc).__name__}: {exc})"[:300])
 
@@ -406,6 +399,11 @@ def load_proof(path) -> dict:
         text = utf8_text(read_input(path), str(path))
     except ScenarioError as exc:
         raise InputError(exc.file, exc.field, exc.message.replace("scenario file", "proof file")) from None
+
+    lists, values = text.count("["), text.count(",")
+    if lists > LIMITS["file_lists"] or values > LIMITS["file_values"]:
+        raise InputError(str(path), "size", f"{lists} lists and {values} commas: more than any proof the planner "
+                                            f"writes (at most {LIMITS['file_lists']} and {LIMITS['file_values']})")
 
     def refuse(name):
         raise ValueError(f"{name} is not JSON")

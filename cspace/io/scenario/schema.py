@@ -69,6 +69,25 @@ class Shape:
     disk: tuple[float, float, float] | None = None
     convex: bool = False
 
+    def inner_polygon(self) -> np.ndarray:
+        """A polygon inside the shape as written: the polygon itself, or for a disk the regular
+        polygon of as many sides inscribed in it (:func:`cspace.kernel.polygons.disk.disk_inner_polygon`;
+        (0, 2) when the disk is too small to hold one). What a proof that no path exists reasons
+        about (``polygon``, around the disk, is what a certified path keeps clear of).
+
+        >>> from cspace.kernel.polygons.disk import disk_polygon
+        >>> sh = Shape(disk_polygon((0, 0), 1.0, sides=8), disk=(0.0, 0.0, 1.0), convex=True)
+        >>> bool(np.hypot(*sh.inner_polygon().T).max() < 1.0 < np.hypot(*sh.polygon.T).min())
+        True
+        """
+        if self.disk is None:
+            return self.polygon
+        from ...kernel.polygons.disk import disk_inner_polygon
+
+        cx, cy, r = self.disk
+        inner = disk_inner_polygon((cx, cy), r, len(self.polygon))
+        return inner
+
     def to_shapely(self):
         """The shape as a shapely Polygon (imported lazily)."""
         import shapely
@@ -120,12 +139,18 @@ class Scenario:
         whose motions are Dubins or Reeds–Shepp curves)."""
         return self.space in ROTATING_SPACES
 
-    def margins(self) -> list[np.ndarray]:
+    @property
+    def has_disks(self) -> bool:
+        """Whether a robot part or an obstacle is a disk (its polygon then only circumscribes it)."""
+        return any(s.disk is not None for s in self.robot) or any(s.disk is not None for s in self.obstacles)
+
+    def margins(self, inner: bool = False) -> list[np.ndarray]:
         """The margin operands the robot is inflated by (:func:`cspace.kernel.minkowski.margin.margin_shapes`);
-        empty without a clearance or a margin polygon."""
+        empty without a clearance or a margin polygon. ``inner``: the clearance's disk by its
+        inscribed polygon (what a proof that no path keeps the clearance is made of)."""
         from ...kernel.minkowski.margin import margin_shapes
 
-        return margin_shapes(self.clearance, self.margin, self.disk_tolerance)
+        return margin_shapes(self.clearance, self.margin, self.disk_tolerance, inner=inner)
 
     @property
     def dim(self) -> int:

@@ -91,8 +91,9 @@ class ShapeChecks(FieldChecks):
 
             for sh in shapes:
                 sh.polygon = rotate(sh.polygon, theta)
-                if sh.disk is not None:
-                    sh.disk = (0.0, 0.0, sh.disk[2])
+                if sh.disk is not None:  # a part's disk turns about the reference point with it
+                    (cx, cy), = rotate(np.array([sh.disk[:2]], dtype=np.float64), theta).tolist()
+                    sh.disk = (cx, cy, sh.disk[2])
         return shapes, kind
 
     def margin(self, t, theta: float, tol: float) -> np.ndarray | None:

@@ -32,9 +32,11 @@ MARGIN_PHASE = 0.3819660112501051  # (3 - sqrt 5) / 2 of a side: see the module 
 
 
 def margin_shapes(clearance: float = 0.0, polygon=None, disk_tolerance: float = DEFAULT_RELATIVE_ERROR,
-                  theta: float = 0.0) -> list[np.ndarray]:
+                  theta: float = 0.0, *, inner: bool = False) -> list[np.ndarray]:
     """The convex margin operands: the disk polygon of radius ``clearance`` (if positive)
     and the anisotropic ``polygon`` (if given, turned by ``theta``), CCW, around the origin.
+    ``inner``: the disk's polygon inscribed in it instead (same sides and phase), for a proof
+    that no path keeps the clearance (it must hold for the disk as written).
 
     An empty list means no margin: the C-space is built exactly as without one.
 
@@ -50,7 +52,15 @@ def margin_shapes(clearance: float = 0.0, polygon=None, disk_tolerance: float = 
     if not d >= 0.0 or d != d or d == float("inf"):
         raise ValueError(f"margin_shapes: clearance must be a finite number >= 0, got {clearance!r}")
     if d > 0.0:
-        out.append(disk_polygon((0.0, 0.0), d, sides=disk_sides(d, disk_tolerance * d), phase=MARGIN_PHASE))
+        n = disk_sides(d, disk_tolerance * d)
+        if inner:
+            from ..polygons.disk import disk_inner_polygon
+
+            m = disk_inner_polygon((0.0, 0.0), d, n, phase=MARGIN_PHASE)
+            if len(m):
+                out.append(m)
+        else:
+            out.append(disk_polygon((0.0, 0.0), d, sides=n, phase=MARGIN_PHASE))
     if polygon is not None:
         p = np.asarray(polygon, dtype=np.float64).reshape(-1, 2)
         if theta:

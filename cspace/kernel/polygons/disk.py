@@ -69,3 +69,37 @@ def disk_error(radius: float, sides: int) -> float:
     0.414214
     """
     return radius * (1.0 / math.cos(math.pi / sides) - 1.0)
+
+
+def disk_inner_polygon(center, radius: float, sides: int, phase: float = 0.0) -> np.ndarray:
+    """CCW regular ``sides``-gon INSIDE the disk: the vertices of :func:`disk_polygon`'s
+    circumscribed polygon (the same angles) brought onto a circle a little smaller than the
+    disk, so that rounding never puts one outside it. What a proof that no path exists
+    reasons about (less obstacle, a smaller robot: the proof holds for the disk itself);
+    its distance to the disk is at most r (1 − cos(π/N)) plus the rounding shrink.
+
+    Shrink: cos and sin err by an ulp of 1, the product and the sum with the centre by an ulp
+    of the result, so every vertex lies within r (1 − s) + 2^-50 r + 4 ulp(|c| + r) of the
+    centre; s r = 2^-46 r + 16 ulp(|c| + r) keeps it strictly inside.
+
+    >>> p = disk_inner_polygon((3.0, -2.0), 1.0, 16)
+    >>> bool(np.all(np.hypot(p[:, 0] - 3.0, p[:, 1] + 2.0) < 1.0)), len(p)
+    (True, 16)
+    >>> bool(np.all(np.hypot(p[:, 0] - 3.0, p[:, 1] + 2.0) > 1.0 - 1e-12))
+    True
+    """
+    n = int(sides)
+    cx, cy = float(center[0]), float(center[1])
+    r = float(radius)
+    m = max(abs(cx), abs(cy)) + r
+    inner = r - (2.0**-46 * r + 16.0 * math.ulp(m))
+    if not inner > 0.0:
+        return np.zeros((0, 2))
+    ang = -math.pi / 2 + math.pi / n + 2.0 * math.pi * np.arange(n) / n
+    if phase:
+        ang = ang + 2.0 * math.pi * phase / n
+    pts = np.column_stack([cx + inner * np.cos(ang), cy + inner * np.sin(ang)])
+    from .hull import convex_hull  # exact: rounded points of a tiny disk far off stay a convex CCW ring
+
+    hull = convex_hull(pts)
+    return hull if len(hull) >= 3 else np.zeros((0, 2))
