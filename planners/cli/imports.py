@@ -1,5 +1,5 @@
-"""``cspace import``: a ROS occupancy-grid map (``.yaml``), an OMPL.app problem (``.cfg``) or an
-SVG drawing (``.svg``: Bench-MR's polygon worlds) as a scenario TOML, with a report of what was read and what the import changed.
+"""``cspace import``: a ROS occupancy-grid map (``.yaml``), an OMPL.app problem (``.cfg``), an
+SVG drawing (``.svg``: Bench-MR's polygon worlds) or a MovingAI map (``.map``) as a scenario TOML, with a report of what was read and what the import changed.
 
 The options that say what such a file does not (the robot, the start and goal)
 are shared with ``cspace plan``, which plans these files directly.
@@ -13,13 +13,13 @@ from ..errors import InputError
 
 
 def register(sub) -> None:
-    p = sub.add_parser("import", help="convert a ROS map (.yaml), an OMPL.app problem (.cfg) or an SVG drawing "
-                                      "(.svg) to a scenario",
+    p = sub.add_parser("import", help="convert a ROS map (.yaml), an OMPL.app problem (.cfg), an SVG drawing "
+                                      "(.svg) or a MovingAI map (.map) to a scenario",
                        description="Import a ROS map_server map (YAML + image), an OMPL.app .cfg problem "
                                    "(COLLADA meshes, needs pip install -e \".[io]\") or an SVG drawing (every "
                                    "path an obstacle, y up as Bench-MR reads it) and write it as a scenario "
-                                   "TOML; exit 0 written, 2 bad input.")
-    p.add_argument("file", help="map YAML (.yaml), OMPL.app problem (.cfg) or SVG drawing (.svg)")
+                                   "TOML, or a MovingAI grid map (.map); exit 0 written, 2 bad input.")
+    p.add_argument("file", help="map YAML (.yaml), OMPL.app problem (.cfg), SVG drawing (.svg) or MovingAI map (.map)")
     p.add_argument("--out", required=True, help="scenario TOML to write (never one of the inputs)")
     add_import_options(p)
     p.add_argument("--verbose", "-v", action="store_true",
@@ -48,10 +48,16 @@ def add_import_options(p) -> None:
     g.add_argument("--convex-hulls", action="store_true", default=None,
                    help="replace each SVG path (and an SVG robot) by its convex hull, as Bench-MR does "
                         "(default: the true shapes)")
+    g.add_argument("--grid-reading", choices=("movingai", "bench-mr"), default=None,
+                   help="a MovingAI map's frame: movingai (default: row 0 at the top, as MovingAI draws it) or "
+                        "bench-mr (rows upwards, cells centred on integer points, only '.' passable, as "
+                        "Bench-MR reads it)")
+    g.add_argument("--border", action="store_true", default=None,
+                   help="a MovingAI map's outermost cells blocked (Bench-MR's create_border)")
 
 
 IMPORT_FLAGS = ("robot", "radius", "polygon", "start", "goal", "unknown", "tolerance", "flatten_curves",
-                "convex_hulls")
+                "convex_hulls", "grid_reading", "border")
 
 
 def import_options(args, src: str):
@@ -63,8 +69,8 @@ def import_options(args, src: str):
     if not is_import(src):
         if given:
             raise InputError(src, f"--{given[0].replace('_', '-')}", "applies to imported files (.yaml maps, .cfg "
-                                                                     "problems, .svg drawings) only; a scenario "
-                                                                     "TOML names its own")
+                                                                     "problems, .svg drawings, .map grids) only; a "
+                                                                     "scenario TOML names its own")
         return None
     robots = [f for f in ("robot", "radius", "polygon") if getattr(args, f) is not None]
     if len(robots) > 1:
@@ -86,7 +92,8 @@ def import_options(args, src: str):
                          start=_numbers(args.start, "--start", 2, 3) if args.start is not None else None,
                          goal=_numbers(args.goal, "--goal", 2, 3) if args.goal is not None else None,
                          unknown=args.unknown or "obstacle", tolerance=args.tolerance,
-                         flatten_curves=flatten, convex_hulls=hulls)
+                         flatten_curves=flatten, convex_hulls=hulls, grid_reading=getattr(args, "grid_reading", None),
+                         border=bool(getattr(args, "border", None)))
 
 
 def imported_scenario(args, src: str, options, outputs: list):
@@ -129,7 +136,7 @@ def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
     return vals
 
 
-def input_files(src: str, robot: str | None = None, queries: str | None = None) -> list[str]:
+def input_files(src: str, robot: str | None = None, queries: str | None = None, scen: str | None = None) -> list[str]:
     """Every file a command reads, which no output may be: the scenario (or the map YAML and
     the image it names, or the cfg and its meshes, resolved as the import resolves them),
     the ``--robot`` file and the ``--queries`` file. Listed without importing; a file that
@@ -144,13 +151,15 @@ def input_files(src: str, robot: str | None = None, queries: str | None = None) 
                 from cspace.io.importers.omplapp import mesh_files
 
                 files += mesh_files(src)
+            elif src.lower().endswith((".svg", ".map")):
+                pass  # one file
             else:
                 from cspace.io.importers.occupancy import read_map_yaml
 
                 files.append(read_map_yaml(src).image)
         except (ScenarioError, OSError, ValueError):
             pass
-    return files + [f for f in (robot, queries) if f is not None]
+    return files + [f for f in (robot, queries, scen) if f is not None]
 
 
 def read_robot(path: str, convex_hull: bool = False, flatten: float | None = None) -> dict:
@@ -189,8 +198,8 @@ def run(args) -> int:
 
     src = args.file
     if not is_import(src):
-        raise InputError(src, "file", "expected a map YAML (.yaml, .yml), an OMPL.app problem (.cfg) or an SVG "
-                                      "drawing (.svg)")
+        raise InputError(src, "file", "expected a map YAML (.yaml, .yml), an OMPL.app problem (.cfg), an SVG "
+                                      "drawing (.svg) or a MovingAI map (.map)")
     check_input(src)
     check_output(args.out, "--out", {".toml": "toml"}, inputs=input_files(src, args.robot))
     options = import_options(args, src)

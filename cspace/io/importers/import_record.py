@@ -21,6 +21,8 @@ class ImportOptions:
     simplification error in world units (None: two cells of a map; 0: the exact
     staircase of cells). ``flatten_curves`` is the largest distance of a chord from an SVG
     curve (None: curves refused); ``convex_hulls`` replaces each SVG path by its convex hull.
+    ``grid_reading`` (``"movingai"`` or ``"bench-mr"``) and ``border`` place a MovingAI map
+    (:mod:`cspace.io.importers.movingai`).
     """
 
     robot: dict | None = None
@@ -30,6 +32,8 @@ class ImportOptions:
     tolerance: float | None = None
     flatten_curves: float | None = None
     convex_hulls: bool = False
+    grid_reading: str | None = None
+    border: bool = False
 
 
 @dataclass

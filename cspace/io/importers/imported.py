@@ -1,5 +1,6 @@
 """Scenarios imported from other formats: ROS occupancy-grid maps (``.yaml``),
-OMPL.app problem files (``.cfg``) and SVG drawings (``.svg``, :mod:`cspace.io.importers.svg`).
+OMPL.app problem files (``.cfg``), SVG drawings (``.svg``, :mod:`cspace.io.importers.svg`) and
+MovingAI grid maps (``.map``, :mod:`cspace.io.importers.movingai`).
 
 An import builds the same dict a scenario TOML parses to, so one validator
 (:func:`cspace.io.scenario.validate.scenario_from_dict`) checks both, and :func:`to_toml` writes
@@ -23,7 +24,8 @@ from ..scenario.validate import scenario_from_dict
 MAP_SUFFIXES = (".yaml", ".yml")
 CFG_SUFFIXES = (".cfg",)
 SVG_SUFFIXES = (".svg",)
-SUFFIXES = MAP_SUFFIXES + CFG_SUFFIXES + SVG_SUFFIXES
+GRID_SUFFIXES = (".map",)
+SUFFIXES = MAP_SUFFIXES + CFG_SUFFIXES + SVG_SUFFIXES + GRID_SUFFIXES
 # A map's default simplification tolerance, in cells: 2 lets Douglas-Peucker (within 0.8 cell)
 # straighten a diagonal staircase (its corners are 0.71 cell off the diagonal); 1 would not.
 DEFAULT_TOLERANCE_CELLS = 2.0
@@ -65,6 +67,10 @@ def import_file(path, options: ImportOptions | None = None) -> Imported:
         from .svg import import_svg
 
         return import_svg(path, options)
+    if path.lower().endswith(GRID_SUFFIXES):
+        from .movingai import import_movingai
+
+        return import_movingai(path, options)
     return import_map(path, options)
 
 
