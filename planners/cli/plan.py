@@ -220,6 +220,12 @@ def run(args) -> int:
         count_as_load(res, import_s)
     print(summary(res, verbose=args.verbose))
     doc = res.as_dict()
+    if args.json is not None and ompl_available():  # Bench-MR's metrics of every solved path, beside ours
+        from ..bench.benchmr import result_metrics
+
+        doc["bench_mr"] = result_metrics(res)
+        for q, r in zip(doc.get("queries", []), res.queries or []):
+            q["bench_mr"] = result_metrics(r)
     if rows is not None:
         from .scen import annotate
 
