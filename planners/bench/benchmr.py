@@ -171,12 +171,12 @@ def metrics(points: np.ndarray, goal) -> dict:
     }
 
 
-def result_metrics(res) -> dict | None:
+def result_metrics(res, sc=None) -> dict | None:
     """Bench-MR's metrics of a solved :class:`planners.core.result.PlanResult`, with ours beside
-    them (None when unsolved)."""
+    them (None when unsolved); ``sc``: its scenario (a query's result has none of its own)."""
     if not res.solved or res.path is None or len(res.path) == 0:
         return None
-    sc = res.scenario_data
+    sc = sc if sc is not None else res.scenario_data
     space = getattr(sc, "space", "translation")
     pts = interpolated(res.path, space, getattr(sc, "turning_radius", None), sc.bounds)
     m = metrics(pts, res.goal)

@@ -225,7 +225,7 @@ def run(args) -> int:
 
         doc["bench_mr"] = result_metrics(res)
         for q, r in zip(doc.get("queries", []), res.queries or []):
-            q["bench_mr"] = result_metrics(r)
+            q["bench_mr"] = result_metrics(r, res.scenario_data)
     if rows is not None:
         from .scen import annotate
 

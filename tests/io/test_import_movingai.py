@@ -129,6 +129,7 @@ def test_plan_scen_rows_as_queries_with_their_octile_optimum(tmp_path, capsys):
     assert [m["octile_optimum"] for m in doc["movingai"]] == opt[:2]
     # the exact any-angle optimum never exceeds the octile (8-connected grid) optimum
     assert all(m["length"] <= m["octile_optimum"] + 1e-9 for m in doc["movingai"])
+    assert all(q["bench_mr"]["exact_goal_path"] for q in doc["queries"])  # Bench-MR's metrics per query
     starts = [q["path"][0][:2] for q in doc["queries"]]
     assert starts == [[0.5, 5.5], [4.5, 4.5]]  # cell centres, row 0 at the top
 
