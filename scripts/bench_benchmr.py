@@ -16,12 +16,16 @@ Problems (read from a Bench-MR checkout, ``--bench-mr DIR``; nothing of it is co
   start or goal puts the car on a blocked cell are counted and left out).
 
 Per problem and seed, in turn: ours, cspace's time to its first certified path
-(``se2_peers.ours_first``: the proof before sampling, then RRTConnect stopped at its first
-solution, CPU seconds), and the peer, OMPL's RRTConnect on the same state space with a shapely
-state checker and OMPL's discrete motion check at Bench-MR's 0.005 of the extent
+(``se2_peers.ours_first``: the proof before sampling, then RRTConnect (RRT for Dubins, whose
+one-way curves RRTConnect's goal tree drives backwards) stopped at its first solution, CPU
+seconds), and the peer, the same OMPL planner on the same state space with a shapely state
+checker and OMPL's discrete motion check at Bench-MR's 0.005 of the extent
 (``se2_peers.peer_first``). Every path either returns is judged by the independent shapely sweep
 along its curves (``sweep_oracle.car_sweep_check``). The table: solved, colliding, median and mean
-time to the first path, and ours / peer over the problems both solve with a sound path.
+time to the first path, and ours / peer over the problems both solve with a sound path. Then the
+peer's paths are written in Bench-MR's results format and re-checked by ``cspace recheck``'s
+routine (``planners.bench.benchmr_results.recheck``): how many paths its discrete check called
+collision-free cross an obstacle, and the recheck's time.
 
 Usage: python scripts/bench_benchmr.py [--bench-mr DIR] [--git-dir GIT] [--seeds N] [--time S] [--rows N]
        [--quick] [--skip-movingai] [--no-peer] [--true-shapes] [--json FILE]
@@ -162,20 +166,51 @@ def run_problem(p: dict, seeds: int, limit: float, peer: bool) -> dict:
     def collides(path):
         return car_sweep_check(sc, path, lambda a, b: seg(a, b, sc.turning_radius), sc.turning_radius)["collides"]
 
+    planner = planner_for(sc.space)
     runs = []
     for qi, q in enumerate(sc.all_queries()):
         for seed in range(seeds):
-            path, cpu = se2_peers.ours_first(sc, cs, adapter, q, seed, limit)
+            path, cpu = se2_peers.ours_first(sc, cs, adapter, q, seed, limit, planner)
             row = {"query": qi, "seed": seed, "ours_s": cpu if path is not None else None,
                    "ours_colliding": bool(path is not None and collides(path))}
             if peer:
                 path, cpu = se2_peers.peer_first(adapter, checker, adapter.pose(q.start), adapter.pose(q.goal), seed,
-                                                 limit, resolution=RESOLUTION)
+                                                 limit, planner, resolution=RESOLUTION)
                 row.update(peer_s=cpu if path is not None else None,
-                           peer_colliding=bool(path is not None and collides(path)))
+                           peer_colliding=bool(path is not None and collides(path)),
+                           peer_path=None if path is None else np.asarray(path, float).tolist())
             runs.append(row)
-    return {"world": p["world"], "space": p["space"], "build_s": build, "runs": runs,
-            "queries": len(sc.all_queries()), "left_out": p.get("left_out", 0)}
+    return {"world": p["world"], "space": p["space"], "planner": planner, "build_s": build, "runs": runs,
+            "queries": len(sc.all_queries()), "left_out": p.get("left_out", 0), "sc": sc}
+
+
+def planner_for(space: str) -> str:
+    """RRTConnect, but RRT for Dubins: RRTConnect's goal tree grows by motions driven backwards,
+    which a one-way Dubins curve is not (both sides use the same planner).
+
+    >>> planner_for("dubins"), planner_for("reeds-shepp")
+    ('RRT', 'RRTConnect')
+    """
+    return "RRT" if space == "dubins" else "RRTConnect"
+
+
+def peer_recheck(r: dict) -> dict:
+    """The peer's paths in Bench-MR's results format (each called collision-free, as its discrete
+    check called them), re-checked by ``cspace recheck``'s routine: paths, colliding, seconds."""
+    from planners.bench.benchmr_results import recheck
+
+    sc = r["sc"]
+    robot = [np.asarray(x.polygon, float).tolist() for x in sc.robot]
+    doc = {"settings": {"env": {"collision": {"collision_model": 1, "robot_shape": robot[0], "robot_parts": robot}},
+                        "steer": {"car_turning_radius": sc.turning_radius},
+                        "steering": "dubins" if sc.space == "dubins" else "reeds_shepp"},
+           "runs": [{"environment": {"type": "polygon", "obstacles": [np.asarray(o.polygon).tolist() for o in sc.obstacles],
+                                     "holes": [[np.asarray(h).tolist() for h in o.holes] for o in sc.obstacles]},
+                     "plans": {f"peer_{i}": {"path": x["peer_path"], "stats": {"path_found": True, "path_collides": False}}
+                               for i, x in enumerate(r["runs"]) if x.get("peer_path")}}]}
+    t0 = time.perf_counter()
+    rows = recheck(doc, r["world"])
+    return {"paths": len(rows), "colliding": sum(x["colliding"] for x in rows), "seconds": time.perf_counter() - t0}
 
 
 def summary(r: dict, peer: bool) -> dict:
@@ -247,6 +282,17 @@ def main(argv=None) -> int:
               flush=True)
     rows = [summary(r, peer) for r in results]
     print(table(rows, peer))
+    if peer:
+        n = bad = 0
+        secs = 0.0
+        for r, row in zip(results, rows):
+            rc = peer_recheck(r)
+            row["peer_recheck"] = rc
+            n, bad, secs = n + rc["paths"], bad + rc["colliding"], secs + rc["seconds"]
+            print(f"recheck of the peer's paths, {r['world']} {r['space']}: {rc['colliding']} of {rc['paths']} called "
+                  f"collision-free by its 0.005 discrete check collide")
+        print(f"recheck: {n} paths in {secs:.2f} s ({secs / max(n, 1) * 1e3:.1f} ms a path, a C-space per world "
+              "included), {bad} colliding")
     poly = [x for r in results if r["world"] in POSES for x in r["runs"]]
     firsts = [x["ours_s"] for x in poly if x["ours_s"] is not None]
     if firsts:
@@ -255,7 +301,8 @@ def main(argv=None) -> int:
               f"{sum(x['ours_colliding'] for x in poly)} colliding (target 0)")
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"rows": rows, "results": results}, fh, indent=1)
+            json.dump({"rows": rows, "results": [{k: v for k, v in r.items() if k != "sc"} for r in results]}, fh,
+                      indent=1)
     return 0
 
 

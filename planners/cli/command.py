@@ -28,6 +28,7 @@ COMMANDS = {
     "import": "planners.cli.imports",
     "check-proof": "planners.cli.check_proof",
     "view": "planners.cli.view",
+    "recheck": "planners.cli.recheck",
 }
 # Each command's one-line help, for the listing of ``cspace --help`` (and a bare
 # ``cspace``), which then imports no command module, nor numpy: start-up stays short.
@@ -42,6 +43,7 @@ HELP = {
               "(.map) to a scenario",
     "check-proof": "re-check a proof that no path exists (from plan --proof)",
     "view": "plan a scenario and write one offline, interactive HTML page of the plan",
+    "recheck": "re-check the paths of a Bench-MR results file exactly (any planner's)",
 }
 
 

@@ -33,6 +33,8 @@ def register(sub) -> None:
                                   "as `cspace view` does")
     p.add_argument("--json", help="write the result as JSON")
     p.add_argument("--csv", help="write the path's waypoints as CSV (x,y or x,y,theta, with a header)")
+    p.add_argument("--bench-mr-json", metavar="FILE", help="write the plan (each query a run) in Bench-MR's results "
+                                                           "format, with its metrics (needs OMPL)")
     p.add_argument("--proof", help="a rotating robot or a car proven to have no path: write the proof (JSON), "
                                    "which `cspace check-proof SCENARIO PROOF` re-checks independently")
     from ..adapters.objectives import OBJECTIVE_PLANNERS, OBJECTIVES
@@ -166,8 +168,12 @@ def run(args) -> int:
         check_output(args.csv, "--csv", inputs=inputs)
     if args.proof is not None:
         check_output(args.proof, "--proof", inputs=inputs)
+    if args.bench_mr_json is not None:
+        check_output(args.bench_mr_json, "--bench-mr-json", inputs=inputs)
+        if not ompl_available():
+            raise InputError(src, "--bench-mr-json", f"Bench-MR's metrics interpolate with OMPL ({OMPL_HINT})")
     check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
-                    (args.csv, "--csv"), (args.proof, "--proof")])
+                    (args.csv, "--csv"), (args.proof, "--proof"), (args.bench_mr_json, "--bench-mr-json")])
     from ..core.plan import plan
 
     if args.verbose and args.planner != "exact":
@@ -179,7 +185,7 @@ def run(args) -> int:
     scenario = src
     t_import = time.perf_counter()  # a load done here (an import, a queries file) is this run's load
     outputs = [(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
-               (args.csv, "--csv"), (args.proof, "--proof")]
+               (args.csv, "--csv"), (args.proof, "--proof"), (args.bench_mr_json, "--bench-mr-json")]
     if rows is not None:  # a MovingAI map and its .scen rows
         from .scen import scen_scenario
 
@@ -188,9 +194,7 @@ def run(args) -> int:
         from .imports import imported_scenario
 
         try:
-            scenario = imported_scenario(args, src, options, [
-                (args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
-                (args.csv, "--csv"), (args.proof, "--proof")])
+            scenario = imported_scenario(args, src, options, outputs)
         except ScenarioError as exc:
             if queries is not None and exc.field in from_queries:  # the pose came from the queries file
                 raise InputError(args.queries, f"queries[0].{exc.field}", exc.message) from None
@@ -232,6 +236,10 @@ def run(args) -> int:
         print("\n".join(annotate(doc, rows, kept, res.queries or [res])))
     if args.json is not None:
         write_json(args.json, doc, "--json")
+    if args.bench_mr_json is not None:
+        from ..bench.benchmr_results import results_document
+
+        write_json(args.bench_mr_json, results_document(res), "--bench-mr-json")
     if args.csv is not None:
         write_paths_csv(args.csv, res)
     if args.plot is not None:
