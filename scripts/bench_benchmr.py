@@ -48,7 +48,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
 
-import se2_peers  # noqa: E402
+import se2_peers  # noqa: E402  (the peer's checker and planning)
 from sweep_oracle import car_sweep_check  # noqa: E402
 
 # Bench-MR's notebook "Benchmark Polygon Worlds": (x, y, theta) start and goal per problem.
@@ -170,9 +170,9 @@ def run_problem(p: dict, seeds: int, limit: float, peer: bool) -> dict:
     runs = []
     for qi, q in enumerate(sc.all_queries()):
         for seed in range(seeds):
-            path, cpu = se2_peers.ours_first(sc, cs, adapter, q, seed, limit, planner)
-            row = {"query": qi, "seed": seed, "ours_s": cpu if path is not None else None,
-                   "ours_colliding": bool(path is not None and collides(path))}
+            path, cpu, proof_cpu, proven = ours_first(sc, cs, adapter, q, seed, limit, planner)
+            row = {"query": qi, "seed": seed, "ours_s": cpu if path is not None else None, "ours_proof_s": proof_cpu,
+                   "proven_unsolvable": proven, "ours_colliding": bool(path is not None and collides(path))}
             if peer:
                 path, cpu = se2_peers.peer_first(adapter, checker, adapter.pose(q.start), adapter.pose(q.goal), seed,
                                                  limit, planner, resolution=RESOLUTION)
@@ -182,6 +182,23 @@ def run_problem(p: dict, seeds: int, limit: float, peer: bool) -> dict:
             runs.append(row)
     return {"world": p["world"], "space": p["space"], "planner": planner, "build_s": build, "runs": runs,
             "queries": len(sc.all_queries()), "left_out": p.get("left_out", 0), "sc": sc}
+
+
+def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
+    """``se2_peers.ours_first`` with its two stages timed apart: (path or None, CPU seconds, of which
+    the proof before sampling, whether that proof found the query unsolvable)."""
+    from planners.core.exact_se2 import quick_proof
+    from planners.core.routine import run_planner
+
+    c0 = time.process_time()
+    proof = quick_proof(sc, cs, query, limit)
+    c1 = time.process_time()
+    if proof is not None:
+        return None, c1 - c0, c1 - c0, True
+    pose = adapter.pose
+    res = run_planner(adapter, planner, [(pose(query.start), pose(query.goal))], limit, seed, simplify=False,
+                      until_first=True)[0]
+    return (res.path if res.solved else None), time.process_time() - c0, c1 - c0, False
 
 
 def planner_for(space: str) -> str:
@@ -216,8 +233,11 @@ def peer_recheck(r: dict) -> dict:
 def summary(r: dict, peer: bool) -> dict:
     runs = r["runs"]
     ours = [x["ours_s"] for x in runs if x["ours_s"] is not None]
+    proofs = [x["ours_proof_s"] for x in runs if x["ours_s"] is not None]
     row = {"world": r["world"], "space": r["space"], "runs": len(runs), "left_out": r["left_out"],
            "ours_solved": len(ours), "ours_colliding": sum(x["ours_colliding"] for x in runs),
+           "proven_unsolvable": sum(x["proven_unsolvable"] for x in runs),
+           "ours_proof_median_s": statistics.median(proofs) if proofs else None,
            "ours_median_s": statistics.median(ours) if ours else None,
            "ours_mean_s": statistics.mean(ours) if ours else None}
     if peer:
@@ -232,14 +252,16 @@ def summary(r: dict, peer: bool) -> dict:
 
 
 def table(rows: list[dict], peer: bool) -> str:
-    head = ["world", "space", "runs", "ours solved", "ours colliding", "ours median", "ours mean"]
+    head = ["world", "space", "runs", "ours solved (proven unsolvable)", "ours colliding", "ours median",
+            "of which proof", "ours mean"]
     if peer:
         head += ["peer solved", "peer colliding", "peer median", "ours / peer (sound, both)"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     ms = lambda v: "-" if v is None else f"{v * 1e3:.0f} ms"  # noqa: E731
     for r in rows:
         cells = [r["world"], r["space"], str(r["runs"]) + (f" ({r['left_out']} rows left out)" if r["left_out"] else ""),
-                 str(r["ours_solved"]), str(r["ours_colliding"]), ms(r["ours_median_s"]), ms(r["ours_mean_s"])]
+                 f"{r['ours_solved']} ({r['proven_unsolvable']})", str(r["ours_colliding"]), ms(r["ours_median_s"]),
+                 ms(r["ours_proof_median_s"]), ms(r["ours_mean_s"])]
         if peer:
             cells += [str(r["peer_solved"]), str(r["peer_colliding"]), ms(r["peer_median_s"]),
                       "-" if r["ratio"] is None else f"{r['ratio']:.2f}x"]
