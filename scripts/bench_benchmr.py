@@ -28,7 +28,7 @@ routine (``planners.bench.benchmr_results.recheck``): how many paths its discret
 collision-free cross an obstacle, and the recheck's time.
 
 Usage: python scripts/bench_benchmr.py [--bench-mr DIR] [--git-dir GIT] [--seeds N] [--time S] [--rows N]
-       [--quick] [--skip-movingai] [--no-peer] [--true-shapes] [--json FILE]
+       [--quick] [--skip-movingai] [--no-peer] [--true-shapes] [--json FILE] [--figures DIR]
 Without a checkout (--bench-mr DIR, or $BENCH_MR) it says so and exits 0.
 """
 from __future__ import annotations
@@ -269,6 +269,20 @@ def table(rows: list[dict], peer: bool) -> str:
     return "\n".join(lines)
 
 
+def figures(problems: list[dict], folder: str, limit: float) -> None:
+    """One picture per world and car model: every query planned (seed 0) on one C-space."""
+    from planners import plan
+    from planners.pictures.plot import plot_result
+
+    os.makedirs(folder, exist_ok=True)
+    for p in problems:
+        res = plan(p["sc"], planner=planner_for(p["sc"].space), time=limit, seed=0, all_queries=True)
+        out = os.path.join(folder, f"{p['world']}_{p['space']}.png")
+        plot_result(res, out)
+        solved = sum(r.solved for r in (res.queries or [res]))
+        print(f"figure {out}: {solved}/{len(res.queries or [res])} queries solved")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bench-mr", default=os.environ.get("BENCH_MR", ""),
@@ -282,6 +296,8 @@ def main(argv=None) -> int:
     ap.add_argument("--no-peer", action="store_true", help="cspace only")
     ap.add_argument("--true-shapes", action="store_true", help="the drawn shapes, not Bench-MR's convex hulls")
     ap.add_argument("--json")
+    ap.add_argument("--figures", metavar="DIR", help="also plan every problem's queries once (seed 0) and save a "
+                                                     "picture of each world and car model with cspace's paths")
     args = ap.parse_args(argv)
     if not os.path.isdir(os.path.join(args.bench_mr or "-", "bin", "polygon_mazes")):
         print(f"no Bench-MR checkout at {args.bench_mr!r} (give --bench-mr DIR or set BENCH_MR): nothing run")
@@ -321,6 +337,8 @@ def main(argv=None) -> int:
         print(f"polygon worlds: ours {len(firsts)}/{len(poly)} runs solved, median time to the first certified path "
               f"{statistics.median(firsts) * 1e3:.0f} ms (target <= 150 ms), "
               f"{sum(x['ours_colliding'] for x in poly)} colliding (target 0)")
+    if args.figures:
+        figures(problems, args.figures, args.time)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"rows": rows, "results": [{k: v for k, v in r.items() if k != "sc"} for r in results]}, fh,
