@@ -190,3 +190,35 @@ def test_rectangles_in_any_encoding_land_where_drawn(rects, mat):
     got = shapely.union_all([shapely.Polygon(o["polygon"], o.get("holes", [])) for o in
                              import_file(path, ImportOptions(start=(1e4, 1e4), goal=(1e4, 1e4 + 1))).data["obstacles"]])
     assert same(got, want, 1e-6 * max(1.0, want.area)) and math.isclose(got.area, want.area, rel_tol=1e-9)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.text(alphabet="MmLlHhVvZzCcAaQqXx0123456789.,-+eE nai\t", max_size=60),
+       st.text(alphabet="translatemrixscolw(),.-0123456789 e", max_size=30))
+def test_any_path_data_or_transform_is_an_obstacle_or_one_scenario_error(d, transform):
+    """Property (fuzz): whatever the path data and the transform, the import returns obstacles or
+    raises ScenarioError (one line), never another exception."""
+    import os
+    import tempfile
+
+    from cspace.io.scenario.messages import ScenarioError
+
+    path = os.path.join(tempfile.mkdtemp(), "f.svg")
+    body = f'<g transform="{transform}"><path id="p" d="{d}"/></g>'
+    open(path, "w").write(SVG.format(body))
+    try:
+        import_file(path, ImportOptions(start=(1e6, 1e6), goal=(1e6, 1e6 + 1), flatten_curves=0.1))
+    except ScenarioError as exc:
+        assert "\n" not in str(exc)
+
+
+def test_a_curve_needing_too_many_chords_is_refused_before_the_work(tmp_path, capsys):
+    f = write(tmp_path, '<path id="big" d="M 0,0 C 0,1e6 1e6,1e6 1e6,0 Z"/>')
+    code = main(["plan", f, "--flatten-curves", "1e-9", "--start", "-5,5", "--goal", "-6,5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "path 'big'" in err[0] and "chords" in err[0]
+
+
+def test_an_arc_between_ends_closer_than_rounding_is_a_point():
+    subs, _, _ = parse_path("M 0,0 H 1 V 1 A 1,1 0 0 1 1,1.0000000000000002 Z", flatten=0.01)
+    assert len(subs[0]) >= 4 and np.isfinite(subs[0]).all()

@@ -167,6 +167,11 @@ def _curve(kind: str, a: np.ndarray, base: np.ndarray, cur: np.ndarray, last_ctr
         end = base + a[2:4] if kind == "q" else base + a[0:2]
         c1, c2 = cur + 2.0 / 3.0 * (q - cur), end + 2.0 / 3.0 * (q - end)  # the same curve as a cubic
         last = q
+    # Wang's bound: this many uniform pieces put a cubic within tol of its chords; past the
+    # point budget the curve is refused before any subdivision (bounded work).
+    dd = max(float(np.hypot(*(cur - 2 * c1 + c2))), float(np.hypot(*(c1 - 2 * c2 + end))))
+    if math.sqrt(0.75 * dd / tol) > MAX_POINTS:
+        raise PathDataError(f"a curve needs over {MAX_POINTS} chords within the tolerance (raise --flatten-curves)")
     pts: list = []
     _cubic(cur, c1, c2, end, tol, pts, 0)
     return pts, (c2 if kind in "cs" else last)
@@ -208,6 +213,8 @@ def _arc(p0, rx, ry, phi_deg, large: bool, sweep: bool, p1, tol: float) -> list:
         rx, ry = rx * math.sqrt(lam), ry * math.sqrt(lam)
     num = rx * rx * ry * ry - rx * rx * y1 * y1 - ry * ry * x1 * x1
     den = rx * rx * y1 * y1 + ry * ry * x1 * x1
+    if not den > 0:  # the ends closer than the squares resolve: a point-sized arc
+        return [p1]
     k = math.sqrt(max(0.0, num / den)) * (-1 if large == sweep else 1)
     cx1, cy1 = k * rx * y1 / ry, -k * ry * x1 / rx
     cx, cy = c * cx1 - s * cy1 + (p0[0] + p1[0]) / 2, s * cx1 + c * cy1 + (p0[1] + p1[1]) / 2
