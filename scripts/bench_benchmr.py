@@ -22,7 +22,10 @@ seconds), and the peer, the same OMPL planner on the same state space with a sha
 checker and OMPL's discrete motion check at Bench-MR's 0.005 of the extent
 (``se2_peers.peer_first``). Every path either returns is judged by the independent shapely sweep
 along its curves (``sweep_oracle.car_sweep_check``). The table: solved, colliding, median and mean
-time to the first path, and ours / peer over the problems both solve with a sound path. Then the
+time to the first path, and ours / peer over the problems both solve with a sound path (medians
+and means: the C-space and the proof's regions are built once per world and scene and reused by
+the later queries and seeds, as ``cspace plan --all-queries`` and ``cspace bench`` reuse them, so
+the first run of a world pays for them: the mean shows it, the median mostly not). Then the
 peer's paths are written in Bench-MR's results format and re-checked by ``cspace recheck``'s
 routine (``planners.bench.benchmr_results.recheck``): how many paths its discrete check called
 collision-free cross an obstacle, and the recheck's time.
@@ -246,7 +249,10 @@ def summary(r: dict, peer: bool) -> dict:
                 and not x["peer_colliding"]]
         row.update(peer_solved=len(theirs), peer_colliding=sum(x["peer_colliding"] for x in runs),
                    peer_median_s=statistics.median(theirs) if theirs else None,
+                   peer_mean_s=statistics.mean(theirs) if theirs else None,
                    ratio=(statistics.median(a for a, _ in both) / statistics.median(b for _, b in both)) if both
+                   else None,
+                   ratio_mean=(statistics.mean(a for a, _ in both) / statistics.mean(b for _, b in both)) if both
                    else None)
     return row
 
@@ -255,7 +261,8 @@ def table(rows: list[dict], peer: bool) -> str:
     head = ["world", "space", "runs", "ours solved (proven unsolvable)", "ours colliding", "ours median",
             "of which proof", "ours mean"]
     if peer:
-        head += ["peer solved", "peer colliding", "peer median", "ours / peer (sound, both)"]
+        head += ["peer solved", "peer colliding", "peer median", "peer mean", "ours / peer, medians (sound, both)",
+                 "means"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     ms = lambda v: "-" if v is None else f"{v * 1e3:.0f} ms"  # noqa: E731
     for r in rows:
@@ -263,8 +270,9 @@ def table(rows: list[dict], peer: bool) -> str:
                  f"{r['ours_solved']} ({r['proven_unsolvable']})", str(r["ours_colliding"]), ms(r["ours_median_s"]),
                  ms(r["ours_proof_median_s"]), ms(r["ours_mean_s"])]
         if peer:
-            cells += [str(r["peer_solved"]), str(r["peer_colliding"]), ms(r["peer_median_s"]),
-                      "-" if r["ratio"] is None else f"{r['ratio']:.2f}x"]
+            cells += [str(r["peer_solved"]), str(r["peer_colliding"]), ms(r["peer_median_s"]), ms(r["peer_mean_s"]),
+                      "-" if r["ratio"] is None else f"{r['ratio']:.2f}x",
+                      "-" if r["ratio_mean"] is None else f"{r['ratio_mean']:.2f}x"]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -330,7 +338,7 @@ def main(argv=None) -> int:
             print(f"recheck of the peer's paths, {r['world']} {r['space']}: {rc['colliding']} of {rc['paths']} called "
                   f"collision-free by its 0.005 discrete check collide")
         print(f"recheck: {n} paths in {secs:.2f} s ({secs / max(n, 1) * 1e3:.1f} ms a path, a C-space per world "
-              "included), {bad} colliding")
+              f"included), {bad} colliding")
     poly = [x for r in results if r["world"] in POSES for x in r["runs"]]
     firsts = [x["ours_s"] for x in poly if x["ours_s"] is not None]
     if firsts:
