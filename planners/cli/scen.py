@@ -133,8 +133,9 @@ def estimate_headings(data: dict, points: list, time_limit: float = 10.0) -> lis
 
     >>> data = {"bounds": {"xmin": 0, "xmax": 4, "ymin": 0, "ymax": 4},
     ...         "obstacles": [{"polygon": [[1, 0], [2, 0], [2, 3], [1, 3]]}]}
+    >>> # around the wall's top corners (1, 3) and (2, 3): atan2(2.5, 0.5) and atan2(-2.5, 1.5)
     >>> [tuple(round(math.degrees(a)) for a in h) for h in estimate_headings(data, [((0.5, 0.5), (3.5, 0.5))])]
-    [(80, -80)]
+    [(79, -59)]
     """
     import numpy as np
 
