@@ -27,7 +27,8 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
     ``"dubins"`` or ``"reeds-shepp"``) overrides the file's ``space`` (``--space`` on the
     command line), ``turning_radius`` its ``turning_radius`` (``--turning-radius``).
 
-    A ROS map (``.yaml``) or an OMPL.app problem (``.cfg``) is imported
+    A ROS map (``.yaml``), an OMPL.app problem (``.cfg``), an SVG drawing (``.svg``) or a MovingAI
+    map (``.map``) is imported
     (:mod:`cspace.io.importers.imported`); ``options`` (an :class:`cspace.io.importers.imported.ImportOptions`)
     give what such a file does not say: the robot, a map's start and goal.
 
@@ -39,7 +40,7 @@ def load_scenario(path, space: str | None = None, turning_radius: float | None =
     (0.9, 0.9)
     """
     path = os.fspath(path)
-    if path.lower().endswith((".yaml", ".yml", ".cfg")):  # the suffixes of cspace.io.importers.imported
+    if path.lower().endswith((".yaml", ".yml", ".cfg", ".svg", ".map")):  # the suffixes of cspace.io.importers.imported
         from .importers.imported import load_imported
 
         return load_imported(path, space=space, options=options, turning_radius=turning_radius)

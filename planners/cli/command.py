@@ -28,6 +28,7 @@ COMMANDS = {
     "import": "planners.cli.imports",
     "check-proof": "planners.cli.check_proof",
     "view": "planners.cli.view",
+    "recheck": "planners.cli.recheck",
 }
 # Each command's one-line help, for the listing of ``cspace --help`` (and a bare
 # ``cspace``), which then imports no command module, nor numpy: start-up stays short.
@@ -38,9 +39,11 @@ HELP = {
     "bench": "error against run time for OMPL planners vs the exact shortest path",
     "stability": "run stiff and extreme cases through every layer",
     "generate": "write a random scenario (random, maze, narrow, disks, office)",
-    "import": "convert a ROS map (.yaml) or an OMPL.app problem (.cfg) to a scenario",
+    "import": "convert a ROS map (.yaml), an OMPL.app problem (.cfg), an SVG drawing (.svg) or a MovingAI map "
+              "(.map) to a scenario",
     "check-proof": "re-check a proof that no path exists (from plan --proof)",
     "view": "plan a scenario and write one offline, interactive HTML page of the plan",
+    "recheck": "re-check the paths of a Bench-MR results file exactly (any planner's)",
 }
 
 

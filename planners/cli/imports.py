@@ -1,5 +1,5 @@
-"""``cspace import``: a ROS occupancy-grid map (``.yaml``) or an OMPL.app problem (``.cfg``)
-as a scenario TOML, with a report of what was read and what the import changed.
+"""``cspace import``: a ROS occupancy-grid map (``.yaml``), an OMPL.app problem (``.cfg``), an
+SVG drawing (``.svg``: Bench-MR's polygon worlds) or a MovingAI map (``.map``) as a scenario TOML, with a report of what was read and what the import changed.
 
 The options that say what such a file does not (the robot, the start and goal)
 are shared with ``cspace plan``, which plans these files directly.
@@ -13,11 +13,13 @@ from ..errors import InputError
 
 
 def register(sub) -> None:
-    p = sub.add_parser("import", help="convert a ROS map (.yaml) or an OMPL.app problem (.cfg) to a scenario",
-                       description="Import a ROS map_server map (YAML + image) or an OMPL.app .cfg problem "
-                                   "(COLLADA meshes, needs pip install -e \".[io]\") and write it as a scenario "
-                                   "TOML; exit 0 written, 2 bad input.")
-    p.add_argument("file", help="map YAML (.yaml) or OMPL.app problem (.cfg)")
+    p = sub.add_parser("import", help="convert a ROS map (.yaml), an OMPL.app problem (.cfg), an SVG drawing "
+                                      "(.svg) or a MovingAI map (.map) to a scenario",
+                       description="Import a ROS map_server map (YAML + image), an OMPL.app .cfg problem "
+                                   "(COLLADA meshes, needs pip install -e \".[io]\") or an SVG drawing (every "
+                                   "path an obstacle, y up as Bench-MR reads it) and write it as a scenario "
+                                   "TOML, or a MovingAI grid map (.map); exit 0 written, 2 bad input.")
+    p.add_argument("file", help="map YAML (.yaml), OMPL.app problem (.cfg), SVG drawing (.svg) or MovingAI map (.map)")
     p.add_argument("--out", required=True, help="scenario TOML to write (never one of the inputs)")
     add_import_options(p)
     p.add_argument("--verbose", "-v", action="store_true",
@@ -27,9 +29,11 @@ def register(sub) -> None:
 
 def add_import_options(p) -> None:
     """The robot, start, goal and tracing options (import and plan share them)."""
-    g = p.add_argument_group("imported files (.yaml maps, .cfg problems)")
+    g = p.add_argument_group("imported files (.yaml maps, .cfg problems, .svg drawings)")
     g.add_argument("--robot", metavar="ROBOT.toml", help="the robot: a TOML file with a [robot] table "
-                                                          "(polygon, parts or radius, as in a scenario)")
+                                                          "(polygon, parts or radius, as in a scenario), or an "
+                                                          "SVG file whose first path is the robot, centred on the "
+                                                          "mean of its points as Bench-MR centres it")
     g.add_argument("--radius", type=float, help="the robot: a disk of this radius")
     g.add_argument("--polygon", metavar="X,Y;X,Y;...", help="the robot: a polygon about its reference point")
     g.add_argument("--start", metavar="X,Y[,THETA]", help="start pose (a map has none; a .cfg's is overridden)")
@@ -38,9 +42,22 @@ def add_import_options(p) -> None:
                    help="a map's unknown cells: obstacle (default) or free")
     g.add_argument("--tolerance", type=float, help="largest simplification error of a map's obstacles, in map "
                                                    "units (default: two cells; 0: the exact staircase of cells)")
+    g.add_argument("--flatten-curves", type=float, metavar="TOL",
+                   help="an SVG's curves as chords within TOL of them, each such obstacle grown by TOL so that it "
+                        "contains the curve (default: a curve is refused)")
+    g.add_argument("--convex-hulls", action="store_true", default=None,
+                   help="replace each SVG path (and an SVG robot) by its convex hull, as Bench-MR does "
+                        "(default: the true shapes)")
+    g.add_argument("--grid-reading", choices=("movingai", "bench-mr"), default=None,
+                   help="a MovingAI map's frame: movingai (default: row 0 at the top, as MovingAI draws it) or "
+                        "bench-mr (rows upwards, cells centred on integer points, only '.' passable, as "
+                        "Bench-MR reads it)")
+    g.add_argument("--border", action="store_true", default=None,
+                   help="a MovingAI map's outermost cells blocked (Bench-MR's create_border)")
 
 
-IMPORT_FLAGS = ("robot", "radius", "polygon", "start", "goal", "unknown", "tolerance")
+IMPORT_FLAGS = ("robot", "radius", "polygon", "start", "goal", "unknown", "tolerance", "flatten_curves",
+                "convex_hulls", "grid_reading", "border")
 
 
 def import_options(args, src: str):
@@ -51,15 +68,20 @@ def import_options(args, src: str):
     given = [f for f in IMPORT_FLAGS if getattr(args, f, None) is not None]
     if not is_import(src):
         if given:
-            raise InputError(src, f"--{given[0]}", "applies to imported files (.yaml maps, .cfg problems) only; "
-                                                   "a scenario TOML names its own")
+            raise InputError(src, f"--{given[0].replace('_', '-')}", "applies to imported files (.yaml maps, .cfg "
+                                                                     "problems, .svg drawings, .map grids) only; a "
+                                                                     "scenario TOML names its own")
         return None
     robots = [f for f in ("robot", "radius", "polygon") if getattr(args, f) is not None]
     if len(robots) > 1:
         raise InputError(src, f"--{robots[1]}", f"--{robots[0]} and --{robots[1]} exclude each other (one robot)")
     robot = None
+    flatten = getattr(args, "flatten_curves", None)
+    if flatten is not None and not (flatten > 0 and flatten < float("inf")):
+        raise InputError(src, "--flatten-curves", f"must be a positive finite distance, got {flatten}")
+    hulls = bool(getattr(args, "convex_hulls", None))
     if args.robot is not None:
-        robot = read_robot(args.robot)
+        robot = read_robot(args.robot, convex_hull=hulls, flatten=flatten)
     elif args.radius is not None:
         if not (args.radius > 0 and args.radius < float("inf")):
             raise InputError(src, "--radius", f"must be a positive number, got {args.radius}")
@@ -69,7 +91,9 @@ def import_options(args, src: str):
     return ImportOptions(robot=robot,
                          start=_numbers(args.start, "--start", 2, 3) if args.start is not None else None,
                          goal=_numbers(args.goal, "--goal", 2, 3) if args.goal is not None else None,
-                         unknown=args.unknown or "obstacle", tolerance=args.tolerance)
+                         unknown=args.unknown or "obstacle", tolerance=args.tolerance,
+                         flatten_curves=flatten, convex_hulls=hulls, grid_reading=getattr(args, "grid_reading", None),
+                         border=bool(getattr(args, "border", None)))
 
 
 def imported_scenario(args, src: str, options, outputs: list):
@@ -112,7 +136,7 @@ def _numbers(text: str, option: str, lo: int, hi: int) -> tuple:
     return vals
 
 
-def input_files(src: str, robot: str | None = None, queries: str | None = None) -> list[str]:
+def input_files(src: str, robot: str | None = None, queries: str | None = None, scen: str | None = None) -> list[str]:
     """Every file a command reads, which no output may be: the scenario (or the map YAML and
     the image it names, or the cfg and its meshes, resolved as the import resolves them),
     the ``--robot`` file and the ``--queries`` file. Listed without importing; a file that
@@ -127,18 +151,31 @@ def input_files(src: str, robot: str | None = None, queries: str | None = None) 
                 from cspace.io.importers.omplapp import mesh_files
 
                 files += mesh_files(src)
+            elif src.lower().endswith((".svg", ".map")):
+                pass  # one file
             else:
                 from cspace.io.importers.occupancy import read_map_yaml
 
                 files.append(read_map_yaml(src).image)
         except (ScenarioError, OSError, ValueError):
             pass
-    return files + [f for f in (robot, queries) if f is not None]
+    return files + [f for f in (robot, queries, scen) if f is not None]
 
 
-def read_robot(path: str) -> dict:
-    """The ``[robot]`` table of a TOML file (a robot file, or any scenario)."""
+def read_robot(path: str, convex_hull: bool = False, flatten: float | None = None) -> dict:
+    """The ``[robot]`` table of a TOML file (a robot file, or any scenario), or the robot of an
+    SVG file (its first path, centred as Bench-MR centres it: :func:`cspace.io.importers.svg.svg_robot`)."""
     from cspace.io.scenario.files import read_input, toml_reader
+
+    if path.lower().endswith(".svg"):
+        from cspace.io.importers.svg import svg_robot
+        from cspace.io.scenario.files import check_input
+
+        check_input(path)
+        robot, _, warnings = svg_robot(path, convex_hull=convex_hull, flatten=flatten)
+        for w in warnings:
+            sys.stderr.write(f"warning: {w}\n")
+        return robot
 
     tomllib = toml_reader()
     raw = read_input(path)
@@ -161,7 +198,8 @@ def run(args) -> int:
 
     src = args.file
     if not is_import(src):
-        raise InputError(src, "file", "expected a map YAML (.yaml, .yml) or an OMPL.app problem (.cfg)")
+        raise InputError(src, "file", "expected a map YAML (.yaml, .yml), an OMPL.app problem (.cfg), an SVG "
+                                      "drawing (.svg) or a MovingAI map (.map)")
     check_input(src)
     check_output(args.out, "--out", {".toml": "toml"}, inputs=input_files(src, args.robot))
     options = import_options(args, src)

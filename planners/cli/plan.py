@@ -14,8 +14,9 @@ def register(sub) -> None:
                        description="Plan a path for a translating robot, a rotating one (--space se2) or a car "
                                    "(--space dubins / reeds-shepp); "
                                    "exit 0 solved, 1 not solved, 2 bad input.")
-    p.add_argument("scenario", help="scenario TOML file, or a ROS map (.yaml) or OMPL.app problem (.cfg) to "
-                                    "import on the fly (see the options for imported files)")
+    p.add_argument("scenario", help="scenario TOML file, or a ROS map (.yaml), OMPL.app problem (.cfg), SVG "
+                                    "drawing (.svg) or MovingAI map (.map) to import on the fly (see the options "
+                                    "for imported files)")
     p.add_argument("--planner", help="OMPL planner (case-insensitive), 'exact' or 'auto' (the proof, the slab "
                                      "graph, sampling and refinement in one budget); default: the scenario's, else auto "
                                      "for a rotating robot or a car, RRTConnect for a translating one")
@@ -34,6 +35,8 @@ def register(sub) -> None:
                                   "as `cspace view` does")
     p.add_argument("--json", help="write the result as JSON")
     p.add_argument("--csv", help="write the path's waypoints as CSV (x,y or x,y,theta, with a header)")
+    p.add_argument("--bench-mr-json", metavar="FILE", help="write the plan (each query a run) in Bench-MR's results "
+                                                           "format, with its metrics (needs OMPL)")
     p.add_argument("--proof", help="a rotating robot or a car proven to have no path: write the proof (JSON), "
                                    "which `cspace check-proof SCENARIO PROOF` re-checks independently")
     from ..adapters.objectives import OBJECTIVE_PLANNERS, OBJECTIVES
@@ -45,8 +48,10 @@ def register(sub) -> None:
                         f"the planners {takers}, in space translation or se2")
     p.add_argument("--verbose", "-v", action="store_true", help="print the C-space report and OMPL's messages")
     from .imports import add_import_options
+    from .scen import add_scen_options
 
     add_import_options(p)
+    add_scen_options(p)
     p.set_defaults(run=run)
 
 
@@ -143,9 +148,14 @@ def run(args) -> int:
                 if getattr(options, key) is None and _pose(first.get(key)) is not None:
                     setattr(options, key, _pose(first.get(key)))
                     from_queries.add(key)
+    from .scen import scen_rows
+
+    rows = scen_rows(args, src)  # --scen: a MovingAI scenario file's rows as the queries
+    if rows is not None:
+        args.all_queries = True
     from .imports import input_files
 
-    inputs = input_files(src, args.robot, args.queries)  # every file read, the import's included
+    inputs = input_files(src, args.robot, args.queries, args.scen)  # every file read, the import's included
     fmt = check_output(args.plot, "--plot", PLOT_FORMATS, inputs=inputs) if args.plot is not None else None
     if args.animate is not None:
         check_output(args.animate, "--animate", {".gif": "gif"}, inputs=inputs)
@@ -160,8 +170,12 @@ def run(args) -> int:
         check_output(args.csv, "--csv", inputs=inputs)
     if args.proof is not None:
         check_output(args.proof, "--proof", inputs=inputs)
+    if args.bench_mr_json is not None:
+        check_output(args.bench_mr_json, "--bench-mr-json", inputs=inputs)
+        if not ompl_available():
+            raise InputError(src, "--bench-mr-json", f"Bench-MR's metrics interpolate with OMPL ({OMPL_HINT})")
     check_distinct([(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
-                    (args.csv, "--csv"), (args.proof, "--proof")])
+                    (args.csv, "--csv"), (args.proof, "--proof"), (args.bench_mr_json, "--bench-mr-json")])
     from ..core.plan import plan
 
     if args.verbose and args.planner != "exact":
@@ -172,13 +186,17 @@ def run(args) -> int:
 
     scenario = src
     t_import = time.perf_counter()  # a load done here (an import, a queries file) is this run's load
-    if options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
+    outputs = [(args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
+               (args.csv, "--csv"), (args.proof, "--proof"), (args.bench_mr_json, "--bench-mr-json")]
+    if rows is not None:  # a MovingAI map and its .scen rows
+        from .scen import scen_scenario
+
+        scenario, kept = scen_scenario(args, src, options, rows, outputs)
+    elif options is not None:  # a map or an OMPL.app problem: imported here, planned as a scenario
         from .imports import imported_scenario
 
         try:
-            scenario = imported_scenario(args, src, options, [
-                (args.json, "--json"), (args.plot, "--plot"), (args.animate, "--animate"), (args.html, "--html"),
-                (args.csv, "--csv"), (args.proof, "--proof")])
+            scenario = imported_scenario(args, src, options, outputs)
         except ScenarioError as exc:
             if queries is not None and exc.field in from_queries:  # the pose came from the queries file
                 raise InputError(args.queries, f"queries[0].{exc.field}", exc.message) from None
@@ -192,7 +210,7 @@ def run(args) -> int:
         scenario = with_queries(scenario, queries, args.queries)
     import_s = time.perf_counter() - t_import
     try:
-        loaded = options is not None or queries is not None  # a Scenario, its space and radius applied
+        loaded = options is not None or queries is not None  # a Scenario, its space and radius applied (--scen too)
         res = plan(scenario, planner=args.planner, time=args.time, seed=args.seed, iterations=args.iterations,
                    simplify=not args.no_simplify, all_queries=args.all_queries,
                    space=None if loaded else args.space, slabs=args.slabs,
@@ -207,8 +225,23 @@ def run(args) -> int:
 
         count_as_load(res, import_s)
     print(summary(res, verbose=args.verbose))
+    doc = res.as_dict()
+    if args.json is not None and ompl_available():  # Bench-MR's metrics of every solved path, beside ours
+        from ..bench.benchmr import result_metrics
+
+        doc["bench_mr"] = result_metrics(res)
+        for q, r in zip(doc.get("queries", []), res.queries or []):
+            q["bench_mr"] = result_metrics(r, res.scenario_data)
+    if rows is not None:
+        from .scen import annotate
+
+        print("\n".join(annotate(doc, rows, kept, res.queries or [res])))
     if args.json is not None:
-        write_json(args.json, res.as_dict(), "--json")
+        write_json(args.json, doc, "--json")
+    if args.bench_mr_json is not None:
+        from ..bench.benchmr_results import results_document
+
+        write_json(args.bench_mr_json, results_document(res), "--bench-mr-json")
     if args.csv is not None:
         write_paths_csv(args.csv, res)
     if args.plot is not None:
@@ -230,7 +263,7 @@ def run(args) -> int:
     results = res.queries or [res]
     if args.proof is not None:
         write_proof(args.proof, results)
-    return 0 if all(r.solved for r in results) else 1
+    return 0 if all(r.solved for r in results) and (rows is None or len(kept) == len(rows)) else 1
 
 
 def write_paths_csv(path: str, res) -> None:

@@ -99,6 +99,8 @@ RUN_SLOW = os.environ.get("CSPACE_DOCS_SLOW") == "1"
 UNMARKED = {
     "s.toml: colour: unknown field": "messages of faulty scenario files (tests/io/test_messages.py checks them)",
     'pip install -e ".[io]"': "commands, shown as text: they need an OMPL.app checkout",
+    "cspace plan ../bench-mr/": "commands, shown as text: they need a Bench-MR checkout (tests/io/test_import_svg.py "
+                                "runs the format on files of its own)",
     "dask scheduler": "commands, shown as text: servers on several machines (tests/bench/test_bench_cluster.py "
                       "runs `--scheduler` on a LocalCluster)",
 }

@@ -19,7 +19,10 @@ class ImportOptions:
     ``(x, y, theta)`` (a ``.cfg`` gives its own, which these override).
     ``unknown`` is ``"obstacle"`` or ``"free"``; ``tolerance`` is the largest
     simplification error in world units (None: two cells of a map; 0: the exact
-    staircase of cells).
+    staircase of cells). ``flatten_curves`` is the largest distance of a chord from an SVG
+    curve (None: curves refused); ``convex_hulls`` replaces each SVG path by its convex hull.
+    ``grid_reading`` (``"movingai"`` or ``"bench-mr"``) and ``border`` place a MovingAI map
+    (:mod:`cspace.io.importers.movingai`).
     """
 
     robot: dict | None = None
@@ -27,6 +30,10 @@ class ImportOptions:
     goal: tuple | None = None
     unknown: str = "obstacle"
     tolerance: float | None = None
+    flatten_curves: float | None = None
+    convex_hulls: bool = False
+    grid_reading: str | None = None
+    border: bool = False
 
 
 @dataclass

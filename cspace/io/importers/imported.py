@@ -1,5 +1,6 @@
-"""Scenarios imported from other formats: ROS occupancy-grid maps (``.yaml``) and
-OMPL.app problem files (``.cfg``).
+"""Scenarios imported from other formats: ROS occupancy-grid maps (``.yaml``),
+OMPL.app problem files (``.cfg``), SVG drawings (``.svg``, :mod:`cspace.io.importers.svg`) and
+MovingAI grid maps (``.map``, :mod:`cspace.io.importers.movingai`).
 
 An import builds the same dict a scenario TOML parses to, so one validator
 (:func:`cspace.io.scenario.validate.scenario_from_dict`) checks both, and :func:`to_toml` writes
@@ -22,7 +23,9 @@ from ..scenario.validate import scenario_from_dict
 
 MAP_SUFFIXES = (".yaml", ".yml")
 CFG_SUFFIXES = (".cfg",)
-SUFFIXES = MAP_SUFFIXES + CFG_SUFFIXES
+SVG_SUFFIXES = (".svg",)
+GRID_SUFFIXES = (".map",)
+SUFFIXES = MAP_SUFFIXES + CFG_SUFFIXES + SVG_SUFFIXES + GRID_SUFFIXES
 # A map's default simplification tolerance, in cells: 2 lets Douglas-Peucker (within 0.8 cell)
 # straighten a diagonal staircase (its corners are 0.71 cell off the diagonal); 1 would not.
 DEFAULT_TOLERANCE_CELLS = 2.0
@@ -52,10 +55,22 @@ def import_file(path, options: ImportOptions | None = None) -> Imported:
         raise ScenarioError("--unknown", "unknown", f"must be obstacle or free, got {options.unknown!r}")
     if options.tolerance is not None and not (math.isfinite(options.tolerance) and options.tolerance >= 0):
         raise ScenarioError("--tolerance", "tolerance", f"must be a finite number >= 0, got {options.tolerance}")
+    if options.flatten_curves is not None and not (math.isfinite(options.flatten_curves)
+                                                   and options.flatten_curves > 0):
+        raise ScenarioError("--flatten-curves", "flatten_curves", f"must be a positive finite distance, got "
+                                                                  f"{options.flatten_curves}")
     if path.lower().endswith(CFG_SUFFIXES):
         from .omplapp import import_cfg
 
         return import_cfg(path, options)
+    if path.lower().endswith(SVG_SUFFIXES):
+        from .svg import import_svg
+
+        return import_svg(path, options)
+    if path.lower().endswith(GRID_SUFFIXES):
+        from .movingai import import_movingai
+
+        return import_movingai(path, options)
     return import_map(path, options)
 
 

@@ -1,0 +1,358 @@
+"""Bench-MR's suite, side by side: its four polygon worlds and MovingAI city maps, cspace against
+OMPL with a discrete-checking peer, every path judged by an independent swept check.
+
+Problems (read from a Bench-MR checkout, ``--bench-mr DIR``; nothing of it is copied here):
+
+- the 20 polygon problems: parking1-3 and warehouse (``bin/polygon_mazes/*.svg``, imported with
+  ``--convex-hulls`` as Bench-MR plans them; ``--true-shapes`` keeps the drawn shapes), each with
+  its robot (``car.svg``, ``warehouse_robot.svg``) and the 5 start/goal poses of Bench-MR's notebook
+  (``python/Benchmark Polygon Worlds.ipynb``), in Dubins and Reeds–Shepp with turning radius 4.
+  The poses were written for the drawings before Bench-MR's commit 7692815 (which moved each
+  world): they are shifted by the difference of the obstacles' box corners, old to new, computed
+  from the checkout's git history when it has it (``git show 7692815^:...``, the old reading:
+  absolute path coordinates, y negated, scaled 1/22), else the recorded shifts (``SHIFT``);
+- the last ``--rows`` rows (default 10) of ``Berlin_0_256`` and ``Boston_2_512`` (Reeds–Shepp,
+  Bench-MR's car, MovingAI's frame, headings estimated as Bench-MR estimates them; rows whose
+  start or goal puts the car on a blocked cell are counted and left out).
+
+Per problem and seed, in turn: ours, cspace's time to its first certified path
+(``se2_peers.ours_first``: the proof before sampling, then RRTConnect (RRT for Dubins, whose
+one-way curves RRTConnect's goal tree drives backwards) stopped at its first solution, CPU
+seconds), and the peer, the same OMPL planner on the same state space with a shapely state
+checker and OMPL's discrete motion check at Bench-MR's 0.005 of the extent
+(``se2_peers.peer_first``). Every path either returns is judged by the independent shapely sweep
+along its curves (``sweep_oracle.car_sweep_check``). The table: solved, colliding, median and mean
+time to the first path, and ours / peer over the problems both solve with a sound path (medians
+and means: the C-space and the proof's regions are built once per world and scene and reused by
+the later queries and seeds, as ``cspace plan --all-queries`` and ``cspace bench`` reuse them, so
+the first run of a world pays for them: the mean shows it, the median mostly not). Then the
+peer's paths are written in Bench-MR's results format and re-checked by ``cspace recheck``'s
+routine (``planners.bench.benchmr_results.recheck``): how many paths its discrete check called
+collision-free cross an obstacle, and the recheck's time.
+
+Usage: python scripts/bench_benchmr.py [--bench-mr DIR] [--git-dir GIT] [--seeds N] [--time S] [--rows N]
+       [--quick] [--skip-movingai] [--no-peer] [--true-shapes] [--json FILE] [--figures DIR]
+Without a checkout (--bench-mr DIR, or $BENCH_MR) it says so and exits 0.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+sys.path.insert(0, ROOT)
+
+import se2_peers  # noqa: E402  (the peer's checker and planning)
+from sweep_oracle import car_sweep_check  # noqa: E402
+
+# Bench-MR's notebook "Benchmark Polygon Worlds": (x, y, theta) start and goal per problem.
+POSES = {
+    "parking1": [((0, -2.27, 0), (7.72, -7.72, -1.58)), ((7.72, -7.72, -1.58), (0, -2.27, 3.14)),
+                 ((7.72, -7.72, -1.58), (10, -7.72, 1.58)), ((7.72, -7.72, -1.58), (15, -2.27, 0)),
+                 ((15, -2.27, 3.14), (7.72, -7.72, -1.58))],
+    "parking2": [((0, -2.27, 0), (10.91, 2.73, 1.57)), ((10.91, 2.73, 1.57), (0, -2.27, 3.14)),
+                 ((0, -2.27, 0), (13.5, -7, 1.57)), ((13.5, -7, 1.57), (0, -2.27, 3.14)),
+                 ((13.5, -7, 1.57), (10.91, 2.73, 1.57))],
+    "parking3": [((15.45, -2.27, 0), (3.4, 0.34, 0)), ((5, -2.27, 0), (19.5, -6, 0)),
+                 ((19.5, -6, 3.14), (5, -2.27, 3.14)), ((19.5, -2.5, 3.14), (4.5, 0.5, 3.14)),
+                 ((4.5, 0.5, 0), (19.5, -2.5, 0))],
+    "warehouse": [((-2.5, 4.55, -1.58), (65, 2.5, -1.58)), ((-2.5, -55, 0), (55, 5.5, 0)),
+                  ((14.5, -28, 1.58), (48, -28, 1.58)), ((65, -55, 3.14), (14.5, 0, 1.58)),
+                  ((3, -5, 3.14), (66, -5, 1.58))],
+}
+ROBOT = {"parking1": "car.svg", "parking2": "car.svg", "parking3": "car.svg", "warehouse": "warehouse_robot.svg"}
+# The old drawings' frame to the current one (the obstacles' box corners), measured on the
+# checkout fetched 2026-11 (master after 7692815) with old_frame_shift().
+SHIFT = {"parking1": (1.3795, -4.756), "parking2": (1.3795, -4.7422), "parking3": (9.0207, -9.451),
+         "warehouse": (11.1359, -12.1615)}
+OLD_COMMIT = "7692815^"
+RADIUS = 4.0
+RESOLUTION = 0.005  # Bench-MR's OMPL state validity checking resolution (fraction of the extent)
+MAPS = ("Berlin_0_256", "Boston_2_512")
+
+
+def old_frame_shift(bench_mr: str, world: str, git_dir: str | None = None) -> tuple[float, float] | None:
+    """The shift from the drawing before 7692815 (as Bench-MR read it then: absolute path
+    coordinates, y negated, scaled 1/22, transforms ignored) to the current one (as it reads it
+    now), from the checkout's git history: the obstacles' boxes' lower-left corners. None
+    without the history."""
+    import re
+
+    import shapely
+
+    from cspace.io.importers.svg import read_svg, path_shapes
+    from cspace.io.importers.svg_path import parse_path
+
+    try:
+        where = ["--git-dir", git_dir] if git_dir else ["-C", bench_mr]
+        old = subprocess.run(["git", *where, "show", f"{OLD_COMMIT}:bin/polygon_mazes/{world}.svg"],
+                             capture_output=True, text=True, timeout=60, check=True).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    pts = [np.concatenate(parse_path(d)[0]) * (1, -1) / 22 for d in re.findall(r'^\s*d="([^"]*)"', old, re.M)]
+    lo_old = np.concatenate(pts).min(axis=0)
+    path = os.path.join(bench_mr, "bin", "polygon_mazes", f"{world}.svg")
+    paths, _ = read_svg(path)
+    new = shapely.union_all([g for p in paths for g in path_shapes(p, path, None, True)[0]])
+    return float(new.bounds[0] - lo_old[0]), float(new.bounds[1] - lo_old[1])
+
+
+def polygon_problems(bench_mr: str, hulls: bool, git_dir: str | None = None) -> list[dict]:
+    """The 20 polygon problems in both car models: {name, sc (with queries), shift}."""
+    from cspace.io.importers.imported import ImportOptions, import_file
+    from cspace.io.importers.svg import svg_robot
+    from cspace.io.scenario.validate import scenario_from_dict, with_queries
+
+    folder = os.path.join(bench_mr, "bin", "polygon_mazes")
+    out = []
+    for world, pairs in POSES.items():
+        shift = old_frame_shift(bench_mr, world, git_dir) or SHIFT[world]
+        robot = svg_robot(os.path.join(folder, ROBOT[world]), convex_hull=hulls)[0]
+        moved = [tuple((p[0] + shift[0], p[1] + shift[1], p[2]) for p in pair) for pair in pairs]
+        imp = import_file(os.path.join(folder, f"{world}.svg"),
+                          ImportOptions(robot=robot, start=moved[0][0], goal=moved[0][1], convex_hulls=hulls))
+        b = imp.data["bounds"]
+        for s, g in moved:  # every pose inside the bounds (Bench-MR's boxes are the obstacles')
+            for x, y, _ in (s, g):
+                b["xmin"], b["xmax"] = min(b["xmin"], x), max(b["xmax"], x)
+                b["ymin"], b["ymax"] = min(b["ymin"], y), max(b["ymax"], y)
+        for space in ("reeds-shepp", "dubins"):
+            sc = scenario_from_dict(imp.data, world, space=space, turning_radius=RADIUS)
+            sc = with_queries(sc, {"queries": [{"start": list(s), "goal": list(g)} for s, g in moved]}, world)
+            out.append({"world": world, "space": space, "sc": sc, "shift": shift})
+    return out
+
+
+def movingai_problems(bench_mr: str, rows: int) -> list[dict]:
+    """The last ``rows`` rows of each city map, Reeds–Shepp, Bench-MR's car, as `cspace plan --scen` reads them."""
+    from types import SimpleNamespace
+
+    from cspace.io.importers.imported import ImportOptions
+    from cspace.io.importers.movingai import read_scen
+    from cspace.io.importers.svg import svg_robot
+    from planners.cli.scen import scen_scenario
+
+    folder = os.path.join(bench_mr, "bin", "moving_ai_scenarios")
+    robot = svg_robot(os.path.join(bench_mr, "bin", "polygon_mazes", "car.svg"))[0]
+    out = []
+    for name in MAPS:
+        src, scen = os.path.join(folder, f"{name}.map"), os.path.join(folder, f"{name}.map.scen")
+        selected = read_scen(scen, f"-{rows}:")
+        args = SimpleNamespace(scen=scen, space="reeds-shepp", turning_radius=RADIUS, scen_headings=None)
+        sc, kept = scen_scenario(args, src, ImportOptions(robot=robot), selected, [])
+        out.append({"world": name, "space": "reeds-shepp", "sc": sc, "left_out": len(selected) - len(kept)})
+    return out
+
+
+def run_problem(p: dict, seeds: int, limit: float, peer: bool) -> dict:
+    """Every query x seed: ours then the peer, each path judged."""
+    from cspace.car.curves import dubins_segments, reeds_shepp_segments
+    from planners.core.plan import build_cspace, make_adapter
+
+    sc = p["sc"]
+    seg = dubins_segments if sc.space == "dubins" else reeds_shepp_segments
+    t0 = time.perf_counter()
+    cs = build_cspace(sc)
+    adapter = make_adapter(sc, cs)
+    build = time.perf_counter() - t0
+    checker = se2_peers.shapely_checker(sc) if peer else None
+
+    def collides(path):
+        return car_sweep_check(sc, path, lambda a, b: seg(a, b, sc.turning_radius), sc.turning_radius)["collides"]
+
+    planner = planner_for(sc.space)
+    runs = []
+    for qi, q in enumerate(sc.all_queries()):
+        for seed in range(seeds):
+            path, cpu, proof_cpu, proven = ours_first(sc, cs, adapter, q, seed, limit, planner)
+            row = {"query": qi, "seed": seed, "ours_s": cpu if path is not None else None, "ours_proof_s": proof_cpu,
+                   "proven_unsolvable": proven, "ours_colliding": bool(path is not None and collides(path))}
+            if peer:
+                path, cpu = se2_peers.peer_first(adapter, checker, adapter.pose(q.start), adapter.pose(q.goal), seed,
+                                                 limit, planner, resolution=RESOLUTION)
+                row.update(peer_s=cpu if path is not None else None,
+                           peer_colliding=bool(path is not None and collides(path)),
+                           peer_path=None if path is None else np.asarray(path, float).tolist())
+            runs.append(row)
+    return {"world": p["world"], "space": p["space"], "planner": planner, "build_s": build, "runs": runs,
+            "queries": len(sc.all_queries()), "left_out": p.get("left_out", 0), "sc": sc}
+
+
+def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
+    """``se2_peers.ours_first`` with its two stages timed apart: (path or None, CPU seconds, of which
+    the proof before sampling, whether that proof found the query unsolvable)."""
+    from planners.core.exact_se2 import quick_proof
+    from planners.core.routine import run_planner
+
+    c0 = time.process_time()
+    proof = quick_proof(sc, cs, query, limit)
+    c1 = time.process_time()
+    if proof is not None:
+        return None, c1 - c0, c1 - c0, True
+    pose = adapter.pose
+    res = run_planner(adapter, planner, [(pose(query.start), pose(query.goal))], limit, seed, simplify=False,
+                      until_first=True)[0]
+    return (res.path if res.solved else None), time.process_time() - c0, c1 - c0, False
+
+
+def planner_for(space: str) -> str:
+    """RRTConnect, but RRT for Dubins: RRTConnect's goal tree grows by motions driven backwards,
+    which a one-way Dubins curve is not (both sides use the same planner).
+
+    >>> planner_for("dubins"), planner_for("reeds-shepp")
+    ('RRT', 'RRTConnect')
+    """
+    return "RRT" if space == "dubins" else "RRTConnect"
+
+
+def peer_recheck(r: dict) -> dict:
+    """The peer's paths in Bench-MR's results format (each called collision-free, as its discrete
+    check called them), re-checked by ``cspace recheck``'s routine: paths, colliding, seconds."""
+    from planners.bench.benchmr_results import recheck
+
+    sc = r["sc"]
+    robot = [np.asarray(x.polygon, float).tolist() for x in sc.robot]
+    doc = {"settings": {"env": {"collision": {"collision_model": 1, "robot_shape": robot[0], "robot_parts": robot}},
+                        "steer": {"car_turning_radius": sc.turning_radius},
+                        "steering": "dubins" if sc.space == "dubins" else "reeds_shepp"},
+           "runs": [{"environment": {"type": "polygon", "obstacles": [np.asarray(o.polygon).tolist() for o in sc.obstacles],
+                                     "holes": [[np.asarray(h).tolist() for h in o.holes] for o in sc.obstacles]},
+                     "plans": {f"peer_{i}": {"path": x["peer_path"], "stats": {"path_found": True, "path_collides": False}}
+                               for i, x in enumerate(r["runs"]) if x.get("peer_path")}}]}
+    t0 = time.perf_counter()
+    rows = recheck(doc, r["world"])
+    return {"paths": len(rows), "colliding": sum(x["colliding"] for x in rows), "seconds": time.perf_counter() - t0}
+
+
+def summary(r: dict, peer: bool) -> dict:
+    runs = r["runs"]
+    ours = [x["ours_s"] for x in runs if x["ours_s"] is not None]
+    proofs = [x["ours_proof_s"] for x in runs if x["ours_s"] is not None]
+    row = {"world": r["world"], "space": r["space"], "runs": len(runs), "left_out": r["left_out"],
+           "ours_solved": len(ours), "ours_colliding": sum(x["ours_colliding"] for x in runs),
+           "proven_unsolvable": sum(x["proven_unsolvable"] for x in runs),
+           "ours_proof_median_s": statistics.median(proofs) if proofs else None,
+           "ours_median_s": statistics.median(ours) if ours else None,
+           "ours_mean_s": statistics.mean(ours) if ours else None}
+    if peer:
+        theirs = [x["peer_s"] for x in runs if x["peer_s"] is not None]
+        both = [(x["ours_s"], x["peer_s"]) for x in runs if x["ours_s"] is not None and x["peer_s"] is not None
+                and not x["peer_colliding"]]
+        row.update(peer_solved=len(theirs), peer_colliding=sum(x["peer_colliding"] for x in runs),
+                   peer_median_s=statistics.median(theirs) if theirs else None,
+                   peer_mean_s=statistics.mean(theirs) if theirs else None,
+                   ratio=(statistics.median(a for a, _ in both) / statistics.median(b for _, b in both)) if both
+                   else None,
+                   ratio_mean=(statistics.mean(a for a, _ in both) / statistics.mean(b for _, b in both)) if both
+                   else None)
+    return row
+
+
+def table(rows: list[dict], peer: bool) -> str:
+    head = ["world", "space", "runs", "ours solved (proven unsolvable)", "ours colliding", "ours median",
+            "of which proof", "ours mean"]
+    if peer:
+        head += ["peer solved", "peer colliding", "peer median", "peer mean", "ours / peer, medians (sound, both)",
+                 "means"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    ms = lambda v: "-" if v is None else f"{v * 1e3:.0f} ms"  # noqa: E731
+    for r in rows:
+        cells = [r["world"], r["space"], str(r["runs"]) + (f" ({r['left_out']} rows left out)" if r["left_out"] else ""),
+                 f"{r['ours_solved']} ({r['proven_unsolvable']})", str(r["ours_colliding"]), ms(r["ours_median_s"]),
+                 ms(r["ours_proof_median_s"]), ms(r["ours_mean_s"])]
+        if peer:
+            cells += [str(r["peer_solved"]), str(r["peer_colliding"]), ms(r["peer_median_s"]), ms(r["peer_mean_s"]),
+                      "-" if r["ratio"] is None else f"{r['ratio']:.2f}x",
+                      "-" if r["ratio_mean"] is None else f"{r['ratio_mean']:.2f}x"]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def figures(problems: list[dict], folder: str, limit: float) -> None:
+    """One picture per world and car model: every query planned (seed 0) on one C-space."""
+    from planners import plan
+    from planners.pictures.plot import plot_result
+
+    os.makedirs(folder, exist_ok=True)
+    for p in problems:
+        res = plan(p["sc"], planner=planner_for(p["sc"].space), time=limit, seed=0, all_queries=True)
+        out = os.path.join(folder, f"{p['world']}_{p['space']}.png")
+        plot_result(res, out)
+        solved = sum(r.solved for r in (res.queries or [res]))
+        print(f"figure {out}: {solved}/{len(res.queries or [res])} queries solved")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--bench-mr", default=os.environ.get("BENCH_MR", ""),
+                    help="a Bench-MR checkout (github.com/robot-motion/bench-mr); default: $BENCH_MR")
+    ap.add_argument("--quick", action="store_true", help="1 seed, 3 s a run, the last 3 rows of each map")
+    ap.add_argument("--git-dir", help="the checkout's git directory, when it is not DIR/.git (a bare mirror)")
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--time", type=float, default=10.0, help="seconds per run")
+    ap.add_argument("--rows", type=int, default=10, help="the last N .scen rows of each city map")
+    ap.add_argument("--skip-movingai", action="store_true")
+    ap.add_argument("--no-peer", action="store_true", help="cspace only")
+    ap.add_argument("--true-shapes", action="store_true", help="the drawn shapes, not Bench-MR's convex hulls")
+    ap.add_argument("--json")
+    ap.add_argument("--figures", metavar="DIR", help="also plan every problem's queries once (seed 0) and save a "
+                                                     "picture of each world and car model with cspace's paths")
+    args = ap.parse_args(argv)
+    if not os.path.isdir(os.path.join(args.bench_mr or "-", "bin", "polygon_mazes")):
+        print(f"no Bench-MR checkout at {args.bench_mr!r} (give --bench-mr DIR or set BENCH_MR): nothing run")
+        return 0
+    if args.quick:
+        args.seeds, args.time, args.rows = 1, 3.0, 3
+    peer = not args.no_peer
+    problems = polygon_problems(args.bench_mr, hulls=not args.true_shapes, git_dir=args.git_dir)
+    for p in problems[::2]:
+        print(f"{p['world']}: the published poses shifted by ({p['shift'][0]:.4f}, {p['shift'][1]:.4f})")
+    if not args.skip_movingai:
+        problems += movingai_problems(args.bench_mr, args.rows)
+    results = []
+    for p in problems:
+        r = run_problem(p, args.seeds, args.time, peer)
+        results.append(r)
+        s = summary(r, peer)
+        print(f"{s['world']} {s['space']}: ours {s['ours_solved']}/{s['runs']} solved, {s['ours_colliding']} colliding"
+              + (f"; peer {s['peer_solved']}/{s['runs']}, {s['peer_colliding']} colliding" if peer else ""),
+              flush=True)
+    rows = [summary(r, peer) for r in results]
+    print(table(rows, peer))
+    if peer:
+        n = bad = 0
+        secs = 0.0
+        for r, row in zip(results, rows):
+            rc = peer_recheck(r)
+            row["peer_recheck"] = rc
+            n, bad, secs = n + rc["paths"], bad + rc["colliding"], secs + rc["seconds"]
+            print(f"recheck of the peer's paths, {r['world']} {r['space']}: {rc['colliding']} of {rc['paths']} called "
+                  f"collision-free by its 0.005 discrete check collide")
+        print(f"recheck: {n} paths in {secs:.2f} s ({secs / max(n, 1) * 1e3:.1f} ms a path, a C-space per world "
+              f"included), {bad} colliding")
+    poly = [x for r in results if r["world"] in POSES for x in r["runs"]]
+    firsts = [x["ours_s"] for x in poly if x["ours_s"] is not None]
+    if firsts:
+        print(f"polygon worlds: ours {len(firsts)}/{len(poly)} runs solved, median time to the first certified path "
+              f"{statistics.median(firsts) * 1e3:.0f} ms (target <= 150 ms), "
+              f"{sum(x['ours_colliding'] for x in poly)} colliding (target 0)")
+    if args.figures:
+        figures(problems, args.figures, args.time)
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump({"rows": rows, "results": [{k: v for k, v in r.items() if k != "sc"} for r in results]}, fh,
+                      indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
