@@ -234,13 +234,9 @@ def main(argv=None) -> int:
     if args.quick:
         args.pairs = min(args.pairs, 10)
     yaml_path = find_map(args.nav2)
-    peer = not args.no_peer
-    if peer:
-        try:
-            import coal  # noqa: F401
-        except ImportError:
-            print("coal is not installed (pip install coal, or the bench extra): the peer is skipped")
-            peer = False
+    from benchutil import coal_peer
+
+    peer = coal_peer(not args.no_peer)
     from planners.core.plan import make_adapter, plan
 
     occ, res, origin = occupied(yaml_path)

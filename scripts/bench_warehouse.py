@@ -116,13 +116,9 @@ def main(argv=None) -> int:
     from planners.core.exact_se2 import prepare
     from planners.core.plan import build_cspace
 
-    peer = not args.no_peer
-    if peer:
-        try:
-            import coal  # noqa: F401
-        except ImportError:
-            print("coal is not installed (pip install coal, or the bench extra): the peer is skipped")
-            peer = False
+    from benchutil import coal_peer
+
+    peer = coal_peer(not args.no_peer)
     with tempfile.TemporaryDirectory(prefix="warehouse-") as folder:
         yaml, qfile = wh.write(folder, args.size, 0, args.pairs)
         img = wh.warehouse(args.size, 0)

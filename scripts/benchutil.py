@@ -18,3 +18,19 @@ def median_time(fn, reps: int) -> float:
         fn()
         out.append(time.perf_counter() - t)
     return statistics.median(out)
+
+
+def coal_peer(wanted: bool) -> bool:
+    """Whether the OMPL + coal peer runs: ``wanted`` and coal importable (a line says why not).
+
+    >>> coal_peer(False)
+    False
+    """
+    import importlib.util
+
+    if not wanted:
+        return False
+    if importlib.util.find_spec("coal") is None:
+        print("coal is not installed (pip install coal, or the bench extra): the peer is skipped")
+        return False
+    return True

@@ -82,6 +82,17 @@ def total_length(pts: np.ndarray) -> float:
     return float(np.hypot(*np.diff(pts[:, :2], axis=0).T).sum()) if len(pts) > 1 else 0.0
 
 
+def _next_far(pts: np.ndarray, i: int, x: float, y: float) -> int | None:
+    """The first index after ``i`` whose point lies CURVATURE_STEP or more from (x, y) (Bench-MR's
+    curvature walk skips the points closer than that); None past the end."""
+    while True:
+        i += 1
+        if i >= len(pts):
+            return None
+        if math.hypot(pts[i, 0] - x, pts[i, 1] - y) >= CURVATURE_STEP:
+            return i
+
+
 def _circle_curvatures(pts: np.ndarray):
     """Bench-MR's walk for the curvature metrics: (curvature, |p1 p2| + |p2 p3|) per circle,
     its indices advanced exactly as its loops advance them."""
@@ -92,20 +103,14 @@ def _circle_curvatures(pts: np.ndarray):
     i = 0
     while i < n - 2:
         x1, y1 = pts[i, 0], pts[i, 1]
-        while True:
-            i += 1
-            if i >= n:
-                return out
-            x2, y2 = pts[i, 0], pts[i, 1]
-            if math.hypot(x2 - x1, y2 - y1) >= CURVATURE_STEP:
-                break
-        while True:
-            i += 1
-            if i >= n:
-                return out
-            x3, y3 = pts[i, 0], pts[i, 1]
-            if math.hypot(x3 - x2, y3 - y2) >= CURVATURE_STEP:
-                break
+        i = _next_far(pts, i, x1, y1)
+        if i is None:
+            return out
+        x2, y2 = pts[i, 0], pts[i, 1]
+        i = _next_far(pts, i, x2, y2)
+        if i is None:
+            return out
+        x3, y3 = pts[i, 0], pts[i, 1]
         i += 1  # the for loop's own step
         if (x1 == x2 and y1 == y2) or (x2 == x3 and y2 == y3) or (x1 == x3 and y1 == y3):
             continue
