@@ -81,12 +81,17 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     clock = _Clock(time_limit)
     kind = sc.space if sc.rotates else "translation"
     turns = sc.rotates and bool(cspace.body_pieces)  # a point robot does not turn: nothing to prove
+
+    def sample(budget: float, budget_iterations: int | None = iterations) -> PlanResult:
+        """One turn of the sampler on this query (its stage's seconds counted as ``sampling``)."""
+        return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, seed,
+                                                          iterations=budget_iterations, simplify=simplify,
+                                                          scenario=sc.name)[0])
+
     if tuple(query.start) == tuple(query.goal):
-        return _answer(run_planner(adapter, SAMPLER, [pair], time_limit, seed, scenario=sc.name)[0], "sampling", clock, seed)
+        return _answer(sample(time_limit, None), "sampling", clock, seed)
     if turns and kind != "dubins":  # a slice of sampling: an open scene is answered here, a large map too
-        cap = min(SLICE_SHARE * time_limit, clock.left())
-        r = clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], cap, seed, iterations=SLICE_ITERATIONS,
-                                                        simplify=simplify, scenario=sc.name)[0])
+        r = sample(min(SLICE_SHARE * time_limit, clock.left()), SLICE_ITERATIONS)
         if r.solved:
             return _answer(r, "sampling", clock, seed)
         # FREE at the first slabs, and POSSIBLE there where FREE does not join
@@ -110,9 +115,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         # Where a refinement follows, sampling gets a short turn: long enough for an open scene
         # (as long as the first slabs and the proof took), short of the refinement's time.
         budget = clock.left() if share == 1.0 else min(share * clock.left(), max(SAMPLE_MIN, clock.elapsed()))
-        sampled = clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, seed,
-                                                              iterations=iterations, simplify=simplify,
-                                                              scenario=sc.name)[0])
+        sampled = sample(budget)
         if sampled.solved:
             return _answer(sampled, "sampling", clock, seed)
     failed = sampled
@@ -122,9 +125,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
             return _answer(r, "refinement", clock, seed)
         failed = r or failed  # its "not decided" statement says more than sampling's "no path found"
         if kind != "translation" and clock.left() > 0:  # refinement ended early: sample with the rest
-            again = clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], clock.left(), seed,
-                                                                iterations=iterations, simplify=simplify,
-                                                                scenario=sc.name)[0])
+            again = sample(clock.left())
             if again.solved:
                 return _answer(again, "sampling", clock, seed)
     if failed is None:  # the earlier stages used the whole limit
