@@ -17,19 +17,20 @@ import sys
 from ..errors import InputError
 
 
-def warmed(sc, slabs: int | None = None) -> tuple:
+def warmed(sc, slabs: int | None = None, cs=None) -> tuple:
     """``(cspace, exact result or None)``: a scenario's C-space as the runs use it, its lazy parts
     filled once here rather than in every forked run (whose work is lost when it exits). A
     rotating robot: every slab built, the proof before sampling's regions and their labelled
     components (:func:`planners.core.exact_se2.prepare`: every run then answers it by lookups) and,
     in SE(2), the exact planner run on it (None for a car, which cannot follow its turns in place);
-    translation: the exact planner's C-space and result."""
+    translation: the exact planner's C-space and result. ``cs``: the rotating robot's C-space if
+    it is already built (its slabs are filled here)."""
     from ..core.plan import build_cspace, plan
 
     if sc.rotates:
         from ..core.exact_se2 import prepare
 
-        cs = build_cspace(sc, slabs)
+        cs = cs if cs is not None else build_cspace(sc, slabs)
         for k in range(cs.slabs):
             cs.slab(k)
         if cs.body_pieces:  # (a point robot does not turn: no proof before sampling)
@@ -40,7 +41,7 @@ def warmed(sc, slabs: int | None = None) -> tuple:
 
 
 def reference(files: list[str], quiet: bool = True, held: dict | None = None, space: str | None = None,
-              slabs: int | None = None) -> list[dict]:
+              slabs: int | None = None, before=None) -> list[dict]:
     """Load each scenario and compute its reference length once.
 
     Returns ``[{"file", "scenario", "optimum", "reference", "space", "slabs"}]``.
@@ -53,41 +54,51 @@ def reference(files: list[str], quiet: bool = True, held: dict | None = None, sp
     file's name is added), so that the summary, the figure and the logs keep them
     apart. With ``held``, ``held[file] = (scenario, cspace)`` keeps each built C-space
     for the runs. A missing or malformed file is a ScenarioError (exit 2).
+    ``before(entries)``: called once every file is read, before any reference is computed, with
+    the same entries but ``optimum`` None (what names a run: a campaign's conflicts are
+    found before the costly part).
     """
     from cspace.io.load import load_scenario
 
-    out = []
+    from ..core.plan import build_cspace
+
+    loaded = []  # (file, scenario, its C-space if it rotates: lazy, so cheap to build here)
     for f in files:
         full = os.path.abspath(f)
-        if any(o["file"] == full for o in out):
+        if any(o[0] == full for o in loaded):
             raise InputError(f, "scenario", "given twice")
         sc = load_scenario(f, space=space)
-        cs, ex = warmed(sc, slabs)
+        loaded.append((full, sc, build_cspace(sc, slabs) if sc.rotates else None))
+    names = [sc.name for _, sc, _ in loaded]
+    names = [f"{n} ({os.path.relpath(files[i])}, #{i + 1})" if names.count(n) > 1 else n for i, n in enumerate(names)]
+    ids = [{"file": full, "scenario": name, "optimum": None, "upper": None,
+            "reference": "lower_bound" if sc.rotates else "optimum", "space": sc.space if sc.rotates else "translation",
+            "slabs": cs.slabs if sc.rotates else None} for (full, sc, cs), name in zip(loaded, names)]
+    if before is not None:
+        before(ids)
+    out = []
+    for (full, sc, cs), entry in zip(loaded, ids):
+        cs, ex = warmed(sc, slabs, cs)
+        entry = dict(entry)
         if sc.rotates:  # SE(2) or a car: the inscribed disk gives a lower bound on the length
             from ..core.bounds import disk_bound
 
             db = disk_bound(sc, sc.all_queries()[0])
-            bound = db.lower_bound if math.isfinite(db.lower_bound) else None
-            entry = {"file": full, "scenario": sc.name, "optimum": bound, "reference": "lower_bound",
-                     "space": sc.space, "slabs": cs.slabs, "upper": None}
+            entry["optimum"] = db.lower_bound if math.isfinite(db.lower_bound) else None
             note = db.message  # "lower bound L (inscribed disk r = ...)", or why there is none
             if ex is not None:  # SE(2); a car cannot follow the exact planner's turns in place
                 entry.update(upper=float(ex.length) if ex.solved else None, exact_s=ex.timings.get("solve"),
                              exact_total_s=ex.timings.get("total"), exact_message=ex.message)
                 note += f"; exact: {ex.message}"
-            out.append(entry)
         else:
-            out.append({"file": full, "scenario": sc.name, "optimum": float(ex.length) if ex.solved else None,
-                        "reference": "optimum", "space": "translation", "slabs": None})
+            entry["optimum"] = float(ex.length) if ex.solved else None
+            del entry["upper"]
             note = f"exact shortest path {ex.length:.6g} ({ex.message})"
+        out.append(entry)
         if held is not None:
             held[full] = (sc, cs)
         if not quiet:
             sys.stderr.write(f"{sc.name}: {note}\n")
-    names = [o["scenario"] for o in out]
-    for i, o in enumerate(out):
-        if names.count(o["scenario"]) > 1:
-            o["scenario"] = f"{o['scenario']} ({os.path.relpath(files[i])}, #{i + 1})"
     return out
 
 

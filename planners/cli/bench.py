@@ -216,25 +216,36 @@ def run(args) -> int:
         raise InputError("bench", "--slabs", f"must be an integer from 4 to 4096, got {args.slabs}")
     db, log = getattr(args, "db", None), getattr(args, "log", None)
     check_campaign(db, log, getattr(args, "resume", False), out, args.scenario)
-    scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs)
-    check_scenarios(objective, held)
-    os.makedirs(out, exist_ok=True)
-    tasks = make_tasks(scenarios, planners, times, args.runs, args.iterations, abort_on, objective)
-    campaign, stored = None, []
-    if db or log:
+    iterations, resume = args.iterations, getattr(args, "resume", False)
+    campaign, left = None, None
+
+    def open_campaign(ids):  # every file read, no reference computed yet: a conflict costs nothing
+        nonlocal campaign, left
         from ..bench.campaign import Campaign
 
-        campaign = Campaign(db, tasks)
-        try:
+        first = make_tasks(ids, planners, times, args.runs, iterations, abort_on, objective)
+        campaign = Campaign(db, first)  # (closed below if what follows fails)
+        left = {campaign.task_key(t) for t in campaign.select(first, resume)}
+
+    try:
+        scenarios = reference(args.scenario, quiet=args.quiet, held=held, space=args.space, slabs=args.slabs,
+                              before=open_campaign if (db or log) else None)
+        check_scenarios(objective, held)
+        os.makedirs(out, exist_ok=True)
+        tasks = make_tasks(scenarios, planners, times, args.runs, iterations, abort_on, objective)
+        stored = []
+        if campaign is not None:
+            campaign.tasks = {campaign.task_key(t): t for t in tasks}
             n, every = len(tasks), tasks
-            tasks = campaign.select(tasks, getattr(args, "resume", False))
+            tasks = [t for t in tasks if campaign.task_key(t) in left]
             if len(tasks) < n:  # resumed: the stored runs are read back, so --out describes the campaign
                 stored = campaign.stored_rows(every)
                 if not args.quiet:
                     sys.stderr.write(f"--resume: {n - len(tasks)} of {n} runs already in {db}\n")
-        except BaseException:
+    except BaseException:
+        if campaign is not None:
             campaign.close()
-            raise
+        raise
     t0 = time.perf_counter()
     try:
         rows, interrupted = sweep(tasks, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,

@@ -149,6 +149,28 @@ def test_resume_runs_only_what_is_missing_and_a_second_sweep_adds_to_the_databas
     assert len(dump(db)["runs"]) == 4 and len(dump(db)["experiments"]) == 2
 
 
+@pytest.mark.parametrize("scene", [BASIC, str(ROOT / "scenarios" / "se2" / "door_tight.toml")],
+                         ids=["translation", "se2"])
+def test_a_campaign_conflict_is_found_before_any_reference_is_computed(tmp_path, capsys, monkeypatch, scene):
+    # The reference (the exact planner's path, every slab, the proof's regions) is the costly part
+    # of a sweep's start: a database that already holds the runs is refused before it, and
+    # --resume still finds them (a run's identity, slab count included, is known before it).
+    import planners.bench.reference as ref
+
+    db = tmp_path / "c.db"
+    args = ["--planners", "RRTConnect", "--times", "0.01", "--runs", 1, "--out", tmp_path / "o", "--db", db]
+    assert bench(scene, *args) == 0
+    capsys.readouterr()
+    warmed = []
+    real = ref.warmed
+    monkeypatch.setattr(ref, "warmed", lambda *a, **k: warmed.append(a) or real(*a, **k))
+    assert bench(scene, *args) == 2
+    assert "already holds 1 of this sweep's 1 runs" in capsys.readouterr().err
+    assert warmed == []
+    assert bench(scene, *args, "--resume") == 0  # nothing left to run, nothing stored twice
+    assert len(dump(db)["runs"]) == 1 and len(warmed) == 1
+
+
 @pytest.mark.parametrize("extra, needle", [(["--resume"], "--resume: needs --db"),
                                            (["--db", "{tmp}"], "--db: not a file name"),
                                            (["--db", "{tmp}/text.db"], "not a benchmark database")])
