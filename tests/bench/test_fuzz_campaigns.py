@@ -196,6 +196,7 @@ class Server:
             c.close()
 
 
+@pytest.mark.slow
 @budget(12)
 @given(data=st.data())
 def test_fuzz_scheduler_addresses(data, monkeypatch_module):

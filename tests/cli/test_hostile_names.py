@@ -62,7 +62,9 @@ def test_a_name_from_a_file_name_is_shown_escaped(tmp_path):
 MATH = ["a $\\frac{1 x$ b", "$$", "$x^$", "back\\slash $\\undefined$", "50$ and 60$"]
 
 
-@pytest.mark.parametrize("name", MATH, ids=range(len(MATH)))
+# One name in the quick pass, every one in the slow pass (each draws every picture: ~2.5 s).
+@pytest.mark.parametrize("name", [pytest.param(m, marks=() if i == 0 else pytest.mark.slow) for i, m in enumerate(MATH)],
+                         ids=range(len(MATH)))
 def test_a_name_is_text_in_every_picture_never_mathtext(tmp_path, name):
     # matplotlib reads $...$ as mathtext: a scene's name with dollars raised a ParseException
     # (exit 3) in plot titles; names are text in the plot, the animation and the bench figure

@@ -137,6 +137,7 @@ def _near_degenerate(rng, t):
     return A, B
 
 
+@pytest.mark.slow
 @needs_c
 def test_flat_triangles_take_the_same_branch(monkeypatch):
     """The fallback of _solve3 (a flat triangle: its first best edge by _norm2, which only the

@@ -229,6 +229,7 @@ def test_pure_path_has_no_compiled_motion(scenes):
     assert pure.motion_free((2.5, 2, 0), (7.5, 2, 0)) and not pure.motion_free((3.1, 5, 1.5), (3.1, 5, -1.5))
 
 
+@pytest.mark.slow
 def test_pure_answers_are_sweep_checked(scenes):
     """On any build (CSPACE_PURE=1 too): free motions of the product path pass the shapely sweep."""
     sc, cs, pure = scenes["bug-trap-se2"]

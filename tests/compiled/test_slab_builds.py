@@ -244,6 +244,7 @@ def test_the_batched_slabs_check_the_range_once_for_all():
 # ---------------------------------------------------------------- whole C-spaces: batched against pure
 
 
+@pytest.mark.slow
 @needs_c
 @settings(max_examples=25, deadline=None)
 @given(polygon_seeds, st.sampled_from([4, 8, 13, 16]))

@@ -228,6 +228,7 @@ def test_vectorised_route_equals_scalar_route_on_floats(seed, scale, offset, k):
     assert S.tolist() == [list(v) for v in _scalar_reference(*polys)]
 
 
+@pytest.mark.slow
 @settings(max_examples=10, deadline=None)
 @given(st.integers(0, 2**32 - 1))
 def test_vectorised_route_exact_on_integers(seed):
@@ -297,6 +298,7 @@ def test_vectorised_route_at_underflowing_scale():
     assert np.array_equal(minkowski_sum(P * s, Q * s), ref * s)
 
 
+@pytest.mark.slow
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.booleans(), st.integers(2, 3), st.sampled_from(["int", "float", "parallel"]))
 def test_vectorised_route_is_independent_of_start_vertex_and_orientation(seed, reverse, k, kind):

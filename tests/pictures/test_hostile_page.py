@@ -128,6 +128,7 @@ def browser():
         yield b
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_a_hostile_name_fetches_nothing_and_makes_no_link(browser, tmp_path):
     from cspace.io.load import scenario_from_dict

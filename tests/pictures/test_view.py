@@ -267,7 +267,7 @@ def open_page(b, path):
 
 
 @needs_chromium
-@pytest.mark.parametrize("kind", list(SCENES))
+@pytest.mark.parametrize("kind", [k if k == "se2" else pytest.param(k, marks=pytest.mark.slow) for k in SCENES])
 def test_browser_slider_moves_the_robot(browser, pages, kind):
     b = browser
     open_page(b, pages[kind])
@@ -294,6 +294,7 @@ def test_browser_angle_slider_changes_the_cspace(browser, pages, kind):
     assert changed(before, b.screenshot()) > 200
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_browser_play_and_pause(browser, pages):
     b = browser

@@ -54,7 +54,9 @@ def assert_sound(sc, res, query_index: int = 0):
         assert verdict.valid, verdict
 
 
-@pytest.mark.parametrize("path", ROTATING, ids=lambda p: "/".join(p.split(os.sep)[-2:]))
+# parallel_tight (2-6 s: its slab graph asks for room three times) in the slow pass.
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if p.endswith("parallel_tight.toml") else p
+                                  for p in ROTATING], ids=lambda p: "/".join(p.split(os.sep)[-2:]))
 def test_the_default_answers_every_bundled_rotating_scene(path):
     sc = load_scenario(path)
     res = planners.plan(path)  # no planner named: auto
@@ -148,7 +150,8 @@ def _corridor(slack: float) -> dict:
                           {"polygon": [[hi, 0], [10, 0], [10, 10], [hi, 10]]}]}
 
 
-@pytest.mark.parametrize("slack,parts", [(0.2, 1), (0.4, 3), (0.3, 2)])
+@pytest.mark.parametrize("slack,parts", [(0.4, 3), pytest.param(0.2, 1, marks=pytest.mark.slow),
+                                         pytest.param(0.3, 2, marks=pytest.mark.slow)])
 def test_laumond_curves_follow_a_sideways_path_and_pass_the_sweep(slack, parts):
     """A car can't drive sideways, but it can follow a sideways SE(2) path closely enough with
     many short Reeds–Shepp curves: every curve passes the independent sweep."""

@@ -76,6 +76,7 @@ DOORS = dict(R=st.floats(0.5, 30.0), w=st.floats(0.3, 2.0), h=st.floats(0.05, 0.
              exp=st.sampled_from([0.0, 1e3, 3e5, 1e6]), tol=st.sampled_from([1e-3, 1e-2]), disk=st.booleans())
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None)
 @given(**DOORS)
 @example(R=10.0, w=0.8, h=0.3, spare=0.003, exp=0.0, tol=1e-3, disk=False)  # the pillars

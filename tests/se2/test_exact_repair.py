@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from cspace.se2 import exact
 from cspace.se2.exact_path import AssemblyError
@@ -61,6 +62,7 @@ def test_a_slab_that_always_fails_is_refined_until_its_halves_pass(monkeypatch):
     assert all(bad[0] not in w for w in seen[-1:])
 
 
+@pytest.mark.slow
 def test_no_time_left_after_failures_is_undecided_with_the_reason(monkeypatch):
     r, _ = run(monkeypatch, lambda walk, part: 1)
     assert r.status == "undecided" and r.stats["repairs"] >= 1

@@ -88,6 +88,7 @@ def test_a_margin_is_in_the_statement():
 DOOR = dict(R=st.floats(1.0, 20.0), spare=st.floats(0.01, 0.3), seam=st.booleans(), clearance=st.sampled_from([0.0, 0.05]))
 
 
+@pytest.mark.slow
 @settings(max_examples=10, deadline=None)
 @given(**DOOR)
 @example(R=10.0, spare=0.003 / 0.3, seam=False, clearance=0.0)  # the pillars: D must count the disks

@@ -211,6 +211,7 @@ def test_core_containment_against_dense_sampling(points, scale, turn, shift, a, 
         assert not shapely.covers(poly.buffer(-1e-5), pts).all()
 
 
+@pytest.mark.slow
 @settings(max_examples=120, deadline=None)
 @given(st.integers(9, 300), st.floats(0.2, 3.0), st.floats(0.0, 0.45), st.integers(0, 2**32 - 1),
        st.tuples(st.floats(-0.5, 0.5), st.floats(-0.5, 0.5)), st.floats(-4, 4), st.floats(1e-6, math.pi / 2),

@@ -123,8 +123,9 @@ def _ngon(n, r=0.01):
     (lambda p: p.__setitem__("robot_pieces", [_ngon(LIMITS["piece_vertices"] + 1, 0.05)]), "robot piece"),
     (lambda p: p.__setitem__("slabs", p["slabs"] * (LIMITS["slabs"] // len(p["slabs"]) + 1)), "slabs"),
     (lambda p: p.__setitem__("edges", p["edges"] * 50), "edges"),
-    (lambda p: p.update(slabs=[dict(s, cores=[np.round(_ngon(150, 0.05), 3).tolist()])
-                               for s in p["slabs"] * (4000 // len(p["slabs"]))], edges=[]), "units of work"),
+    pytest.param(lambda p: p.update(slabs=[dict(s, cores=[np.round(_ngon(150, 0.05), 3).tolist()])
+                                            for s in p["slabs"] * (4000 // len(p["slabs"]))], edges=[]),
+                 "units of work", marks=pytest.mark.slow),
     (lambda p: p["slabs"][0]["components"][0].__setitem__("shell", _ngon(20000, 50.0)), "components of"),
 ])
 def test_a_proof_past_what_the_planner_writes_is_refused_before_the_work(small, tmp_path, capsys, how, what):
