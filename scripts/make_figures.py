@@ -148,17 +148,19 @@ def plan_figure(scenario: str, planner: str | None = None, seed: int = SEED) -> 
     return draw
 
 
-def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False, folder: str = "se2") -> Callable[[str], str]:
+def se2_plan_figure(scenario: str, seed: int = 0, animate: bool = False, folder: str = "se2",
+                    planner: str | None = None) -> Callable[[str], str]:
     """A rotating robot's plan (scenarios/se2/, or a car's in scenarios/car/ with
     ``folder="car"``), its footprint along the path; with ``animate`` also the GIF of
-    ``cspace plan --animate`` beside the PNG (same name, .gif)."""
+    ``cspace plan --animate`` beside the PNG (same name, .gif). ``planner``: as the guide's
+    command names it (None: the scene's own, or the default)."""
 
     def draw(out: str) -> str:
         from planners.pictures.animate import animate_path
         from planners import plan
         from planners.pictures.plot import plot_result
 
-        res = plan(os.path.join(SCENARIOS, folder, f"{scenario}.toml"), seed=seed)
+        res = plan(os.path.join(SCENARIOS, folder, f"{scenario}.toml"), seed=seed, planner=planner)
         plot_result(res, out)
         if animate and res.solved:
             animate_path(res, os.path.splitext(out)[0] + ".gif")
@@ -309,6 +311,7 @@ def figures() -> list[Figure]:
         Figure("basic_exact", "basic", "exact shortest path of basic.toml", plan_figure("basic", planner="exact")),
         Figure("clearance_plan", "clearance", "clearance.toml: the exact path keeping a 0.3 margin",
                plan_figure("clearance")),
+        Figure("u_robot_cspace", "basic", "C-space of u_robot.toml (a non-convex robot)", cspace_figure("u_robot")),
     ]
     for fam in FAMILIES:
         out.append(Figure(f"{fam}_cspace", "families", f"C-space of {fam}.toml", cspace_figure(fam)))
@@ -320,9 +323,9 @@ def figures() -> list[Figure]:
     out.append(Figure("se2_tee_slot_slab", "se2", "SE(2): the slab C-space of theta = pi/2",
                       se2_slab_figure("tee_slot", 1.5707963267948966)))
     out.append(Figure("plank_corner_tight", "se2exact", "SE(2) exact: a plank round a corner, 1 % of room",
-                      se2_plan_figure("plank_corner_tight")))
+                      se2_plan_figure("plank_corner_tight", planner="exact")))
     out.append(Figure("door_tight", "se2exact", "SE(2) exact: a box through a door 1 % wider than it",
-                      se2_plan_figure("door_tight")))
+                      se2_plan_figure("door_tight", planner="exact")))
     out.append(Figure("bug_trap_l_slabs", "se2exact", "SE(2) exact: the slab graph of the L in the trap",
                       slab_pair_figure("bug_trap_l", -0.25 * math.pi, 0.0, 0.25 * math.pi)))
     out.append(Figure("car_parking", "car", "car: parallel parking, Reeds-Shepp (GIF beside it)",
