@@ -244,3 +244,27 @@ def test_readme_python_programs_run(doc, line, body, monkeypatch):
     env: dict = {}
     exec(compile(body, f"{doc}:{line}", "exec"), env)
     assert env["res"].solved and env["cs"].is_free([(1, 1), (2.7, 3)]).tolist() == [True, False]
+
+
+def test_the_guide_quotes_bench_import_as_the_benchmarks_page_shows_it():
+    # The guide's sentence on bench_import once quoted figures 5-40x off those its page showed:
+    # every number it quotes is the page's (which make_benchmarks_page writes from a run).
+    with open(os.path.join(ROOT, "docs", "guide.md"), encoding="utf-8") as fh:
+        guide = fh.read()
+    with open(os.path.join(ROOT, "docs", "benchmarks.md"), encoding="utf-8") as fh:
+        page = fh.read()
+    section = page[page.index("## bench_import"):]
+    section = section[:section.index("\n## ", 3)]
+    col = {name: float(re.search(re.escape(name) + r"\s+([\d.]+)", section).group(1))
+           for name in ("import default (2 cells)", "import exact (0)", "C-space build default (2 cells)",
+                        "C-space build exact (0)")}
+    default = re.search(r"default \(2 cells\): \d+ obstacles, (\d+) vertices, (\d+) C-obstacle pieces; .*?\((\d+) vertices",
+                        section)
+    exact_pieces = re.search(r"exact \(0\): \d+ obstacles, \d+ vertices, (\d+) C-obstacle pieces", section).group(1)
+    sentence = guide[guide.index("`python scripts/bench_import.py` times"):]
+    sentence = " ".join(sentence[:sentence.index("The targets")].split())
+    want = (f"the default import takes {col['import default (2 cells)']:.3f} s and leaves {default.group(1)} vertices of "
+            f"the staircase's {default.group(3)}, whose C-space (a 0.25 m disk robot, {default.group(2)} pieces) builds "
+            f"in {col['C-space build default (2 cells)']:.3f} s; the exact staircase imports in "
+            f"{col['import exact (0)']:.3f} s and builds in {col['C-space build exact (0)']:.3f} s ({exact_pieces} pieces)")
+    assert want in sentence, f"the guide says:\n{sentence}\nthe page's run says:\n{want}"
