@@ -78,15 +78,20 @@ def car_judge(sc, path) -> bool:
 
 
 def scene_rows(files: list, planners_: tuple, seeds: int, limit: float, judge) -> list[dict]:
+    from benchutil import Progress
+
     from cspace.io.load import load_scenario
 
     rows = []
+    progress = Progress(f"bench_auto: {len(files)} scenes x {seeds} seeds x {len(planners_)} planners",
+                        len(files) * seeds * len(planners_), most_s=limit)
     for f in files:
         name = load_scenario(f).name
         runs = {p: [] for p in planners_}
         for seed in range(seeds):  # interleaved
             for p in planners_:
                 runs[p].append(run(f, p, seed, limit, judge))
+                progress.step(f"{name}, seed {seed}, {p}")
         row = {"scene": name, "seeds": seeds, "stages": sorted({str(r["stage"]) for r in runs["auto"]})}
         for p, rs in runs.items():
             times = [r["cpu"] for r in rs if r["answered"]]

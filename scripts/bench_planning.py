@@ -363,7 +363,12 @@ def prepare(names) -> list[tuple]:
 def run_all(prepared, checkers, planners, seeds: int, tlim: float) -> dict:
     """Every run, interleaved: seed-major, the checkers' order rotated per seed (so that no
     checker always runs first on a warm or cold machine). ``{(scene, planner, checker): [run]}``"""
+    from benchutil import Progress
+
     runs: dict = {}
+    progress = Progress(f"bench_planning: {seeds} seeds x {len(prepared)} scenes x {len(planners)} planners x "
+                        f"{len(checkers)} checkers, interleaved", seeds * len(prepared) * len(planners) * len(checkers),
+                        most_s=tlim)
     for seed in range(seeds):
         order = checkers[seed % len(checkers):] + checkers[:seed % len(checkers)]
         for name, sc, _cs, spaces, *_ in prepared:
@@ -371,7 +376,7 @@ def run_all(prepared, checkers, planners, seeds: int, tlim: float) -> dict:
             for planner in planners:
                 for who in order:
                     runs.setdefault((name, planner, who), []).append(one_run(spaces[who], planner, seed, start, goal, tlim))
-        print(f"seed {seed} done", file=sys.stderr, flush=True)
+                    progress.step(f"seed {seed}, {name}, {planner}, {who}")
     return runs
 
 

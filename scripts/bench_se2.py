@@ -309,6 +309,10 @@ def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RR
     if only:
         scenes = [sc for sc in scenes if any(w in sc.name for w in only)]
     rows = []
+    from benchutil import Progress
+
+    progress = Progress(f"bench_se2 (P): {len(scenes)} scenes x {seeds} seeds, ours and {len(peers)} peers, interleaved",
+                        len(scenes) * seeds, most_s=budget * (1 + len(peers)), unit="rounds")
     for sc in scenes:
         cs = build_cspace(sc)
         adapter = make_adapter(sc, cs)
@@ -338,6 +342,7 @@ def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RR
             for m, (path, _) in rounds[0].items():  # the same seed: the same path in every round
                 cpu[m].append(statistics.median(r[m][1] for r in rounds) if path is not None else None)
                 found.append((m, path))
+            progress.step(f"{sc.name}, seed {seed}")
         # The oracle judges the paths after the timed runs: its sweeps (shapely, ~0.1 s a path)
         # between two runs would flush the caches of whichever method runs next.
         for m, path in found:

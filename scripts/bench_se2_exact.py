@@ -77,7 +77,7 @@ def collides(sc, res) -> bool:
     return bool(j["collides"] or j["out_of_bounds"])
 
 
-def run_scene(path: str, seeds: int, limit: float) -> dict:
+def run_scene(path: str, seeds: int, limit: float, progress=None) -> dict:
     sc = load_scenario(path)
     name = os.path.splitext(os.path.basename(path))[0]
     ex_search, ex_total, rrt_total, rrt_first, answers = [], [], [], [], set()
@@ -99,6 +99,8 @@ def run_scene(path: str, seeds: int, limit: float) -> dict:
         elif rr.proof is not None:
             proven += 1
         bad["rrt"] += collides(sc, rr)
+        if progress is not None:
+            progress.step(f"{name}, seed {seed}")
     med = statistics.median
     row = {"scene": name, "expect": sc.expect or "solvable", "exact_answer": " / ".join(sorted(answers)),
            "exact_search_cpu_s": med(ex_search), "exact_total_cpu_s": med(ex_total), "exact_max_total_cpu_s": max(ex_total),
@@ -208,10 +210,14 @@ def main(argv=None) -> int:
         want = set(args.scenes.split(","))
         paths = [p for p in paths if os.path.splitext(os.path.basename(p))[0] in want]
     rows = []
+    from benchutil import Progress
+
+    progress = Progress(f"bench_se2_exact: {len(paths)} scenes x {args.seeds} seeds (exact 30 s, RRTConnect {args.time:g} s)",
+                        len(paths) * args.seeds, most_s=30.0 + args.time, unit="rounds")
     print(f"{'scene':<16} {'exact answer':<18} {'search s':>9} {'path s':>7} {'total s':>8} {'RRTConnect':>10} "
           f"{'proven':>6} {'RRT s':>7} {'RRT 1st s':>9} {'RRT path s':>10} {'exact/RRT':>9} {'colliding':>10}")
     for p in paths:
-        r = run_scene(p, args.seeds, args.time)
+        r = run_scene(p, args.seeds, args.time, progress)
         rows.append(r)
         first = "-" if r["rrt_first_solution_s"] is None else f"{r['rrt_first_solution_s']:.3f}"
         print(f"{r['scene']:<16} {r['exact_answer'][:18]:<18} {r['exact_search_cpu_s']:9.3f} "

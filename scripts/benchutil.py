@@ -34,3 +34,59 @@ def coal_peer(wanted: bool) -> bool:
         print("coal is not installed (pip install coal, or the bench extra): the peer is skipped")
         return False
     return True
+
+
+def _clock(s: float) -> str:
+    """``75.0`` -> ``1m15s``; under a minute, seconds.
+
+    >>> _clock(75.0), _clock(9.4), _clock(3725)
+    ('1m15s', '9s', '62m05s')
+    """
+    s = int(round(s))
+    return f"{s // 60}m{s % 60:02d}s" if s >= 60 else f"{s}s"
+
+
+class Progress:
+    """What a long benchmark runs and how far it has got, on stderr (the tables stay on stdout).
+
+    At once: ``what``, the number of steps and, with ``most_s`` (the longest one step may take),
+    the longest the whole can take. Then, at most every ``every`` seconds of wall time, a line
+    with the steps done, the time so far and an estimate of the time left (from the mean step).
+
+    >>> import io
+    >>> out = io.StringIO()
+    >>> p = Progress("demo: 2 scenes x 2 seeds", 4, most_s=10, every=0, stream=out)
+    >>> for k in range(4):
+    ...     p.step(f"scene {k}")
+    >>> lines = out.getvalue().splitlines()
+    >>> lines[0]
+    'demo: 2 scenes x 2 seeds: 4 runs, each at most 10s (at most 40s in all)'
+    >>> lines[1].startswith("  1/4 runs,"), lines[-1].startswith("  4/4 runs,"), len(lines)
+    (True, True, 5)
+    """
+
+    def __init__(self, what: str, total: int, most_s: float | None = None, every: float = 10.0,
+                 unit: str = "runs", stream=None):
+        import sys
+
+        self.total, self.every, self.unit = total, every, unit
+        self.stream = stream if stream is not None else sys.stderr
+        self.done = 0
+        self.t0 = self.last = time.perf_counter()
+        bound = f", each at most {_clock(most_s)} (at most {_clock(most_s * total)} in all)" if most_s else ""
+        self._say(f"{what}: {total} {unit}{bound}")
+
+    def _say(self, line: str) -> None:
+        self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def step(self, label: str = "") -> None:
+        """One step done (``label``: what it was, shown on the progress line)."""
+        self.done += 1
+        now = time.perf_counter()
+        if now - self.last >= self.every or self.done == self.total:
+            self.last = now
+            spent = now - self.t0
+            left = spent / self.done * (self.total - self.done)
+            self._say(f"  {self.done}/{self.total} {self.unit}, {_clock(spent)} so far, about {_clock(left)} left"
+                      + (f" (last: {label})" if label else ""))
