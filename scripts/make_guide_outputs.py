@@ -16,6 +16,7 @@ the same text once every number is replaced by ``#``. Numbers followed by ``ms``
 :data:`TIME_FLOOR_MS`. Other numbers (lengths, waypoints, counts, bytes) are deterministic with
 the commands' seeds and must equal the fresh ones to the printed digits, unless the block is
 marked ``loose`` (a time-limited anytime planner, a timed benchmark: only the shape is checked).
+A quote with no ``...`` line is the whole output: a fresh line of a shape it lacks is drift.
 ``slow`` blocks run only with ``--slow`` (tests/project/test_docs_drift.py: ``CSPACE_DOCS_SLOW=1``).
 
 ``--write`` replaces each quoted line by its fresh match (numbers, times included, and wording
@@ -166,6 +167,10 @@ def drift(block: Block) -> list[str]:
                     problems.append(f"guide.md:{block.line_no}: time {a.group()} now {b.group()} in {q!r}")
             elif a.group() != b.group():
                 problems.append(f"guide.md:{block.line_no}: {a.group()} now {b.group()} in {q!r}")
+    if not block.loose and "..." not in [q.strip() for q in block.lines]:  # a quote with no elision is whole
+        quoted = {shape(q) for q in block.lines}
+        problems += [f"guide.md:{block.line_no}: the run prints {f!r}, which the quote leaves out (or mark it ...)"
+                     for f in block.fresh if f.strip() and shape(f) not in quoted]
     return problems
 
 

@@ -172,3 +172,16 @@ def test_the_checks_see_drift():
     prose = GUIDE_OUT.prose_drift("mean length 63.35, in about 5 s for the whole\nrun. "
                                   "verified exactly), mean length 63.35", [b])
     assert any("prose time 5 s" in p for p in prose) and any("prose 63.35, now 63.17" in p for p in prose), prose
+
+
+def test_a_whole_quote_missing_a_line_is_drift():
+    # A quote with no "..." elision is the whole output: a line the run prints and the quote
+    # leaves out (the "min clearance" line once) is drift; with an elision it is not.
+    fresh = ["basic: solved by exact: length 17.4205, 7 waypoints, solve 13.8 ms", "min clearance 0 at (2.6, 6.3)",
+             "stages: minkowski -> prune -> index -> visibility"]
+    whole = GUIDE_OUT.Block(commands=["cspace plan scenarios/basic.toml"], loose=False, slow=False,
+                            lines=[fresh[0], fresh[2]], start=0, end=0, line_no=1, fresh=fresh)
+    assert [p for p in GUIDE_OUT.drift(whole) if "min clearance" in p and "leaves out" in p]
+    elided = GUIDE_OUT.Block(commands=whole.commands, loose=False, slow=False, lines=[fresh[0], "...", fresh[2]],
+                             start=0, end=0, line_no=1, fresh=fresh)
+    assert GUIDE_OUT.drift(elided) == []
