@@ -83,7 +83,11 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     turns = sc.rotates and bool(cspace.body_pieces)  # a point robot does not turn: nothing to prove
 
     def sample(budget: float, budget_iterations: int | None = iterations) -> PlanResult:
-        """One turn of the sampler on this query (its stage's seconds counted as ``sampling``)."""
+        """One turn of the sampler on this query (its stage's seconds counted as ``sampling``).
+        Given ``iterations`` (the caller's), a turn is bounded by its count alone, within the
+        time left: where it ends, and so which stage answers, does not depend on the machine."""
+        if iterations is not None:
+            budget = clock.left()
         return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, seed,
                                                           iterations=budget_iterations, simplify=simplify,
                                                           scenario=sc.name)[0])

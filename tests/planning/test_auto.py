@@ -187,3 +187,18 @@ def test_laumond_gives_up_within_its_budget_rather_than_return_a_colliding_curve
     through = np.array([[5.0, 3.0, 0.0], [5.0, 5.0, 0.0]])
     assert to_reeds_shepp(cs, through, 0.5, max_checks=10) is None
     assert to_reeds_shepp(cs, through, 0.5, max_depth=2) is None
+
+
+def test_given_iterations_auto_s_turns_of_sampling_count_them_not_time(monkeypatch):
+    # The short turn of sampling is timed (a share of what is left); with --iterations each turn is
+    # bounded by its count alone, so which stage answers does not depend on the machine's speed.
+    import planners.core.routine as routine
+    from planners.core.auto import SLICE_ITERATIONS
+
+    seen = []
+    real = routine.run_planner
+    monkeypatch.setattr(routine, "run_planner", lambda *a, **k: seen.append((a[3], k.get("iterations"))) or real(*a, **k))
+    res = planners.plan(os.path.join(SCENARIOS, "se2", "door_tight.toml"), seed=0, iterations=40, time=1000.0)
+    assert res.solved and len(seen) >= 2, (res.message, seen)  # the slice and the short turn at least
+    assert all(budget > 500 for budget, _ in seen), seen  # the time left, never a short share of it
+    assert [it for _, it in seen][:2] == [SLICE_ITERATIONS, 40], seen
