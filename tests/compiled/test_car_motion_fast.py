@@ -270,6 +270,7 @@ def test_pure_path_has_no_compiled_curve(scenes):
         assert reeds_shepp_word(2.0, 0.0, 0.0) == ("LSL", (0.0, 2.0, 0.0))
 
 
+@pytest.mark.slow
 def test_pure_answers_are_sweep_checked(scenes):
     """On any build (CSPACE_PURE=1 too): curves the product path calls free pass the sweep."""
     sc, cs, pure = scenes["u_turn.toml"]

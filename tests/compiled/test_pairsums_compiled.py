@@ -36,6 +36,7 @@ def check(pa, pb, min_certified=0.0):
     return done
 
 
+@pytest.mark.slow
 @compiled
 @settings(max_examples=400, deadline=None)
 @given(piece_lists(), st.sampled_from([1.0, 2.0**-40, 2.0**40, 1e-300, 1e300]))
@@ -93,8 +94,9 @@ def test_disks_and_margins():
 
 
 @compiled
-@pytest.mark.parametrize("path", sorted(glob.glob(os.path.join(ROOT, "scenarios", "*.toml"))
-                                  + glob.glob(os.path.join(ROOT, "scenarios", "ompl", "*.toml"))),
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if p.endswith("env2.toml") else p  # (2.5 s)
+                                  for p in sorted(glob.glob(os.path.join(ROOT, "scenarios", "*.toml"))
+                                                  + glob.glob(os.path.join(ROOT, "scenarios", "ompl", "*.toml")))],
                          ids=lambda p: os.path.relpath(p, os.path.join(ROOT, "scenarios")))
 def test_bundled_builds_equal_the_pure_path(path):
     """Every bundled translation scene, plain and with a margin of 1 % of its extent: the same
@@ -137,6 +139,7 @@ def test_inflated_equals_inflated_pieces(seed):
             assert len(got) == len(want) and all(np.array_equal(a, b) for a, b in zip(got, want))
 
 
+@pytest.mark.slow
 @compiled
 @settings(max_examples=200, deadline=None)
 @given(piece_lists(), st.sampled_from([1.0, 2.0**-30, 1e200]))

@@ -33,6 +33,7 @@ def check(polys):
 coords = st.integers(-6, 6).map(float) | st.floats(-1e3, 1e3, allow_nan=False, width=32)
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.lists(st.tuples(coords, coords), min_size=3, max_size=7), min_size=1, max_size=6))
 def test_random_polygons_match_the_scalar_route(raw):

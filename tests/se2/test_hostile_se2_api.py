@@ -264,6 +264,7 @@ def test_a_7025_gon_robot_keeps_the_time_limit(tmp_path):
     assert len(p.stderr.strip().splitlines()) == 1 and "7025 vertices" in p.stderr and "disk_tolerance" in p.stderr
 
 
+@pytest.mark.slow
 def test_the_cspace_build_counts_against_the_time_limit(tmp_path):
     """A robot within the vertex limit whose slabs take longer than --time: not solved, saying so."""
     f = tmp_path / "disk.toml"

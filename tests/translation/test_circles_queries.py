@@ -43,6 +43,7 @@ def test_every_query_has_an_exact_optimum(runs):
     assert all(q.solved for q in exact.queries)
 
 
+@pytest.mark.slow
 def test_ompl_multi_query_bar(runs):
     exact, res = runs
     assert len(res.queries) == 100

@@ -129,6 +129,7 @@ def test_bundled_scenarios_agree(path):
     _agree(os.path.basename(path), cs, dc, _states(cs, 500, rng))
 
 
+@pytest.mark.slow
 def test_from_scenario_builds_the_same_pieces():
     for path in SCENARIOS:
         cs = CSpace.from_scenario(path)
