@@ -19,8 +19,8 @@ Problems (read from a Bench-MR checkout, ``--bench-mr DIR``; nothing of it is co
 The bounds of a polygon world: the obstacles' box and a margin of two turning radii (``MARGIN``):
 Bench-MR's box bounds only the states its planners sample, while OMPL's motion check walks a
 curve's states against the obstacles alone, so its cars drive out of a drawing and back.
-``--box-bounds`` keeps the box alone: a forward-only car parked facing its edge (parking1's and
-parking2's slot poses) then cannot move.
+``--box-bounds`` keeps the box alone: a forward-only car facing its edge closer than its turning
+radius (parking1's and parking2's slot poses) then cannot turn away before it leaves the box.
 
 Per problem and seed, in turn: ours, cspace's time to its first certified path in the default
 planner's order (``ours_first``: a slice of sampling, then the proof before sampling only where
@@ -93,8 +93,9 @@ MAPS = ("Berlin_0_256", "Boston_2_512")
 # walks a curve's states against the obstacles alone, so its cars drive out of a drawing and back
 # (a parking lot has no wall around it). The suite's bounds, which every motion of ours keeps to,
 # are that box and this margin: two turning radii, room for a U-turn outside the drawing.
-# (``--box-bounds``: the box alone. A forward-only car parked facing the box's edge, closer to
-# it than its turning radius, then cannot move: parking1's and parking2's slot poses.)
+# (``--box-bounds``: the box alone. A forward-only car facing the box's edge, closer to it than
+# its turning radius, then cannot turn away before it leaves the box: parking1's and parking2's
+# slot poses make five Dubins queries unsolvable, which no method of cspace proves.)
 MARGIN = 2 * RADIUS
 LATTICE_STEP, LATTICE_CAP = 0.1, 20000  # boxed_in's lattice: step (length units), poses
 
