@@ -32,8 +32,8 @@ The C-space's slabs are built once per world and car model before its queries (t
 (once)"), as the peer's checker is. Every path either returns is judged by the independent shapely
 sweep along its curves (``sweep_oracle.car_sweep_check``). A Dubins query with neither a path nor
 a proof is probed by a lattice (``boxed_in``): when the poses a forward-only car reaches from the
-start, or reaches the goal from, run out, the script says so -- evidence, not a proof: cspace has
-no proof method for a Dubins car. The table: solved, undecided, colliding, median and mean time to
+start, or reaches the goal from, run out without coming near the other end, the script says so --
+evidence, not a proof: cspace has no proof method for a Dubins car. The table: solved, undecided, colliding, median and mean time to
 the first path, and ours / peer over the runs both solve with the peer's path sound (medians and
 means), per row and per world (target <= 0.5x). Then the peer's paths are written in Bench-MR's
 results format and re-checked by ``cspace recheck``'s routine
@@ -252,19 +252,24 @@ def boxed_in(adapter, query, step: float = LATTICE_STEP, cap: int = LATTICE_CAP)
     """Why a Dubins query found neither a path nor a proof, where a lattice shows it: the poses a
     forward-only car reaches from the start by certified steps of ``step`` (left, straight,
     right; poses merged on a grid of 0.6 steps and 2 degrees), or from which it reaches the goal
-    (the same steps in reverse from the goal). When either set ends within ``cap`` poses, that
-    end is boxed in at this resolution -- evidence, not a proof (a finer lattice, or a curve
-    between its poses, might get out; cspace has no proof method for Dubins cars). None: both
-    sets reach past ``cap`` poses."""
+    (the same steps in reverse from the goal). When either set ends within ``cap`` poses without
+    coming near the other end (its grid cell or a neighbour), that end's reach is said to end --
+    evidence, not a proof (a finer lattice, or a curve between its poses, might get further;
+    cspace has no proof method for Dubins cars). None: no such claim.
+
+    >>> boxed_in.__defaults__ == (LATTICE_STEP, LATTICE_CAP)
+    True
+    """
     from cspace.car.curves import advance
 
     car, r = adapter.cspace, adapter.radius
-    for end, pose, sign in (("start", query.start, 1.0), ("goal", query.goal, -1.0)):
+
+    def key(z):
+        return round(z[0] / (0.6 * step)), round(z[1] / (0.6 * step)), round(z[2] % (2 * math.pi) / math.radians(2)) % 180
+
+    ends = (("start", query.start, query.goal, 1.0), ("goal", query.goal, query.start, -1.0))
+    for end, pose, other, sign in ends:
         z0 = tuple(float(v) for v in pose)
-
-        def key(z):
-            return round(z[0] / (0.6 * step)), round(z[1] / (0.6 * step)), round(z[2] % (2 * math.pi) / math.radians(2)) % 180
-
         seen, todo = {key(z0)}, [z0]
         while todo and len(seen) <= cap:
             z = todo.pop()
@@ -274,9 +279,11 @@ def boxed_in(adapter, query, step: float = LATTICE_STEP, cap: int = LATTICE_CAP)
                     if key(z2) not in seen:
                         seen.add(key(z2))
                         todo.append(z2)
-        if not todo:
-            way = "leaves" if sign > 0 else "reaches"
-            return f"the {end} is boxed in: a forward-only car {way} it through {len(seen)} lattice poses only"
+        i, j, k = key(tuple(float(v) for v in other))
+        near = any((i + a, j + b, (k + c) % 180) in seen for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1))
+        if not todo and not near:
+            way, what = ("forward", "goal") if sign > 0 else ("backward", "start")
+            return f"the {end}'s {way} reach ends: {len(seen)} lattice poses, none near the {what}"
     return None
 
 
@@ -347,7 +354,7 @@ def summary(r: dict, peer: bool) -> dict:
 
 
 def table(rows: list[dict], peer: bool) -> str:
-    head = ["world", "space", "runs", "C-space (once)", "ours solved (proven unsolvable)", "undecided (boxed in)",
+    head = ["world", "space", "runs", "C-space (once)", "ours solved (proven unsolvable)", "undecided (a reach ends)",
             "ours colliding", "ours median", "ours mean"]
     if peer:
         head += ["peer solved", "peer colliding", "peer median", "peer mean", "ours / peer, medians (sound, both)",

@@ -231,7 +231,8 @@ def benchmr_lines(rec: dict) -> list[str]:
                  for q in r.get("undecided_queries", [])]
     if undecided:
         lines += ["", "Undecided: neither a path nor a proof within the time limit. cspace has no proof method for a "
-                  "Dubins (forward-only) car; where a lattice of certified steps shows an end boxed in, it is named "
+                  "Dubins (forward-only) car; where a lattice of certified steps shows the start's reach, or the goal's, "
+                  "ending away from the other end, it is named "
                   "(evidence, not a proof):", ""]
         lines += [f"- {w} {sp} query {q}: {why or 'no lattice evidence either'}" for w, sp, q, why in undecided]
     lines += ["", "Ours / the peer per world (both car models; the runs both solve with the peer's path sound), "

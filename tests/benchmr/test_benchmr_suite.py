@@ -34,7 +34,11 @@ def car_scene(walls: bool):
 def test_a_car_parked_facing_a_bumper_is_boxed_in_and_one_in_the_open_is_not():
     sc, adapter = car_scene(walls=True)
     why = SUITE.boxed_in(adapter, sc.all_queries()[0], cap=2000)
-    assert why is not None and why.startswith("the start is boxed in"), why
+    assert why is not None and why.startswith("the start's forward reach ends"), why
+    from types import SimpleNamespace
+
+    near = SimpleNamespace(start=(10.0, 10.0, 0.0), goal=(10.05, 10.0, 0.0))  # within the slot's reach
+    assert SUITE.boxed_in(adapter, near, cap=2000) is None
     sc, adapter = car_scene(walls=False)
     assert SUITE.boxed_in(adapter, sc.all_queries()[0], cap=200) is None  # past the cap: no claim
 
@@ -54,7 +58,7 @@ def test_the_ratio_against_the_peer_is_given_per_world_over_its_sound_runs():
 
 def test_the_page_section_shows_the_table_ratios_and_recheck_counts(tmp_path):
     row = {"world": "parking1", "space": "dubins", "runs": 5, "left_out": 0, "prep_s": 0.1, "ours_solved": 4,
-           "proven_unsolvable": 0, "undecided_queries": [3], "boxed_in": {"3": "the start is boxed in"},
+           "proven_unsolvable": 0, "undecided_queries": [3], "boxed_in": {"3": "the start's forward reach ends"},
            "ours_colliding": 0, "ours_median_s": 0.02, "ours_mean_s": 0.03, "peer_solved": 5, "peer_colliding": 2,
            "peer_median_s": 0.1, "peer_mean_s": 0.2, "ratio": 0.2, "ratio_mean": 0.15, "ratio_runs": 4,
            "peer_recheck": {"paths": 5, "colliding": 2, "seconds": 0.1}}
