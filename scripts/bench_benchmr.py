@@ -8,36 +8,47 @@ Problems (read from a Bench-MR checkout, ``--bench-mr DIR``; nothing of it is co
   its robot (``car.svg``, ``warehouse_robot.svg``) and the 5 start/goal poses of Bench-MR's notebook
   (``python/Benchmark Polygon Worlds.ipynb``), in Dubins and Reeds–Shepp with turning radius 4.
   The poses were written for the drawings before Bench-MR's commit 7692815 (which moved each
-  world): they are shifted by the difference of the obstacles' box corners, old to new, computed
-  from the checkout's git history when it has it (``git show 7692815^:...``, the old reading:
-  absolute path coordinates, y negated, scaled 1/22), else the recorded shifts (``SHIFT``);
+  world): they are shifted by the difference of the obstacles' box corners, old to new, as
+  recorded (``SHIFT``, to 4 decimals: every checkout plans the same poses and draws the same
+  pictures) and checked against the checkout's git history when it has it (``git show
+  7692815^:...``, the old reading: absolute path coordinates, y negated, scaled 1/22);
 - the last ``--rows`` rows (default 10) of ``Berlin_0_256`` and ``Boston_2_512`` (Reeds–Shepp,
   Bench-MR's car, MovingAI's frame, headings estimated as Bench-MR estimates them; rows whose
   start or goal puts the car on a blocked cell are counted and left out).
 
-Per problem and seed, in turn: ours, cspace's time to its first certified path
-(``se2_peers.ours_first``: the proof before sampling, then RRTConnect (RRT for Dubins, whose
-one-way curves RRTConnect's goal tree drives backwards) stopped at its first solution, CPU
-seconds), and the peer, the same OMPL planner on the same state space with a shapely state
-checker and OMPL's discrete motion check at Bench-MR's 0.005 of the extent
-(``se2_peers.peer_first``). Every path either returns is judged by the independent shapely sweep
-along its curves (``sweep_oracle.car_sweep_check``). The table: solved, colliding, median and mean
-time to the first path, and ours / peer over the problems both solve with a sound path (medians
-and means: the C-space and the proof's regions are built once per world and scene and reused by
-the later queries and seeds, as ``cspace plan --all-queries`` and ``cspace bench`` reuse them, so
-the first run of a world pays for them: the mean shows it, the median mostly not). Then the
-peer's paths are written in Bench-MR's results format and re-checked by ``cspace recheck``'s
-routine (``planners.bench.benchmr_results.recheck``): how many paths its discrete check called
+The bounds of a polygon world: the obstacles' box and a margin of two turning radii (``MARGIN``):
+Bench-MR's box bounds only the states its planners sample, while OMPL's motion check walks a
+curve's states against the obstacles alone, so its cars drive out of a drawing and back.
+``--box-bounds`` keeps the box alone: a forward-only car facing its edge closer than its turning
+radius (parking1's and parking2's slot poses) then cannot turn away before it leaves the box.
+
+Per problem and seed, in turn: ours, cspace's time to its first certified path in the default
+planner's order (``ours_first``: a slice of sampling, then the proof before sampling only where
+the slice found nothing, then the planner, RRTConnect (RRT for Dubins, whose one-way curves
+RRTConnect's goal tree drives backwards) stopped at its first solution; CPU seconds), and the
+peer, the same OMPL planner on the same state space with a shapely state checker and OMPL's
+discrete motion check at Bench-MR's step, 0.005 of its box's extent (``se2_peers.peer_first``).
+The C-space's slabs are built once per world and car model before its queries (the column "C-space
+(once)"), as the peer's checker is. Every path either returns is judged by the independent shapely
+sweep along its curves (``sweep_oracle.car_sweep_check``). A Dubins query with neither a path nor
+a proof is probed by a lattice (``boxed_in``): when the poses a forward-only car reaches from the
+start, or reaches the goal from, run out without coming near the other end, the script says so --
+evidence, not a proof: cspace has no proof method for a Dubins car. The table: solved, undecided, colliding, median and mean time to
+the first path, and ours / peer over the runs both solve with the peer's path sound (medians and
+means), per row and per world (target <= 0.5x). Then the peer's paths are written in Bench-MR's
+results format and re-checked by ``cspace recheck``'s routine
+(``planners.bench.benchmr_results.recheck``): how many paths its discrete check called
 collision-free cross an obstacle, and the recheck's time.
 
 Usage: python scripts/bench_benchmr.py [--bench-mr DIR] [--git-dir GIT] [--seeds N] [--time S] [--rows N]
-       [--quick] [--skip-movingai] [--no-peer] [--true-shapes] [--json FILE] [--figures DIR]
+       [--quick] [--skip-movingai] [--no-peer] [--true-shapes] [--box-bounds] [--json FILE] [--figures DIR]
 Without a checkout (--bench-mr DIR, or $BENCH_MR) it says so and exits 0.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -78,6 +89,15 @@ OLD_COMMIT = "7692815^"
 RADIUS = 4.0
 RESOLUTION = 0.005  # Bench-MR's OMPL state validity checking resolution (fraction of the extent)
 MAPS = ("Berlin_0_256", "Boston_2_512")
+# Bench-MR's box (the obstacles') bounds only the states its planners sample: OMPL's motion check
+# walks a curve's states against the obstacles alone, so its cars drive out of a drawing and back
+# (a parking lot has no wall around it). The suite's bounds, which every motion of ours keeps to,
+# are that box and this margin: two turning radii, room for a U-turn outside the drawing.
+# (``--box-bounds``: the box alone. A forward-only car facing the box's edge, closer to it than
+# its turning radius, then cannot turn away before it leaves the box: parking1's and parking2's
+# slot poses make five Dubins queries unsolvable, which no method of cspace proves.)
+MARGIN = 2 * RADIUS
+LATTICE_STEP, LATTICE_CAP = 0.1, 20000  # boxed_in's lattice: step (length units), poses
 
 
 def old_frame_shift(bench_mr: str, world: str, git_dir: str | None = None) -> tuple[float, float] | None:
@@ -106,8 +126,9 @@ def old_frame_shift(bench_mr: str, world: str, git_dir: str | None = None) -> tu
     return float(new.bounds[0] - lo_old[0]), float(new.bounds[1] - lo_old[1])
 
 
-def polygon_problems(bench_mr: str, hulls: bool, git_dir: str | None = None) -> list[dict]:
-    """The 20 polygon problems in both car models: {name, sc (with queries), shift}."""
+def polygon_problems(bench_mr: str, hulls: bool, git_dir: str | None = None, margin: float = MARGIN) -> list[dict]:
+    """The 20 polygon problems in both car models: {name, sc (with queries), shift}. The bounds:
+    the obstacles' box (grown to hold the poses) and ``margin`` around it (see :data:`MARGIN`)."""
     from cspace.io.importers.imported import ImportOptions, import_file
     from cspace.io.importers.svg import svg_robot
     from cspace.io.scenario.validate import scenario_from_dict, with_queries
@@ -115,7 +136,12 @@ def polygon_problems(bench_mr: str, hulls: bool, git_dir: str | None = None) -> 
     folder = os.path.join(bench_mr, "bin", "polygon_mazes")
     out = []
     for world, pairs in POSES.items():
-        shift = old_frame_shift(bench_mr, world, git_dir) or SHIFT[world]
+        # the recorded shift, so that every checkout plans the same poses (and draws the same
+        # pictures); the history, where the checkout has it, must agree with it
+        shift, measured = SHIFT[world], old_frame_shift(bench_mr, world, git_dir)
+        if measured is not None and max(abs(a - b) for a, b in zip(measured, shift)) > 1e-3:
+            raise SystemExit(f"{world}: the checkout's history shifts the poses by ({measured[0]:.4f}, "
+                             f"{measured[1]:.4f}), not the recorded ({shift[0]}, {shift[1]}): another drawing?")
         robot = svg_robot(os.path.join(folder, ROBOT[world]), convex_hull=hulls)[0]
         moved = [tuple((p[0] + shift[0], p[1] + shift[1], p[2]) for p in pair) for pair in pairs]
         imp = import_file(os.path.join(folder, f"{world}.svg"),
@@ -125,10 +151,14 @@ def polygon_problems(bench_mr: str, hulls: bool, git_dir: str | None = None) -> 
             for x, y, _ in (s, g):
                 b["xmin"], b["xmax"] = min(b["xmin"], x), max(b["xmax"], x)
                 b["ymin"], b["ymax"] = min(b["ymin"], y), max(b["ymax"], y)
+        b.update(xmin=b["xmin"] - margin, xmax=b["xmax"] + margin, ymin=b["ymin"] - margin, ymax=b["ymax"] + margin)
+        # the peer's step: Bench-MR's 0.005 of its box's extent, as a fraction of the grown bounds'
+        step = RESOLUTION * math.hypot(b["xmax"] - b["xmin"] - 2 * margin, b["ymax"] - b["ymin"] - 2 * margin) / \
+            math.hypot(b["xmax"] - b["xmin"], b["ymax"] - b["ymin"])
         for space in ("reeds-shepp", "dubins"):
             sc = scenario_from_dict(imp.data, world, space=space, turning_radius=RADIUS)
             sc = with_queries(sc, {"queries": [{"start": list(s), "goal": list(g)} for s, g in moved]}, world)
-            out.append({"world": world, "space": space, "sc": sc, "shift": shift})
+            out.append({"world": world, "space": space, "sc": sc, "shift": shift, "peer_resolution": step})
     return out
 
 
@@ -160,17 +190,19 @@ def run_problem(p: dict, seeds: int, limit: float, peer: bool) -> dict:
 
     sc = p["sc"]
     seg = dubins_segments if sc.space == "dubins" else reeds_shepp_segments
-    t0 = time.perf_counter()
+    c0 = time.process_time()
     cs = build_cspace(sc)
     adapter = make_adapter(sc, cs)
-    build = time.perf_counter() - t0
+    for k in range(cs.slabs):  # the C-space's slabs, once per world (as the peer's checker is built once)
+        cs.slab(k)
+    build = time.process_time() - c0
     checker = se2_peers.shapely_checker(sc) if peer else None
 
     def collides(path):
         return car_sweep_check(sc, path, lambda a, b: seg(a, b, sc.turning_radius), sc.turning_radius)["collides"]
 
     planner = planner_for(sc.space)
-    runs = []
+    runs, boxed = [], {}
     for qi, q in enumerate(sc.all_queries()):
         for seed in range(seeds):
             path, cpu, proof_cpu, proven = ours_first(sc, cs, adapter, q, seed, limit, planner)
@@ -178,30 +210,81 @@ def run_problem(p: dict, seeds: int, limit: float, peer: bool) -> dict:
                    "proven_unsolvable": proven, "ours_colliding": bool(path is not None and collides(path))}
             if peer:
                 path, cpu = se2_peers.peer_first(adapter, checker, adapter.pose(q.start), adapter.pose(q.goal), seed,
-                                                 limit, planner, resolution=RESOLUTION)
+                                                 limit, planner, resolution=p.get("peer_resolution", RESOLUTION))
                 row.update(peer_s=cpu if path is not None else None,
                            peer_colliding=bool(path is not None and collides(path)),
                            peer_path=None if path is None else np.asarray(path, float).tolist())
             runs.append(row)
-    return {"world": p["world"], "space": p["space"], "planner": planner, "build_s": build, "runs": runs,
+        if sc.space == "dubins" and not any(x["ours_s"] is not None or x["proven_unsolvable"]
+                                            for x in runs if x["query"] == qi):
+            boxed[qi] = boxed_in(adapter, q)
+    return {"boxed_in": boxed, "world": p["world"], "space": p["space"], "planner": planner, "build_s": build, "runs": runs,
             "queries": len(sc.all_queries()), "left_out": p.get("left_out", 0), "sc": sc}
 
 
 def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
-    """``se2_peers.ours_first`` with its two stages timed apart: (path or None, CPU seconds, of which
-    the proof before sampling, whether that proof found the query unsolvable)."""
+    """cspace's first certified path, in the order of the default planner (``auto``): a slice of
+    sampling first (``auto.SLICE_ITERATIONS`` iterations, ``auto.SLICE_SHARE`` of the limit), the
+    proof before sampling only where that slice found nothing (on a city map the proof's POSSIBLE
+    regions cost seconds, and a solvable query needs none), then the planner with the rest:
+    (path or None, CPU seconds, of which the proof, whether the proof found the query unsolvable)."""
+    from planners.core.auto import SLICE_ITERATIONS, SLICE_SHARE
     from planners.core.exact_se2 import quick_proof
     from planners.core.routine import run_planner
 
-    c0 = time.process_time()
-    proof = quick_proof(sc, cs, query, limit)
+    c0, w0 = time.process_time(), time.perf_counter()
+    pair = [(adapter.pose(query.start), adapter.pose(query.goal))]
+    res = run_planner(adapter, planner, pair, SLICE_SHARE * limit, seed, iterations=SLICE_ITERATIONS,
+                      simplify=False, until_first=True)[0]
+    if res.solved:
+        return res.path, time.process_time() - c0, 0.0, False
     c1 = time.process_time()
+    proof = quick_proof(sc, cs, query, limit)
+    c2 = time.process_time()
     if proof is not None:
-        return None, c1 - c0, c1 - c0, True
-    pose = adapter.pose
-    res = run_planner(adapter, planner, [(pose(query.start), pose(query.goal))], limit, seed, simplify=False,
-                      until_first=True)[0]
-    return (res.path if res.solved else None), time.process_time() - c0, c1 - c0, False
+        return None, c2 - c0, c2 - c1, True
+    left = limit - (time.perf_counter() - w0)
+    res = run_planner(adapter, planner, pair, max(left, 0.0), seed, simplify=False, until_first=True)[0]
+    return (res.path if res.solved else None), time.process_time() - c0, c2 - c1, False
+
+
+def boxed_in(adapter, query, step: float = LATTICE_STEP, cap: int = LATTICE_CAP) -> str | None:
+    """Why a Dubins query found neither a path nor a proof, where a lattice shows it: the poses a
+    forward-only car reaches from the start by certified steps of ``step`` (left, straight,
+    right; poses merged on a grid of 0.6 steps and 2 degrees), or from which it reaches the goal
+    (the same steps in reverse from the goal). When either set ends within ``cap`` poses without
+    coming near the other end (its grid cell or a neighbour), that end's reach is said to end --
+    evidence, not a proof (a finer lattice, or a curve between its poses, might get further;
+    cspace has no proof method for Dubins cars). None: no such claim.
+
+    >>> boxed_in.__defaults__ == (LATTICE_STEP, LATTICE_CAP)
+    True
+    """
+    from cspace.car.curves import advance
+
+    car, r = adapter.cspace, adapter.radius
+
+    def key(z):
+        return round(z[0] / (0.6 * step)), round(z[1] / (0.6 * step)), round(z[2] % (2 * math.pi) / math.radians(2)) % 180
+
+    ends = (("start", query.start, query.goal, 1.0), ("goal", query.goal, query.start, -1.0))
+    for end, pose, other, sign in ends:
+        z0 = tuple(float(v) for v in pose)
+        seen, todo = {key(z0)}, [z0]
+        while todo and len(seen) <= cap:
+            z = todo.pop()
+            for kind in "LSR":
+                if car.curve_free(z, [(kind, sign * step)], r):
+                    z2 = tuple(float(v) for v in advance(z, kind, sign * step, r))
+                    if key(z2) not in seen:
+                        seen.add(key(z2))
+                        todo.append(z2)
+        i, j, k = key(tuple(float(v) for v in other))
+        near = any((i + a, j + b, (k + c) % 180) in seen for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1))
+        if not todo and not near:
+            way, what = ("forward", "goal") if sign > 0 else ("backward", "start")
+            return f"the {end}'s {way} reach ends: {len(seen)} lattice poses, none near the {what}"
+    return None
 
 
 def planner_for(space: str) -> str:
@@ -233,48 +316,75 @@ def peer_recheck(r: dict) -> dict:
     return {"paths": len(rows), "colliding": sum(x["colliding"] for x in rows), "seconds": time.perf_counter() - t0}
 
 
+def ratios(runs: list[dict]) -> tuple[float | None, float | None, int]:
+    """ours / peer over the runs both solved with the peer's path sound: (medians' ratio, means'
+    ratio, how many runs).
+
+    >>> ratios([{"ours_s": 1.0, "peer_s": 4.0, "peer_colliding": False},
+    ...         {"ours_s": 3.0, "peer_s": 2.0, "peer_colliding": True}, {"ours_s": None, "peer_s": 1.0}])
+    (0.25, 0.25, 1)
+    """
+    both = [(x["ours_s"], x["peer_s"]) for x in runs if x["ours_s"] is not None and x.get("peer_s") is not None
+            and not x["peer_colliding"]]
+    if not both:
+        return None, None, 0
+    a, b = zip(*both)
+    return statistics.median(a) / statistics.median(b), statistics.mean(a) / statistics.mean(b), len(both)
+
+
 def summary(r: dict, peer: bool) -> dict:
     runs = r["runs"]
     ours = [x["ours_s"] for x in runs if x["ours_s"] is not None]
     proofs = [x["ours_proof_s"] for x in runs if x["ours_s"] is not None]
     row = {"world": r["world"], "space": r["space"], "runs": len(runs), "left_out": r["left_out"],
-           "ours_solved": len(ours), "ours_colliding": sum(x["ours_colliding"] for x in runs),
+           "prep_s": r["build_s"], "ours_solved": len(ours), "ours_colliding": sum(x["ours_colliding"] for x in runs),
            "proven_unsolvable": sum(x["proven_unsolvable"] for x in runs),
+           "boxed_in": {str(k): v for k, v in r["boxed_in"].items() if v},
+           "undecided_queries": sorted(r["boxed_in"]),
            "ours_proof_median_s": statistics.median(proofs) if proofs else None,
            "ours_median_s": statistics.median(ours) if ours else None,
            "ours_mean_s": statistics.mean(ours) if ours else None}
     if peer:
         theirs = [x["peer_s"] for x in runs if x["peer_s"] is not None]
-        both = [(x["ours_s"], x["peer_s"]) for x in runs if x["ours_s"] is not None and x["peer_s"] is not None
-                and not x["peer_colliding"]]
         row.update(peer_solved=len(theirs), peer_colliding=sum(x["peer_colliding"] for x in runs),
                    peer_median_s=statistics.median(theirs) if theirs else None,
-                   peer_mean_s=statistics.mean(theirs) if theirs else None,
-                   ratio=(statistics.median(a for a, _ in both) / statistics.median(b for _, b in both)) if both
-                   else None,
-                   ratio_mean=(statistics.mean(a for a, _ in both) / statistics.mean(b for _, b in both)) if both
-                   else None)
+                   peer_mean_s=statistics.mean(theirs) if theirs else None)
+        row["ratio"], row["ratio_mean"], row["ratio_runs"] = ratios(runs)
     return row
 
 
 def table(rows: list[dict], peer: bool) -> str:
-    head = ["world", "space", "runs", "ours solved (proven unsolvable)", "ours colliding", "ours median",
-            "of which proof", "ours mean"]
+    head = ["world", "space", "runs", "C-space (once)", "ours solved (proven unsolvable)", "undecided (a reach ends)",
+            "ours colliding", "ours median", "ours mean"]
     if peer:
         head += ["peer solved", "peer colliding", "peer median", "peer mean", "ours / peer, medians (sound, both)",
                  "means"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     ms = lambda v: "-" if v is None else f"{v * 1e3:.0f} ms"  # noqa: E731
     for r in rows:
+        undecided = len(r["undecided_queries"])
         cells = [r["world"], r["space"], str(r["runs"]) + (f" ({r['left_out']} rows left out)" if r["left_out"] else ""),
-                 f"{r['ours_solved']} ({r['proven_unsolvable']})", str(r["ours_colliding"]), ms(r["ours_median_s"]),
-                 ms(r["ours_proof_median_s"]), ms(r["ours_mean_s"])]
+                 ms(r["prep_s"]), f"{r['ours_solved']} ({r['proven_unsolvable']})",
+                 f"{undecided} queries ({len(r['boxed_in'])})" if undecided else "0",
+                 str(r["ours_colliding"]), ms(r["ours_median_s"]), ms(r["ours_mean_s"])]
         if peer:
             cells += [str(r["peer_solved"]), str(r["peer_colliding"]), ms(r["peer_median_s"]), ms(r["peer_mean_s"]),
                       "-" if r["ratio"] is None else f"{r['ratio']:.2f}x",
                       "-" if r["ratio_mean"] is None else f"{r['ratio_mean']:.2f}x"]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def per_world(results: list[dict]) -> list[dict]:
+    """Per world (both car models of a polygon world together): ours / peer over the peer's sound
+    runs, against the target of 0.5x, in medians and in means."""
+    out = []
+    for world in dict.fromkeys(r["world"] for r in results):
+        runs = [x for r in results if r["world"] == world for x in r["runs"]]
+        med, mean, n = ratios(runs)
+        out.append({"world": world, "sound_runs": n, "ratio_median": med, "ratio_mean": mean,
+                    "met_median": med is not None and med <= 0.5, "met_mean": mean is not None and mean <= 0.5})
+    return out
 
 
 def figures(problems: list[dict], folder: str, limit: float) -> None:
@@ -303,7 +413,9 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-movingai", action="store_true")
     ap.add_argument("--no-peer", action="store_true", help="cspace only")
     ap.add_argument("--true-shapes", action="store_true", help="the drawn shapes, not Bench-MR's convex hulls")
-    ap.add_argument("--json")
+    ap.add_argument("--box-bounds", action="store_true", help="the polygon worlds' bounds: the obstacles' box alone "
+                                                               "(default: and a margin of two turning radii)")
+    ap.add_argument("--json", "--out-json", dest="json", metavar="FILE", help="write the rows and runs as JSON")
     ap.add_argument("--figures", metavar="DIR", help="also plan every problem's queries once (seed 0) and save a "
                                                      "picture of each world and car model with cspace's paths")
     args = ap.parse_args(argv)
@@ -313,7 +425,10 @@ def main(argv=None) -> int:
     if args.quick:
         args.seeds, args.time, args.rows = 1, 3.0, 3
     peer = not args.no_peer
-    problems = polygon_problems(args.bench_mr, hulls=not args.true_shapes, git_dir=args.git_dir)
+    load = os.getloadavg()
+    print(f"load average at start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f} ({os.cpu_count()} CPUs)")
+    problems = polygon_problems(args.bench_mr, hulls=not args.true_shapes, git_dir=args.git_dir,
+                                margin=0.0 if args.box_bounds else MARGIN)
     for p in problems[::2]:
         print(f"{p['world']}: the published poses shifted by ({p['shift'][0]:.4f}, {p['shift'][1]:.4f})")
     if not args.skip_movingai:
@@ -339,18 +454,36 @@ def main(argv=None) -> int:
                   f"collision-free by its 0.005 discrete check collide")
         print(f"recheck: {n} paths in {secs:.2f} s ({secs / max(n, 1) * 1e3:.1f} ms a path, a C-space per world "
               f"included), {bad} colliding")
+    for r in results:
+        for qi, why in sorted(r["boxed_in"].items()):
+            print(f"{r['world']} {r['space']} query {qi}: neither a path nor a proof"
+                  + (f"; {why} (a lattice's evidence, not a proof)" if why else ""))
+    worlds = per_world(results) if peer else []
+    for w in worlds:
+        fmt = lambda v: "-" if v is None else f"{v:.2f}x"  # noqa: E731
+        print(f"ours / peer, {w['world']} (its {w['sound_runs']} runs both solve, the peer's path sound): "
+              f"medians {fmt(w['ratio_median'])}, means {fmt(w['ratio_mean'])} (target <= 0.5x: "
+              f"{'met' if w['met_median'] and w['met_mean'] else 'met in medians' if w['met_median'] else 'MISSED'})")
     poly = [x for r in results if r["world"] in POSES for x in r["runs"]]
     firsts = [x["ours_s"] for x in poly if x["ours_s"] is not None]
     if firsts:
-        print(f"polygon worlds: ours {len(firsts)}/{len(poly)} runs solved, median time to the first certified path "
+        print(f"polygon worlds: ours {len(firsts)}/{len(poly)} runs solved, "
+              f"{sum(x['proven_unsolvable'] for x in poly)} proven unsolvable, median time to the first certified path "
               f"{statistics.median(firsts) * 1e3:.0f} ms (target <= 150 ms), "
               f"{sum(x['ours_colliding'] for x in poly)} colliding (target 0)")
+    for r in results:
+        if r["world"] in MAPS:
+            t = [x["ours_s"] for x in r["runs"] if x["ours_s"] is not None]
+            mean = statistics.mean(t) if t else None
+            print(f"{r['world']}: ours {len(t)}/{len(r['runs'])} solved, mean {'-' if mean is None else f'{mean * 1e3:.0f} ms'}"
+                  f" (target <= 150 ms; the C-space's slabs, built once before the rows, {r['build_s']:.2f} s), "
+                  f"{sum(x['ours_colliding'] for x in r['runs'])} colliding")
     if args.figures:
         figures(problems, args.figures, args.time)
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump({"rows": rows, "results": [{k: v for k, v in r.items() if k != "sc"} for r in results]}, fh,
-                      indent=1)
+            json.dump({"rows": rows, "worlds": worlds, "load_start": list(load), "load_end": list(os.getloadavg()),
+                       "results": [{k: v for k, v in r.items() if k != "sc"} for r in results]}, fh, indent=1)
     return 0
 
 

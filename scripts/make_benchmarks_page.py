@@ -10,6 +10,13 @@ rendered as Markdown tables. ``cspace bench`` (planners: error against run time)
 run on a small sweep too. Outputs of every run are kept in ``--work`` (default: a
 temporary folder); ``--from DIR`` re-renders the page from such a folder without
 running anything. A script missing from ``scripts/`` is listed as "not yet run".
+
+Bench-MR's suite (``scripts/bench_benchmr.py``) reads a Bench-MR checkout, which lives outside
+the repository: it runs only when ``--bench-mr DIR`` (or ``$BENCH_MR``) names one, with
+``BENCH_MR_ARGS`` and ``--figures docs/figures/benchmr`` (a picture of each polygon world and
+car model with cspace's paths, committed with the page); its section then shows the table, the
+per-world ratios, the peer's recheck counts and those pictures. Without a checkout the section
+says how to run it, and nothing outside the repository is read.
 """
 from __future__ import annotations
 
@@ -39,6 +46,11 @@ QUICK_ARGS = {
 PLANNER_SWEEP = ["scenarios/bug_trap.toml", "scenarios/maze.toml", "--planners", "RRTConnect,RRTstar",
                  "--times", "0.1,0.3,1", "--runs", "5", "--workers", "2", "--no-plot", "--quiet"]
 TIMEOUT = 600  # seconds per script
+# Bench-MR's suite: every polygon problem and the last 10 rows of each city map, one seed, 10 s a
+# run (its --quick mode is 3 s and 3 rows); longer than the others, hence its own timeout.
+BENCH_MR_ARGS = ["--seeds", "1", "--time", "10"]
+BENCH_MR_FIGURES = os.path.join("docs", "figures", "benchmr")
+BENCH_MR_TIMEOUT = 1800
 
 
 def help_text(script: str) -> str:
@@ -47,11 +59,14 @@ def help_text(script: str) -> str:
     return proc.stdout
 
 
-def quick_command(name: str, script: str, json_path: str) -> tuple[list[str], bool]:
-    """The command line of a quick run, and whether it writes JSON to ``json_path``."""
+def quick_command(name: str, script: str, json_path: str, bench_mr: str | None = None) -> tuple[list[str], bool]:
+    """The command line of a quick run, and whether it writes JSON to ``json_path``
+    (``bench_benchmr``: its own arguments, with the checkout ``bench_mr``)."""
     h = help_text(script)
     args = list(QUICK_ARGS.get(name, []))
-    if "--quick" in h:
+    if name == "bench_benchmr":
+        args = ["--bench-mr", bench_mr or "", *BENCH_MR_ARGS, "--figures", BENCH_MR_FIGURES]
+    elif "--quick" in h:
         args.append("--quick")
     wants_json = "--out-json" in h
     if wants_json:
@@ -59,18 +74,22 @@ def quick_command(name: str, script: str, json_path: str) -> tuple[list[str], bo
     return ["python", os.path.relpath(script, ROOT), *args], wants_json
 
 
-def run_script(name: str, script: str, work: str) -> dict:
+def run_script(name: str, script: str, work: str, bench_mr: str | None = None) -> dict:
     """Run one bench script, keep its stdout, JSON and timing in ``work``; returns the record."""
     json_path = os.path.join(work, f"{name}.json")
-    cmd, wants_json = quick_command(name, script, json_path)
+    cmd, wants_json = quick_command(name, script, json_path, bench_mr)
+    limit = BENCH_MR_TIMEOUT if name == "bench_benchmr" else TIMEOUT
     t = time.perf_counter()
     try:
-        proc = subprocess.run([sys.executable, *cmd[1:]], capture_output=True, text=True, timeout=TIMEOUT, cwd=ROOT)
+        proc = subprocess.run([sys.executable, *cmd[1:]], capture_output=True, text=True, timeout=limit, cwd=ROOT)
         rc, out, err = proc.returncode, proc.stdout, proc.stderr
     except subprocess.TimeoutExpired as exc:
-        rc, out, err = "timeout", exc.stdout or "", f"timed out after {TIMEOUT} s"
+        rc, out, err = "timeout", exc.stdout or "", f"timed out after {limit} s"
         out = out.decode() if isinstance(out, bytes) else out
-    rec = {"name": name, "command": _shown(cmd, json_path), "seconds": time.perf_counter() - t, "rc": rc,
+    shown = _shown(cmd, json_path)
+    if bench_mr:  # the checkout's place on this machine is no part of the command a reader types
+        shown = shown.replace(shlex.quote(bench_mr), "DIR")
+    rec = {"name": name, "command": shown, "seconds": time.perf_counter() - t, "rc": rc,
            "stdout": out, "stderr": err[-2000:], "json": json_path if wants_json and os.path.exists(json_path) else None}
     with open(os.path.join(work, f"{name}.run.json"), "w") as fh:
         json.dump(rec, fh, indent=1)
@@ -172,6 +191,68 @@ def planner_tables(path: str) -> list[str]:
     return [md_table(table)] if table else ["(no rows)"]
 
 
+def benchmr_lines(rec: dict) -> list[str]:
+    """The Bench-MR section's body from its run's JSON: the table, the ratios per world, the
+    peer's recheck counts and the pictures of the polygon worlds (``--figures``).
+
+    >>> rec = {"json": None, "stdout": "no Bench-MR checkout at '' (...): nothing run\\n"}
+    >>> benchmr_lines(rec)[0].startswith("Not run: it needs a Bench-MR checkout")
+    True
+    """
+    if not rec.get("json"):
+        return ["Not run: it needs a Bench-MR checkout (github.com/robot-motion/bench-mr), which lives outside",
+                "the repository: `python scripts/make_benchmarks_page.py --bench-mr DIR` (or `$BENCH_MR`).", ""]
+    with open(rec["json"]) as fh:
+        data = json.load(fh)
+    ms = lambda v: "-" if v is None else f"{v * 1e3:.0f} ms"  # noqa: E731
+    x = lambda v: "-" if v is None else f"{v:.2f}x"  # noqa: E731
+    load = data.get("load_start")
+    lines = ["Time: CPU seconds to the first path of each query and seed, ours certified (the default planner's "
+             "order: a slice of sampling, the proof before sampling only where it found nothing, then RRTConnect, RRT "
+             "for Dubins), the peer's OMPL's same planner with a shapely state check and the discrete motion check at "
+             "Bench-MR's step (0.005 of its box's extent); each world's C-space is built once, before its queries "
+             "(its own column), as the peer's checker is. A polygon world's bounds are its obstacles' box and two "
+             "turning radii around it: Bench-MR bounds only the states its planners sample, its motion check walks "
+             "curves out of the drawing and back (`--box-bounds`: the box alone). Every path of either side is "
+             "judged by an independent swept check (colliding).", "",
+             f"Load average at the run's start: {', '.join(f'{v:.2f}' for v in load)} (a 2-core machine shared with "
+             "other work: absolute times are inflated, the ratios were measured in the same run)." if load else "", "",
+             "| world | car | runs | C-space (once) | ours solved (proven unsolvable) | undecided | ours colliding | "
+             "ours median | ours mean | peer solved | peer colliding | peer median | peer mean | "
+             "ours / peer, medians | means |", "|" + "---|" * 15]
+    for r in data["rows"]:
+        lines.append("| " + " | ".join([
+            r["world"], r["space"], str(r["runs"]) + (f" ({r['left_out']} rows left out)" if r.get("left_out") else ""),
+            ms(r.get("prep_s")), f"{r['ours_solved']} ({r['proven_unsolvable']})", str(len(r.get("undecided_queries", []))),
+            str(r["ours_colliding"]), ms(r["ours_median_s"]), ms(r["ours_mean_s"]), str(r.get("peer_solved", "-")),
+            str(r.get("peer_colliding", "-")), ms(r.get("peer_median_s")), ms(r.get("peer_mean_s")),
+            x(r.get("ratio")), x(r.get("ratio_mean"))]) + " |")
+    undecided = [(r["world"], r["space"], q, r.get("boxed_in", {}).get(str(q))) for r in data["rows"]
+                 for q in r.get("undecided_queries", [])]
+    if undecided:
+        lines += ["", "Undecided: neither a path nor a proof within the time limit. cspace has no proof method for a "
+                  "Dubins (forward-only) car; where a lattice of certified steps shows the start's reach, or the goal's, "
+                  "ending away from the other end, it is named "
+                  "(evidence, not a proof):", ""]
+        lines += [f"- {w} {sp} query {q}: {why or 'no lattice evidence either'}" for w, sp, q, why in undecided]
+    lines += ["", "Ours / the peer per world (both car models; the runs both solve with the peer's path sound), "
+              "target <= 0.5x:", "", "| world | runs | medians | means |", "|---|---|---|---|"]
+    lines += [f"| {w['world']} | {w['sound_runs']} | {x(w['ratio_median'])} | {x(w['ratio_mean'])} |"
+              for w in data.get("worlds", [])]
+    checked = [r for r in data["rows"] if r.get("peer_recheck")]
+    if checked:
+        lines += ["", "The peer's paths (each called collision-free by its discrete check at Bench-MR's 0.005), "
+                  "written in Bench-MR's results format and re-checked by `cspace recheck`'s routine:", "",
+                  "| world | car | peer's paths | colliding |", "|---|---|---|---|"]
+        lines += [f"| {r['world']} | {r['space']} | {r['peer_recheck']['paths']} | {r['peer_recheck']['colliding']} |"
+                  for r in checked]
+    figures = sorted(glob.glob(os.path.join(ROOT, BENCH_MR_FIGURES, "*.png")))
+    if figures:
+        lines += ["", "cspace's paths (seed 0, one C-space per world and car model; `--figures`):", ""]
+        lines += [f"![{os.path.splitext(os.path.basename(f))[0]}](figures/benchmr/{os.path.basename(f)})" for f in figures]
+    return lines + [""]
+
+
 def machine_note(work: str) -> str:
     """Where the numbers were measured (saved with the run, so --from keeps it)."""
     path = os.path.join(work, "machine.json")
@@ -225,6 +306,11 @@ def render(records: list[dict], missing: list[str], work: str) -> str:
                     lines += [t, ""]
             if r["stdout"].strip():
                 lines += ["```", r["stdout"].rstrip(), "```", ""]
+        elif r["name"] == "bench_benchmr":
+            lines += benchmr_lines(r)
+            if r["stdout"].strip() and r.get("json"):
+                lines += ["<details><summary>The script's output</summary>", "", "```", r["stdout"].rstrip(), "```", "",
+                          "</details>", ""]
         else:
             if r["stdout"].strip():
                 lines += ["```", r["stdout"].rstrip(), "```", ""]
@@ -316,6 +402,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", help="comma-separated bench names to run (e.g. bench_minkowski,cspace_bench); "
                                    "the page's other sections are kept as they are")
     ap.add_argument("--no-planners", action="store_true", help="skip the cspace bench sweep")
+    ap.add_argument("--bench-mr", default=os.environ.get("BENCH_MR") or None, metavar="DIR",
+                    help="a Bench-MR checkout for scripts/bench_benchmr.py (default: $BENCH_MR; without one its "
+                         "section says how to run it)")
     args = ap.parse_args(argv)
     found = {os.path.splitext(os.path.basename(p))[0]: p for p in sorted(glob.glob(os.path.join(ROOT, "scripts", "bench_*.py")))}
     order = [n for n in EXPECTED if n in found] + [n for n in found if n not in EXPECTED]
@@ -325,6 +414,8 @@ def main(argv: list[str] | None = None) -> int:
         work = args.source
         records = []
         for n in order + ["cspace_bench"]:
+            if only and n not in only:
+                continue
             p = os.path.join(work, f"{n}.run.json")
             if os.path.exists(p):
                 with open(p) as fh:
@@ -340,14 +431,18 @@ def main(argv: list[str] | None = None) -> int:
             if only and n not in only:
                 continue
             print(f"running {n} ...", flush=True)
-            records.append(run_script(n, found[n], work))
+            if n == "bench_benchmr" and not args.bench_mr:  # its data lives outside the repository
+                records.append({"name": n, "command": "python scripts/bench_benchmr.py --bench-mr DIR", "seconds": 0.0,
+                                "rc": 0, "stdout": "", "stderr": "", "json": None})
+                continue
+            records.append(run_script(n, found[n], work, args.bench_mr))
             print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
         if not args.no_planners and (not only or "cspace_bench" in only):
             print("running cspace bench ...", flush=True)
             records.append(run_planner_sweep(work))
             print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
     text = render(records, missing, work)
-    if only and not args.source and os.path.exists(args.out):
+    if only and os.path.exists(args.out):
         # Only some sections were run: the others keep what the page already shows.
         with open(args.out) as fh:
             text = splice(fh.read(), text + "\n", {r["name"] for r in records}).rstrip("\n")
