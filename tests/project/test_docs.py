@@ -170,8 +170,9 @@ def _run_block(doc: str, line: int, body: str, tmp_path) -> list[str]:
 
 def not_ignored(paths: list[str]) -> list[str]:
     """Which of these paths (relative to the repository root) its .gitignore does not ignore
-    ([] where git or the repository's history is absent: nothing to judge against)."""
-    if not paths or not os.path.isdir(os.path.join(ROOT, ".git")):
+    ([] where git or the repository's history is absent: nothing to judge against; .git is a folder, or a
+    worktree's file)."""
+    if not paths or not os.path.exists(os.path.join(ROOT, ".git")):
         return []
     try:
         proc = subprocess.run(["git", "-C", ROOT, "check-ignore", "--no-index", "--stdin"], input="\n".join(paths),
@@ -183,7 +184,7 @@ def not_ignored(paths: list[str]) -> list[str]:
 
 
 def test_the_ignore_check_tells_outputs_from_sources():
-    if not os.path.isdir(os.path.join(ROOT, ".git")):
+    if not os.path.exists(os.path.join(ROOT, ".git")):
         pytest.skip("not a git checkout")
     assert not_ignored(["path.png", "bench_out/", "plan.json"]) == []
     assert not_ignored(["scenarios/basic.toml", "cspace/__init__.py"]) == ["scenarios/basic.toml", "cspace/__init__.py"]
