@@ -4,7 +4,7 @@ It runs the project's planners as stages of one budget, each only when the ones 
 not answered, cheapest first (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
-   :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`_slice`): an open
+   :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
    scene, or a query on a large map, is answered here in milliseconds, before any region of the
    slab graph is built (every rotating robot and car: a Dubins car too);
 1. **slab graph** -- the slab graph's search at its first 8 slabs, no refinement (a few
@@ -92,7 +92,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     if tuple(query.start) == tuple(query.goal):
         return _answer(sample(time_limit, None), "sampling", clock, seed)
     if turns:  # a slice of sampling: an open scene is answered here, a large map too
-        r = _slice(sample, cspace, clock, time_limit)
+        r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
             return _answer(r, "sampling", clock, seed)
     if turns and kind != "dubins":  # FREE at the first slabs, and POSSIBLE there where FREE does not join
@@ -136,7 +136,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     return _answer(failed, None, clock, seed)
 
 
-def _slice(sample, cspace, clock: _Clock, time_limit: float) -> PlanResult:
+def sampling_slice(sample, cspace, clock, time_limit: float) -> PlanResult:
     """Stage 0: RRTConnect for :data:`SLICE_ITERATIONS` iterations within :data:`SLICE_SHARE` of
     the limit. The slabs it meets first are built inside it (on a large map, tens of
     milliseconds each: a fresh C-space's first query builds most of them); a slice whose time
