@@ -282,7 +282,8 @@ def run_space(space: str, sc, cs, prep: dict, pairs: list, judge: GridJudge, pee
           f"{mean * 1e3:.1f} ms, p95 {p95 * 1e3:.1f} ms, median {pct(p['cpu'], 50) * 1e3:.1f} ms (wall mean "
           f"{statistics.mean(p['wall']) * 1e3:.1f} ms, p95 {pct(p['wall'], 95) * 1e3:.1f} ms); colliding {p['colliding']}"
           + f"\n  built on first use inside these queries (counted in them): {lazy['slabs']} of {cs.slabs} slabs "
-            f"({lazy['slab_s']:.2f} s), the proof's regions at {lazy['regions']} slabs ({lazy['region_s']:.2f} s)"
+            f"({lazy['slab_s']:.2f} s wall), the slab graph's FREE and POSSIBLE regions (the proof's among them): "
+            f"{lazy['regions']} ({lazy['region_s']:.2f} s wall)"
           + ("" if space == "dubins" else f"\n  targets (CPU): {met}"))
     f = rows["first"]
     print(f"  ours, first certified path (the default planner again, unshortened, after plan(): its slabs built): "
