@@ -67,6 +67,8 @@ def run_script(name: str, script: str, work: str) -> dict:
     """Run one bench script, keep its stdout, JSON and timing in ``work``; returns the record."""
     json_path = os.path.join(work, f"{name}.json")
     cmd, wants_json = quick_command(name, script, json_path)
+    started = {"date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+               "load": list(os.getloadavg()) if hasattr(os, "getloadavg") else None}  # the machine may be shared
     t = time.perf_counter()
     try:
         proc = subprocess.run([sys.executable, *cmd[1:]], capture_output=True, text=True,
@@ -75,7 +77,7 @@ def run_script(name: str, script: str, work: str) -> dict:
     except subprocess.TimeoutExpired as exc:
         rc, out, err = "timeout", exc.stdout or "", f"timed out after {TIMEOUTS.get(name, TIMEOUT)} s"
         out = out.decode() if isinstance(out, bytes) else out
-    rec = {"name": name, "command": _shown(cmd, json_path), "seconds": time.perf_counter() - t, "rc": rc,
+    rec = {"name": name, "command": _shown(cmd, json_path), "seconds": time.perf_counter() - t, "rc": rc, **started,
            "stdout": out, "stderr": err[-2000:], "json": json_path if wants_json and os.path.exists(json_path) else None}
     with open(os.path.join(work, f"{name}.run.json"), "w") as fh:
         json.dump(rec, fh, indent=1)
@@ -219,7 +221,8 @@ def render(records: list[dict], missing: list[str], work: str) -> str:
     lines += [r["command"] for r in records]
     lines += ["```", ""]
     for r in records:
-        lines += [f"## {r['name']}", "", f"`{r['command']}` ({r['seconds']:.0f} s wall, exit {r['rc']})", ""]
+        when = _when(r, work)
+        lines += [f"## {r['name']}", "", f"`{r['command']}` ({r['seconds']:.0f} s wall, exit {r['rc']}{when})", ""]
         if r["name"] == "cspace_bench":
             lines += ["Error = path length / exact optimum − 1 over the solved runs (median and the 25–75 %",
                       "band), and the share of runs solved, per time budget. See the guide,",
@@ -249,6 +252,20 @@ def render(records: list[dict], missing: list[str], work: str) -> str:
         lines += [f"- `scripts/{m}.py`: not in the repository when this page was generated" for m in missing]
         lines += [""]
     return "\n".join(lines)
+
+
+def _when(rec: dict, work: str) -> str:
+    """When a run started and the machine's load then (the machine may be shared); a record
+    without them: the page run's start, from the folder's machine.json."""
+    if rec.get("load"):
+        return f"; started {rec['date']}, load average {', '.join(f'{x:.2f}' for x in rec['load'])}"
+    path = os.path.join(work, "machine.json")
+    if not os.path.exists(path):
+        return ""
+    with open(path) as fh:
+        m = json.load(fh)
+    load = m.get("load")
+    return f"; the page run started {m['date']}, load average then {', '.join(f'{x:.2f}' for x in load)}" if load else ""
 
 
 def _sections(text: str) -> list[tuple[str, str]]:
@@ -331,10 +348,10 @@ def main(argv: list[str] | None = None) -> int:
         records = []
         for n in order + ["cspace_bench"]:
             p = os.path.join(work, f"{n}.run.json")
-            if os.path.exists(p):
+            if os.path.exists(p) and (not only or n in only):
                 with open(p) as fh:
                     records.append(json.load(fh))
-            elif n != "cspace_bench":
+            elif n != "cspace_bench" and (not only or n in only):
                 missing.append(n)
     else:
         work = args.work or tempfile.mkdtemp(prefix="cspace-bench-")
@@ -352,7 +369,7 @@ def main(argv: list[str] | None = None) -> int:
             records.append(run_planner_sweep(work))
             print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
     text = render(records, missing, work)
-    if only and not args.source and os.path.exists(args.out):
+    if only and os.path.exists(args.out):  # (with --from: those sections re-rendered from its records)
         # Only some sections were run: the others keep what the page already shows.
         with open(args.out) as fh:
             text = splice(fh.read(), text + "\n", {r["name"] for r in records}).rstrip("\n")
