@@ -26,7 +26,16 @@ of the two footprints; a turn's sagitta is far below a cell). Targets (issue 35)
 <= 2 s; mean time to a certified path <= 100 ms and p95 <= 200 ms over the 100 pairs; 0
 colliding paths of ours.
 
-Usage: python scripts/bench_warehouse.py [--pairs N] [--size CELLS] [--time S] [--planners A,B] [--no-peer] [--json FILE]
+Cars (``--spaces`` reeds-shepp, dubins; turning radius ``--radius``): the same map and pairs, run
+as scripts/bench_nav2.py runs Nav2's map (its ``prepare_space`` and ``run_space``): preparation
+= the import and the C-space only (slabs and the proof's regions built on first use, inside the
+queries that need them, and counted there); per pair ``plan()`` with the default planner
+(``auto``), its unshortened first path, and OMPL + coal; each car path judged along its curves.
+Targets (issue 47, Reeds-Shepp): preparation <= 2 s, mean <= 45 ms, p95 <= 100 ms, every query
+answered, 0 colliding (Dubins reported beside).
+
+Usage: python scripts/bench_warehouse.py [--pairs N] [--size CELLS] [--time S] [--planners A,B]
+       [--spaces se2,reeds-shepp,dubins] [--radius R] [--no-peer] [--json FILE]
 """
 from __future__ import annotations
 
@@ -46,6 +55,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
 
+import bench_nav2  # noqa: E402
 import make_warehouse_map as wh  # noqa: E402
 import se2_peers  # noqa: E402
 
@@ -103,12 +113,47 @@ def main(argv=None) -> int:
     ap.add_argument("--size", type=int, default=2000, help="cells per side (5 cm each)")
     ap.add_argument("--time", type=float, default=10.0, help="time limit per query (s), both planners")
     ap.add_argument("--planners", default="RRTConnect,exact", help="ours: RRTConnect, exact or both")
+    ap.add_argument("--spaces", default="se2,reeds-shepp,dubins", help="se2 (--planners), and cars (the default planner)")
+    ap.add_argument("--radius", type=float, default=0.5, help="the cars' turning radius (m)")
     ap.add_argument("--no-peer", action="store_true", help="skip OMPL + coal")
     ap.add_argument("--json", help="write the figures as JSON")
     args = ap.parse_args(argv)
     mine = [m for m in args.planners.split(",") if m]
     if not mine or set(mine) - {"RRTConnect", "exact"}:
         ap.error(f"--planners: RRTConnect and/or exact, got {args.planners!r}")
+    spaces = [s for s in args.spaces.split(",") if s]
+    if not spaces or set(spaces) - {"se2", "reeds-shepp", "dubins"}:
+        ap.error(f"--spaces: se2, reeds-shepp and/or dubins, got {args.spaces!r}")
+    from benchutil import coal_peer
+
+    peer = coal_peer(not args.no_peer)
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="warehouse-") as folder:
+        yaml, qfile = wh.write(folder, args.size, 0, args.pairs)
+        img = wh.warehouse(args.size, 0)
+        if "se2" in spaces:
+            out["se2"] = se2_run(args, mine, peer, yaml, qfile, img)
+        cars = [s for s in spaces if s != "se2"]
+        if cars:
+            from cspace.io.load import read_toml
+
+            pairs = [(tuple(q["start"]), tuple(q["goal"])) for q in read_toml(qfile)["queries"]]
+            judge = bench_nav2.GridJudge(img != wh.FREE, wh.RES, (0.0, 0.0), POLYGON, args.radius)
+        for space in cars:
+            sc, cs, prep = bench_nav2.prepare_space(yaml, space, pairs[0], POLYGON, args.radius)
+            print(f"[{space}, r = {args.radius:g} m] preparation {prep['cpu']:.2f} s CPU ({prep['wall']:.2f} s wall): "
+                  f"import {prep['import_cpu']:.2f}, C-space {prep['cspace_cpu']:.2f} ({prep['pieces']} convex pieces, "
+                  f"K = {prep['K']}); slabs and proof regions on first use, in the queries "
+                  f"(target <= 2 s: {'met' if prep['cpu'] <= 2 else 'MISSED'})")
+            out[space] = bench_nav2.run_space(space, sc, cs, prep, pairs, judge, peer, args.time)
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(out, fh, indent=1)
+    return 0
+
+
+def se2_run(args, mine: list, peer: bool, yaml: str, qfile: str, img: np.ndarray) -> dict:
+    """SE(2): RRTConnect and/or exact on one prepared C-space (the module's notes), printed; the figures."""
 
     from cspace.io.importers.imported import ImportOptions, import_file
     from cspace.io.load import read_toml, scenario_from_dict
@@ -116,27 +161,21 @@ def main(argv=None) -> int:
     from planners.core.exact_se2 import prepare
     from planners.core.plan import build_cspace
 
-    from benchutil import coal_peer
-
-    peer = coal_peer(not args.no_peer)
-    with tempfile.TemporaryDirectory(prefix="warehouse-") as folder:
-        yaml, qfile = wh.write(folder, args.size, 0, args.pairs)
-        img = wh.warehouse(args.size, 0)
-        qdata = read_toml(qfile)
-        first = qdata["queries"][0]
-        t0 = time.perf_counter()
-        imp = import_file(yaml, ImportOptions(robot={"polygon": POLYGON}, start=tuple(first["start"]),
-                                              goal=tuple(first["goal"])))
-        sc = with_queries(scenario_from_dict(imp.data, yaml, space="se2"), qdata, qfile)
-        t1 = time.perf_counter()
-        cs = build_cspace(sc)
-        t2 = time.perf_counter()
-        for k in range(cs.slabs):
-            cs.slab(k)
-        t3 = time.perf_counter()
-        regions_s = prepare(cs)  # the POSSIBLE regions the proof before sampling reads
-        exact_s = prepare(cs, exact=True) if "exact" in mine else 0.0  # FREE, meshes, links
-        t3 += regions_s + exact_s
+    qdata = read_toml(qfile)
+    first = qdata["queries"][0]
+    t0 = time.perf_counter()
+    imp = import_file(yaml, ImportOptions(robot={"polygon": POLYGON}, start=tuple(first["start"]),
+                                          goal=tuple(first["goal"])))
+    sc = with_queries(scenario_from_dict(imp.data, yaml, space="se2"), qdata, qfile)
+    t1 = time.perf_counter()
+    cs = build_cspace(sc)
+    t2 = time.perf_counter()
+    for k in range(cs.slabs):
+        cs.slab(k)
+    t3 = time.perf_counter()
+    regions_s = prepare(cs)  # the POSSIBLE regions the proof before sampling reads
+    exact_s = prepare(cs, exact=True) if "exact" in mine else 0.0  # FREE, meshes, links
+    t3 += regions_s + exact_s
     prep = {"import_s": t1 - t0, "cspace_s": t2 - t1, "slabs_s": t3 - t2 - regions_s - exact_s,
             "regions_s": regions_s, "exact_s": exact_s, "total_s": t3 - t0,
             "obstacle_pieces": len(cs.obstacle_pieces), "slabs": cs.slabs,
@@ -186,12 +225,8 @@ def main(argv=None) -> int:
     if peer:
         print(f"OMPL + coal (discrete motion checks): {peer_solved}/{n} solved; first solution mean {pm * 1e3:.1f} ms, "
               f"p95 {pct(peer_first, 95) * 1e3:.1f} ms; colliding paths {peer_bad}")
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump({"prep": prep, "ours": ours,
-                       "peer": {"first": peer_first, "solved": peer_solved, "colliding": peer_bad} if peer else None},
-                      fh, indent=1)
-    return 0
+    return {"prep": prep, "ours": ours,
+            "peer": {"first": peer_first, "solved": peer_solved, "colliding": peer_bad} if peer else None}
 
 
 def exact_first(sc, cs, q, limit: float):

@@ -190,10 +190,10 @@ if _fast is not None:  # cspace.kernel.minkowski.merge.minkowski_sum's small pai
     use_pair_sum(pair_sums)
 
 
-def contained(pieces: list, qs: np.ndarray, ps: np.ndarray) -> np.ndarray | None:
+def contained(pieces: list, qs: np.ndarray, ps: np.ndarray, packed: tuple | None = None) -> np.ndarray | None:
     """Per candidate pair (q, p): is piece p inside convex piece q? ``_fast.contained``
     (cspace/compiled/_build.c): 1 yes, 0 no, -1 not certified (the caller decides); None on
-    the pure path.
+    the pure path. ``packed``: the pieces' vertices end to end and their sizes, if the caller has them.
 
     >>> sq, small = np.array([[0., 0], [4, 0], [4, 4], [0, 4]]), np.array([[1., 1], [2, 1], [1, 2]])
     >>> r = contained([sq, small], np.array([0, 1]), np.array([1, 0]))
@@ -203,8 +203,9 @@ def contained(pieces: list, qs: np.ndarray, ps: np.ndarray) -> np.ndarray | None
     if _fast is None:
         return None
     off = np.zeros(len(pieces) + 1, dtype=np.int64)
-    np.cumsum([len(p) for p in pieces], out=off[1:])
-    xy = np.ascontiguousarray(np.concatenate(pieces) if pieces else np.zeros((0, 2)), dtype=np.float64)
+    np.cumsum(packed[1] if packed is not None else [len(p) for p in pieces], out=off[1:])
+    xy = packed[0] if packed is not None else np.concatenate(pieces) if pieces else np.zeros((0, 2))
+    xy = np.ascontiguousarray(xy, dtype=np.float64)
     out = np.empty(len(qs), dtype=np.int8)
     _fast.contained(xy, off, np.ascontiguousarray(qs, dtype=np.int64), np.ascontiguousarray(ps, dtype=np.int64), out)
     return out

@@ -33,7 +33,7 @@ import numpy as np
 from ..compiled import fastpath
 from ..translation.broadphase import GridIndex
 from ..translation.cspace import CSpace
-from ..translation.build import check_range, decompose_obstacles, decompose_robot, inflated, pair_sums
+from ..translation.build import check_range, contained_pieces, decompose_obstacles, decompose_robot, inflated, pair_sums
 from .pair_filter import pair_filter
 from .pose_checks import check_pieces, check_robot, se2_pose
 from .slab_build import build_slabs, slab_run
@@ -113,6 +113,7 @@ class SE2CSpace(SE2Motions):
         self._grids: list = [None] * K  # the one-lookup grid of each slab (see _combined_grid)
         self._built: list[dict] = []
         self._convex = None
+        self._nest = None  # _sums_nest's answer, once
         olo = np.array([p.min(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         ohi = np.array([p.max(axis=0) for p in self.obstacle_pieces]).reshape(-1, 2)
         self._olo, self._ohi = olo, ohi
@@ -180,7 +181,7 @@ class SE2CSpace(SE2Motions):
         if self._convex is None:  # the pieces' exact convexity, once for all slabs (all True)
             self._convex = [is_convex(p) for p in self.obstacle_pieces]
         outer = CSpace(self.bounds, self.obstacle_pieces, hulls, grid_cells=self.grid_cells or SLAB_GRID_CELLS,
-                       normalized=True, obstacle_convex=self._convex)  # decomposed, CCW pieces: no input conversion per slab
+                       normalized=True, obstacle_convex=self._convex, nested=self._sums_nest())  # decomposed, CCW pieces: no input conversion per slab
         t_outer = time.perf_counter() - t
         if len(outer.obstacle_pieces) != len(self.obstacle_pieces) or len(outer.robot_pieces) != len(hulls):
             # piece_pairs index our pieces: the slab must keep them as given (they are convex)
@@ -207,7 +208,8 @@ class SE2CSpace(SE2Motions):
         ks = [j for j in slab_run(k, self.slabs, pairs) if self._outer[j] is None]
         built = build_slabs(self.bounds, self.obstacle_pieces, self.robot_pieces, [self._lo[j] for j in ks],
                             [self._hi[j] for j in ks], scale=self.scale, pad=self.pad,
-                            grid_cells=self.grid_cells or SLAB_GRID_CELLS)
+                            grid_cells=self.grid_cells or SLAB_GRID_CELLS, obstacles_checked=True,
+                            nested=self._sums_nest())
         for j, (outer, inner, n_inner, seconds, outer_seconds) in zip(ks, built):
             t = time.perf_counter()
             self._outer[j], self._inner[j] = outer, inner
@@ -215,6 +217,13 @@ class SE2CSpace(SE2Motions):
             self._grids[j] = self._combined_grid(j, outer, inner)
             self._built.append({"slab": j, "seconds": seconds + time.perf_counter() - t, "outer_seconds": outer_seconds,
                                 "pieces": len(outer.pieces), "inner_pieces": n_inner})
+
+    def _sums_nest(self) -> bool:
+        """May a slab's sums lie inside one another? With one robot piece, only where obstacle
+        pieces do (Rådström's cancellation; see :meth:`CSpace._prune`): asked once."""
+        if self._nest is None:
+            self._nest = len(self.robot_pieces) != 1 or bool(contained_pieces(self.obstacle_pieces))
+        return self._nest
 
     def _combined_grid(self, k: int, outer: CSpace, inner) -> tuple:
         """Slab k's one-lookup grid: per cell 0 (FREE in the slab C-space: free at every
@@ -409,6 +418,15 @@ class SE2CSpace(SE2Motions):
         """
         self.checks["states"] = int(self._states.__reduce__()[1][0])
         return self.checks["states"]
+
+    def slabs_built(self) -> tuple[int, float]:
+        """How many slabs are built so far (each on its first use) and the seconds they took.
+
+        >>> cs = SE2CSpace((0, 4, 0, 4), [], [np.array([[0., 0], [1, 0], [0, 1]])], slabs=4)
+        >>> cs.slabs_built()[0], cs.is_free((2.0, 2.0, 0.0)), cs.slabs_built()[0] > 0
+        (0, True, True)
+        """
+        return len(self._built), sum(d["seconds"] for d in self._built)
 
     def report(self) -> dict:
         """K and its reason, the slabs built (seconds, piece counts) and the query counters."""

@@ -256,12 +256,16 @@ def _operand_sums(sums: list, nb: int, no: int, at: int, n: int) -> list:
 
 
 def build_slabs(bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray], lo: list[float],
-                hi: list[float], *, scale: float, pad: float, grid_cells: int) -> list[tuple]:
+                hi: list[float], *, scale: float, pad: float, grid_cells: int, obstacles_checked: bool = False,
+                nested: bool = True) -> list[tuple]:
     """Slabs ``[lo[k], hi[k]]`` at once: per slab ``(outer, inner, inner_pieces, seconds,
     outer_seconds)``, outer its :class:`CSpace` of the slab hulls, inner the BLOCKED cells
     (:meth:`GridIndex.blocked_cells`) of the obstacles summed with the inner sets on the
     outer grid's cells (False if there is none), as :meth:`cspace.se2.cspace.SE2CSpace` builds them one
-    by one; the seconds are each slab's share of the run's time.
+    by one; the seconds are each slab's share of the run's time. ``obstacles_checked``: the caller
+    ran :func:`check_range` on the obstacles (pieces of convex decompositions lie within them), so
+    only the bounds and the hulls are checked here (a map's thousands of pieces, once, not per run).
+    ``nested``: passed to each slab's :meth:`CSpace.from_sums` (False: no containment prune).
     """
     t0 = time.perf_counter()
     K, nr = len(lo), len(robot_pieces)
@@ -277,12 +281,13 @@ def build_slabs(bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np
     sums = pair_sums(obstacle_pieces, negs) if obstacle_pieces and negs else []
     t_sums = time.perf_counter() - t
     nb, no = len(negs), len(obstacle_pieces)
-    check_range(tuple(float(v) for v in bounds), list(obstacle_pieces) + [h for hs in hulls for h in hs])  # once, not per slab
+    check_range(tuple(float(v) for v in bounds), ([] if obstacles_checked else list(obstacle_pieces))
+                + [h for hs in hulls for h in hs])  # once, not per slab
     out = []
     for k in range(K):
         t = time.perf_counter()
         outer = CSpace.from_sums(bounds, obstacle_pieces, hulls[k], _operand_sums(sums, nb, no, k * nr, nr),
-                                 grid_cells=grid_cells, seconds=t_sums / K, checked=True)
+                                 grid_cells=grid_cells, seconds=t_sums / K, checked=True, nested=nested)
         t_outer = time.perf_counter() - t
         inner = False
         ni = len(inners[k])

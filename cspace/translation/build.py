@@ -108,13 +108,15 @@ FAR_VERTEX_PIECES = 4096
 BOX_PROPOSALS = 256
 
 
-def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None) -> dict[int, int]:
+def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarray] | None = None,
+                     packed: tuple[np.ndarray, np.ndarray] | None = None) -> dict[int, int]:
     """Convex pieces lying inside another piece (exact containment test): removed -> container.
 
     Candidate pairs come from bounding-box containment; a convex piece P lies in a
     convex piece Q iff every vertex of P is on or left of every edge of Q. Of two
     identical pieces only the later one is removed. ``boxes``: the pieces' (lo, hi)
-    (:func:`cspace.kernel.polygons.polygon.piece_boxes`) when the caller has them.
+    (:func:`cspace.kernel.polygons.polygon.piece_boxes`), ``packed``: their vertices end to end
+    and their sizes (:func:`cspace.kernel.polygons.polygon.pack`), when the caller has them.
     """
     n = len(pieces)
     if n < 2:
@@ -140,8 +142,8 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
             (lo[None, :, 1] >= lo[:, None, 1]) & (hi[None, :, 1] <= hi[:, None, 1])
         np.fill_diagonal(nest, False)
         qs, ps = np.nonzero(nest)  # exactly the pairs the filter below keeps
-    elif (sizes := np.fromiter((len(p) for p in pieces), np.int64, n)).min() >= 3:
-        flat = np.concatenate(pieces)
+    elif (sizes := packed[1] if packed is not None else np.fromiter((len(p) for p in pieces), np.int64, n)).min() >= 3:
+        flat = packed[0] if packed is not None else np.concatenate(pieces)
         owner = np.repeat(np.arange(n), sizes)
         rings = shapely.linearrings(flat, indices=owner)
         rep = np.cumsum(sizes) - sizes  # each piece's first vertex
@@ -164,24 +166,31 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
         qs, ps = qs[inside], ps[inside]
     if not len(qs):  # no box inside another (the common case): nothing to test
         return removed
+    from ..compiled import fastpath
+
+    # Compiled: every candidate's answer at once (-1 where not certified: the exact test below).
+    # A "no" removes nothing whatever the order (identical pieces answer "yes"): only the
+    # others go on, so a large map's thousands of nested boxes cost one C call, not a loop.
+    known = fastpath.contained(pieces, qs, ps, packed)
+    if known is not None:
+        go = known != 0
+        qs, ps, known = qs[go], ps[go], known[go]
+        if not len(qs):
+            return removed
     order = np.argsort(lo[:, 0], kind="stable")
     rank = np.empty(n, dtype=np.int64)
     rank[order] = np.arange(n)
     by = np.lexsort((rank[ps], qs))
     qs, ps = qs[by], ps[by]
+    known = known[by].tolist() if known is not None else [-1] * len(qs)
     cut = np.flatnonzero(np.diff(qs)) + 1
-    from ..compiled import fastpath
-
-    # Compiled: every candidate's answer at once (-1 where not certified: the exact test below).
-    known = fastpath.contained(pieces, qs, ps) if len(qs) else None
-    known = known.tolist() if known is not None else [-1] * len(qs)
     t = 0
-    for q, cand in zip(qs[np.r_[0, cut]].tolist() if len(qs) else [], np.split(ps, cut) if len(qs) else []):
+    for q, cand in zip(qs[np.r_[0, cut]].tolist(), np.split(ps, cut)):
         t0, t = t, t + len(cand)
         if q in removed:
             continue
         Q = pieces[q]
-        s, e = Q, np.roll(Q, -1, axis=0)
+        e = None  # Q's edges' ends, made for the first candidate the compiled test left open
         for p, answer in zip(cand.tolist(), known[t0:t]):
             if p in removed:
                 continue
@@ -189,7 +198,8 @@ def contained_pieces(pieces: list[np.ndarray], boxes: tuple[np.ndarray, np.ndarr
             if P.shape == Q.shape and p < q and np.array_equal(P, Q):
                 continue  # identical: keep the earlier one, drop q when it is visited as p
             if answer < 0:
-                answer = (orient2d_many(s[None, :, :], e[None, :, :], P[:, None, :]) >= 0).all()
+                e = np.roll(Q, -1, axis=0) if e is None else e
+                answer = (orient2d_many(Q[None, :, :], e[None, :, :], P[:, None, :]) >= 0).all()
             if answer:
                 removed[p] = q
     return removed

@@ -62,11 +62,14 @@ class CSpace(PointQueries, SegmentQueries):
         normalized: bool = False,
         obstacle_convex: list[bool] | None = None,
         margin: list[np.ndarray] | None = None,
+        nested: bool = True,
     ):
         # Obstacles and robot parts: (N, 2) arrays in either orientation or shapely Polygons /
         # MultiPolygons (cspace.translation.inputs); ``normalized`` says they are already the loader's
         # CCW, cleaned, validated arrays (from_scenario), so that work is not done twice;
-        # ``obstacle_convex`` then gives their exact convexity (Shape.convex).
+        # ``obstacle_convex`` then gives their exact convexity (Shape.convex). ``nested=False``: the
+        # caller knows no sum lies inside another but by rounding (see :meth:`_prune`).
+        self._nested = nested
         self.bounds = tuple(float(v) for v in bounds)
         self.stages: list[Stage] = []
         owner = None
@@ -188,7 +191,8 @@ class CSpace(PointQueries, SegmentQueries):
 
     @classmethod
     def from_sums(cls, bounds, obstacle_pieces: list[np.ndarray], robot_pieces: list[np.ndarray], sums: list[np.ndarray],
-                  *, grid_cells: int | None = None, seconds: float = 0.0, checked: bool = False) -> "CSpace":
+                  *, grid_cells: int | None = None, seconds: float = 0.0, checked: bool = False,
+                  nested: bool = True) -> "CSpace":
         """The C-space ``CSpace(bounds, obstacle_pieces, robot_pieces, normalized=True)`` builds when
         every obstacle and robot piece is convex (kept as it is) and ``sums`` are their pair
         sums obstacle piece ⊕ −(robot piece), obstacle-major, as :func:`pair_sums` gives them
@@ -205,6 +209,7 @@ class CSpace(PointQueries, SegmentQueries):
         (True, False)
         """
         self = cls.__new__(cls)
+        self._nested = nested
         self.bounds = tuple(float(v) for v in bounds)
         if not checked:
             check_range(self.bounds, list(obstacle_pieces) + list(robot_pieces))
@@ -225,7 +230,11 @@ class CSpace(PointQueries, SegmentQueries):
         return self
 
     def _prune(self, pieces, owner):
-        """Drop pieces that cannot meet the bounds, and pieces inside another piece.
+        """Drop pieces that cannot meet the bounds, and pieces inside another piece (unless the
+        C-space was made with ``nested=False``: an SE(2) slab of one robot piece whose obstacle
+        pieces do not nest. For convex sets A ⊕ C ⊆ B ⊕ C implies A ⊆ B (Rådström's
+        cancellation), so such sums nest only by rounding, and a piece inside another changes
+        no answer when it is kept: the test of thousands of a map's pieces is skipped).
 
         ``self.piece_pairs[k]`` lists the (obstacle piece, robot piece) pairs whose sum
         is kept piece k or lies inside it (robot piece -1 for a point robot): a point in
@@ -252,7 +261,8 @@ class CSpace(PointQueries, SegmentQueries):
             owner = owner[keep] if len(owner) else owner
             lo, hi = lo[keep], hi[keep]  # the kept pieces' boxes, for the containment test and the index
         outside = before - len(keep)
-        contained = contained_pieces(pieces, (lo, hi))
+        contained = contained_pieces(pieces, (lo, hi), (pts, sizes) if len(keep) == before else None) \
+            if getattr(self, "_nested", True) else {}
         if contained:
             for p in sorted(contained):
                 q = contained[p]

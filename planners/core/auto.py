@@ -4,8 +4,9 @@ It runs the project's planners as stages of one budget, each only when the ones 
 not answered, cheapest first (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
-   :data:`SLICE_SHARE` of the limit): an open scene, or a query on a large map, is answered here
-   in milliseconds, before any region of the slab graph is built;
+   :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
+   scene, or a query on a large map, is answered here in milliseconds, before any region of the
+   slab graph is built (every rotating robot and car: a Dubins car too);
 1. **slab graph** -- the slab graph's search at its first 8 slabs, no refinement (a few
    milliseconds on the bundled scenes): a certified path where FREE joins start and goal at
    once (a Reeds–Shepp car's SE(2) path, asked to keep some room, turned into certified curves:
@@ -14,7 +15,7 @@ not answered, cheapest first (a rotating robot or a Reeds–Shepp car):
    :func:`planners.core.exact_se2.quick_proof`; a translating one, where it comes first: start
    and goal in different free components, :func:`planners.core.exact.separated_proof`);
 3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`; all of it for a
-   Dubins car, which has no complete method here and starts at the proof);
+   Dubins car, which has no complete method here and goes from the slice to the proof);
 4. **refinement** -- the exact planner with the rest: the slab graph refined where FREE and
    POSSIBLE disagree (SE(2); a Reeds–Shepp car's path converted as in 1), then sampling again
    with whatever is left; for a translating robot the exact shortest path.
@@ -94,11 +95,11 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
 
     if tuple(query.start) == tuple(query.goal):
         return _answer(sample(time_limit, None), "sampling", clock, seed)
-    if turns and kind != "dubins":  # a slice of sampling: an open scene is answered here, a large map too
-        r = sample(min(SLICE_SHARE * time_limit, clock.left()), SLICE_ITERATIONS)
+    if turns:  # a slice of sampling: an open scene is answered here, a large map too
+        r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
             return _answer(r, "sampling", clock, seed)
-        # FREE at the first slabs, and POSSIBLE there where FREE does not join
+    if turns and kind != "dubins":  # FREE at the first slabs, and POSSIBLE there where FREE does not join
         r = clock.run("slab graph", lambda: _slab_graph(sc, cspace, adapter, query, source,
                                                        min(SLAB_SHARE * time_limit, clock.left()), simplify,
                                                        refine=False))
@@ -137,6 +138,21 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
                             length=math.inf, planner="auto", seed=seed, start=tuple(query.start),
                             goal=tuple(query.goal), message=f"not solved within the time limit ({time_limit:g} s)")
     return _answer(failed, None, clock, seed)
+
+
+def sampling_slice(sample, cspace, clock, time_limit: float) -> PlanResult:
+    """Stage 0: RRTConnect for :data:`SLICE_ITERATIONS` iterations within :data:`SLICE_SHARE` of
+    the limit. The slabs it meets first are built inside it (on a large map, tens of
+    milliseconds each: a fresh C-space's first query builds most of them); a slice whose time
+    ran out while it built slabs is run again (the same seed: the run a C-space with those slabs
+    makes), so that the iteration budget, not the builds, decides whether the slice answers."""
+    built = getattr(cspace, "slabs_built", lambda: (0, 0.0))
+    while True:
+        n, t = built()[0], _now()
+        budget = min(SLICE_SHARE * time_limit, clock.left())
+        r = sample(budget, SLICE_ITERATIONS)
+        if r.solved or built()[0] == n or _now() - t < 0.9 * budget or clock.left() <= 0:
+            return r
 
 
 def _slab_graph(sc, cspace, adapter, query, source, budget: float, simplify: bool, refine: bool):
