@@ -62,6 +62,8 @@ def resolution(regions, widest: float, slack: float) -> tuple[float, str]:
     >>> round(D, 6), words.startswith("no path with clearance above 0.01")
     (0.01, True)
     """
+    if not math.isfinite(widest):
+        return math.inf, "no statement on the clearance of paths (no FREE graph was searched to its end)"
     r = regions.radius
     turn = r * (widest + 2.0 * slack) + 4.0 * regions.hull_pad
     D = regions.margin_reach + turn + regions.excess
