@@ -72,7 +72,9 @@ def resolution(regions, widest: float, slack: float) -> tuple[float, str]:
         parts.insert(0, f"the margin's reach {regions.margin_reach:.6g}")
     if regions.excess:
         parts.append(f"disks' polygon error {regions.excess:.3g}")
-    return D, (f"no path with clearance above {D:.6g} ({' + '.join(parts)}) exists; a tighter one was not decided")
+    disks = "; a smaller disk_tolerance narrows the disks' share" if regions.excess else ""
+    return D, (f"no path with clearance above {D:.6g} ({' + '.join(parts)}) exists; a tighter one was not decided"
+               f"{disks}")
 
 
 def disk_excess(sc) -> float:

@@ -141,3 +141,14 @@ def test_a_time_limit_inside_a_refinement_states_what_the_last_searched_partitio
     res = from_scenario(sc, time_limit=-1.0)  # no time: no FREE graph searched
     assert res.status == "undecided" and res.resolution == math.inf
     assert "no statement" in res.stats["statement"]
+
+
+def test_a_statement_with_disks_names_the_setting_that_narrows_them():
+    from conftest import load_script
+
+    sc = load_script("se2_families").pillars(0)  # the room (0.004) is below the disks' polygon error (0.017)
+    res = from_scenario(sc, refine=False)
+    assert res.status == "undecided" and "disks' polygon error" in res.stats["statement"]
+    assert "a smaller disk_tolerance" in res.stats["statement"]
+    res = from_scenario(rail(1e-3), refine=False)  # no disk: not said
+    assert res.status != "undecided" or "disk_tolerance" not in res.stats["statement"]
