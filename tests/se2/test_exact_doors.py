@@ -138,3 +138,17 @@ def test_a_translation_at_the_starts_own_angle_goes_through_a_tunnel_no_slab_hol
 def test_every_designed_scene_is_solved_or_truly_stated(name, seed):
     assert _judge(name, seed).status == "solved"
     _judge(name, seed, sweep_witness=False, min_width=2 * math.pi / 32)  # a coarse floor: solved or truly stated
+
+
+def test_the_bench_runs_a_designed_family_without_its_peer(tmp_path, capsys):
+    import json
+
+    bench = load_script("bench_se2_exact")
+    out = tmp_path / "rows.json"
+    assert bench.main(["--families", "1", "--family", "seam one motion", "--peer-time", "0", "--time", "30",
+                       "--json", str(out)]) == 0
+    (row,) = json.loads(out.read_text())
+    assert row["family"] == "seam one motion" and row["solved"] == 1 and row["rrt_solved"] is None
+    assert row["colliding"] == 0 and row["proofs_refused"] == 0
+    text = capsys.readouterr().out
+    assert "RRTConnect not run (--peer-time 0)" in text and "seam one motion: solved 1/1 (all)" in text
