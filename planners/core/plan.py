@@ -172,8 +172,9 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     # goal checks build the slabs of a small scene) count against the time limit.
     built_s = load_s + (_now() - wall0) if se2 else 0.0
     tlim -= built_s
-    # a rotating robot's clearance measure refines its bound only until the queries' time is up
-    deadline = _now() + max(tlim, 0.0) * len(queries) if sc.space == "se2" else None
+    # exact's clearance measure of a rotating robot's path refines its bound only until the queries'
+    # time is up (a sampling planner's, often anytime and using its whole limit, is measured in full)
+    deadline = _now() + max(tlim, 0.0) * len(queries) if sc.space == "se2" and name == "exact" else None
     if tlim <= 0:
         results = [_out_of_time(sc, name, sd, q, built_s) for q in queries]
     elif name == "exact" and se2:
