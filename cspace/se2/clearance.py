@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import heapq
 import math
+import time
 
 import numpy as np
 
@@ -30,13 +31,17 @@ MAX_SPLITS = 20000  # sub-motions evaluated at most (then the bound found so far
 
 
 def se2_path_clearance(path, robot_pieces: list, obstacle_pieces: list, angle_step: float = ANGLE_STEP,
-                       max_splits: int = MAX_SPLITS, nearest: Nearest | None = None) -> PathClearance:
+                       max_splits: int = MAX_SPLITS, nearest: Nearest | None = None,
+                       deadline: float | None = None) -> PathClearance:
     """A certified lower bound of a rotating robot's path clearance (module docstring).
 
     ``path`` is (N, 3) poses (x, y, θ) joined by OMPL's SE(2) interpolation;
     ``robot_pieces`` are convex, in the body frame. ``nearest``: a :class:`Nearest` of
     ``obstacle_pieces`` kept by the caller (a C-space's, for many paths); only the pieces
-    near the path are searched (:func:`near_path`: the same answer, to the bit).
+    near the path are searched (:func:`near_path`: the same answer, to the bit). ``deadline``
+    (a ``time.perf_counter()`` value): past it no piece is split further, and the least bound so
+    far is returned (``cut``: still a lower bound, a looser one); the first pass, one bound per
+    quarter turn of each motion, always runs (linear in the path).
 
     >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
     >>> bar = [np.array([[-1., -0.1], [1, -0.1], [1, 0.1], [-1, 0.1]])]
@@ -84,10 +89,14 @@ def se2_path_clearance(path, robot_pieces: list, obstacle_pieces: list, angle_st
         n = max(1, math.ceil(arc / (0.25 * math.pi)))  # slab hulls span at most a quarter turn
         for s in range(n):
             push(i, s / n, (s + 1) / n)
+    cut = False
     while True:
         d, _, i, t0, t1, width, w = heap[0]
         if width <= angle_step or not math.isfinite(d) or count >= max_splits or d >= upper * (1.0 - 1e-9):
             break  # (the bound meets a distance actually reached: it cannot rise further)
+        if deadline is not None and time.perf_counter() >= deadline:
+            cut = True
+            break
         heapq.heappop(heap)
         tm = 0.5 * (t0 + t1)
         push(i, t0, tm)
@@ -95,7 +104,7 @@ def se2_path_clearance(path, robot_pieces: list, obstacle_pieces: list, angle_st
     if w is None:
         return PathClearance(math.inf, (), (), -1, "lower")
     where = interpolate(poses[i], poses[i + 1], 0.5 * (t0 + t1))
-    return PathClearance(float(d), tuple(float(v) for v in where), tuple(float(v) for v in w), i, "lower")
+    return PathClearance(float(d), tuple(float(v) for v in where), tuple(float(v) for v in w), i, "lower", cut)
 
 
 def near_path(obs: Nearest, poses: np.ndarray, rob: list) -> list[Nearest]:

@@ -7,7 +7,8 @@ the zero-width slab [φ, φ] (FREE: the exact translation C-space of the turned 
 δ) holds it at once. The critical angles are φ = ω − ρ (mod π): ω an obstacle edge's direction,
 ρ a robot edge's; each is weighed by the obstacle edges' length at it, and the heaviest few are
 inserted (4: the two senses of two perpendicular walls for a box) into the partition of the
-search (:mod:`cspace.se2.exact`) after its second round.
+search (:mod:`cspace.se2.exact`) after its second round, with the start's and goal's own angles.
+:func:`initial_partition` is the search's first partition (8 equal slabs covering the circle).
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import math
 import numpy as np
 
 from ..kernel.polygons.rotation import wrap_angle
+from ..kernel.slabs.slab import slab_range
 
 
 def critical_angles(robot: list, obstacles: list, count: int = 4) -> list[float]:
@@ -74,3 +76,17 @@ def with_zero_slabs(part: list, angles: list[float]) -> list:
                 out[k + 1:k + 1] = [(phi, phi)]
                 break
     return out
+
+
+def initial_partition(n: int = 8) -> list[tuple[float, float]]:
+    """The search's first slabs: ``n`` equal ones from −π, the last ending one ulp above the float
+    π (which is below the true π), so that they cover the circle in exact arithmetic (last b −
+    first a > 2π), as a proof needs.
+
+    >>> p = initial_partition(8)
+    >>> len(p), p[0][0] == -math.pi, p[-1][1] > math.pi, all(p[k][1] == p[k + 1][0] for k in range(7))
+    (8, True, True, True)
+    """
+    part = [slab_range(k, n) for k in range(n)]
+    part[-1] = (part[-1][0], math.nextafter(math.pi, math.inf))
+    return part

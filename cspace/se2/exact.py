@@ -11,10 +11,8 @@ polygons with holes, and their connected components.
   holding θs that contains its (x, y) (free at every angle of the slab); where none does,
   it joins through the FREE region at its own angle (a zero-width slab): its component
   there is linked to the FREE components of the slab(s) holding θs that overlap it. The
-  goal likewise. A walk from start to goal is a
-  certified path: translations at a fixed angle (short paths inside one component, checked
-  exactly: :mod:`cspace.se2.exact_path`)
-  and rotations in place.
+  goal likewise. A walk from start to goal is a certified path: translations at a fixed angle
+  (short paths inside one component, checked exactly: :mod:`cspace.se2.exact_path`) and rotations in place.
 - POSSIBLE graph: nodes (slab, component); components of adjacent slabs are linked when their
   closures meet (within a tolerance, toward more links); start and goal belong to every
   POSSIBLE component of their slab(s) whose closure is within the tolerance of their (x, y).
@@ -23,13 +21,14 @@ polygons with holes, and their connected components.
   looked for, only when FREE does not join start and goal.
 - Otherwise slabs are bisected: those on a cheapest POSSIBLE walk from start to goal whose
   nodes or links FREE does not yet reproduce ("FREE breaks there"), else those anywhere in
-  the start's POSSIBLE component where it breaks, else all. The search stops at ``min_width``
-  (no slab is cut below it) or at ``time_limit`` (checked before every region is built):
-  After two rounds, zero-width slabs at the critical angles (a robot edge parallel to an
-  obstacle edge: :mod:`cspace.se2.critical`) join the partition (a door just wider than the robot).
-  "undecided", with the resolution D = r·Δmax + the margin's reach + the disks' polygon error
-  (no path with clearance above D exists, since such a path would lie in FREE; note section 4,
-  :mod:`cspace.se2.exact_report`).
+  the start's POSSIBLE component where it breaks, else all (slabs on the cheapest walk even below
+  the floor, to 2^-6 of it). After two rounds, zero-width slabs at the critical angles (a robot
+  edge parallel to an obstacle edge, :mod:`cspace.se2.critical`: a door just wider than the robot)
+  and at the start's and goal's own angles (a translation at an end's angle through a passage no
+  slab's FREE holds) join the partition. The search stops at ``min_width`` or at ``time_limit``
+  (checked before every region is built): "undecided", with the resolution D = r·Δmax + the
+  margin's reach + the disks' polygon error (no path with clearance above D exists, since such a
+  path would lie in FREE; note section 4, :mod:`cspace.se2.exact_report`).
 
 Angles are OMPL's, wrapped to [−π, π); a pose on the boundary ±π belongs to the first and
 the last slab. Nothing depends on randomness or on the iteration order of a set.
@@ -42,11 +41,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..kernel.slabs.slab import slab_range
 from ..kernel.polygons.rotation import TWO_PI, wrap_angle
 from .slab_graph import SlabRegions, point_free
 from .exact_path import AssemblyError, assemble, holding
-from .critical import critical_angles, with_zero_slabs
+from .critical import critical_angles, initial_partition, with_zero_slabs  # noqa: F401 (initial_partition: the API)
 from .exact_report import PROOF_FORMAT, disk_excess, margin_reach, proof_json, resolution  # noqa: F401
 from ..kernel.slabs.slab import ANGLE_SLACK
 from .walks import G_NODE, S_NODE, cheapest_walk, labels, reach, shortest_walk
@@ -121,20 +119,6 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
     return search.run()
 
 
-def initial_partition(n: int = 8) -> list[tuple[float, float]]:
-    """The search's first slabs: ``n`` equal ones from −π, the last ending one ulp above the float
-    π (which is below the true π), so that they cover the circle in exact arithmetic (last b −
-    first a > 2π), as a proof needs.
-
-    >>> p = initial_partition(8)
-    >>> len(p), p[0][0] == -math.pi, p[-1][1] > math.pi, all(p[k][1] == p[k + 1][0] for k in range(7))
-    (8, True, True, True)
-    """
-    part = [slab_range(k, n) for k in range(n)]
-    part[-1] = (part[-1][0], math.nextafter(math.pi, math.inf))
-    return part
-
-
 def slab_regions(obstacle_pieces: list, robot_pieces: list, bounds, margin: list | None = None, *,
                  inner_obstacles: list | None = None, inner_robot: list | None = None,
                  excess: float = 0.0) -> SlabRegions:
@@ -202,6 +186,7 @@ class _Search:
         self.banned: set = set()  # FREE links a failed assembly ruled out (by _key)
         self.force: set = set()  # slabs (a, b) to bisect at the next refinement
         self.repairs: list = []
+        self.searched = None  # the widest slab of the last partition whose FREE graph joined nothing: D's Δ
 
     # -- the loop ------------------------------------------------------------------------
 
@@ -220,6 +205,8 @@ class _Search:
                     fadj = self._free_graph(freg)
                     walk = shortest_walk(fadj, S_NODE, G_NODE, self.start[:2], self.goal[:2], self._turn_cost)
                     self.times["graphs"] += time.perf_counter() - t
+                    if walk is None and not self.banned:  # (a ban may hide a walk FREE has: no statement then)
+                        self.searched = max(b - a for a, b in self.part)
                     if walk is not None:
                         t = time.perf_counter()
                         try:
@@ -246,8 +233,9 @@ class _Search:
                 self.times["graphs"] += time.perf_counter() - t
                 if not self._split(split):
                     return self._result("undecided", reason="minimum slab width reached")
-                if self.refinements == 2:  # after two rounds: zero-width slabs at the critical angles
-                    self.part = with_zero_slabs(self.part, critical_angles(self.R.hull_robot, self.R.obstacles))
+                if self.refinements == 2:  # after two rounds: zero-width slabs at the critical angles, the ends' own
+                    self.part = with_zero_slabs(self.part, critical_angles(self.R.hull_robot, self.R.obstacles)
+                                                + [self.start[2], self.goal[2]])
         except _Timeout:
             return self._result("undecided", reason="time limit")
 
@@ -429,7 +417,10 @@ class _Search:
 
     def _result(self, status: str, path=None, proof=None, **extra) -> SE2ExactResult:
         widest = max(b - a for a, b in self.part)
-        D, words = resolution(self.R, widest, ANGLE_SLACK)
+        # "undecided": D from the last partition whose FREE graph was searched and joined nothing (a
+        # partition refined since, whose FREE the time limit cut, establishes nothing yet)
+        D, words = resolution(self.R, widest if status != "undecided" else
+                              math.inf if self.searched is None else self.searched, ANGLE_SLACK)
         stats = {"slabs": len(self.part), "refinements": self.refinements, "regions_built": dict(self.R.counts),
                  "repairs": len(self.repairs),
                  "graphs": dict(self.graph_sizes), "seconds": dict(self.times),

@@ -62,6 +62,8 @@ def resolution(regions, widest: float, slack: float) -> tuple[float, str]:
     >>> round(D, 6), words.startswith("no path with clearance above 0.01")
     (0.01, True)
     """
+    if not math.isfinite(widest):
+        return math.inf, "no statement on the clearance of paths (no FREE graph was searched to its end)"
     r = regions.radius
     turn = r * (widest + 2.0 * slack) + 4.0 * regions.hull_pad
     D = regions.margin_reach + turn + regions.excess
@@ -70,7 +72,9 @@ def resolution(regions, widest: float, slack: float) -> tuple[float, str]:
         parts.insert(0, f"the margin's reach {regions.margin_reach:.6g}")
     if regions.excess:
         parts.append(f"disks' polygon error {regions.excess:.3g}")
-    return D, (f"no path with clearance above {D:.6g} ({' + '.join(parts)}) exists; a tighter one was not decided")
+    disks = "; a smaller disk_tolerance narrows the disks' share" if regions.excess else ""
+    return D, (f"no path with clearance above {D:.6g} ({' + '.join(parts)}) exists; a tighter one was not decided"
+               f"{disks}")
 
 
 def disk_excess(sc) -> float:

@@ -49,7 +49,8 @@ class PathClearance(NamedTuple):
     ``distance`` (inf without obstacles), ``where``: the reference pose on the path
     where it occurs, ``obstacle_point``: the closest point of the obstacle, ``segment``:
     the path segment's index, ``bound``: ``"exact"`` (translation) or ``"lower"`` (SE(2):
-    never more than the true clearance).
+    never more than the true clearance); ``cut``: the measure stopped at its deadline before its
+    precision (still a lower bound, a looser one).
     """
 
     distance: float
@@ -57,6 +58,7 @@ class PathClearance(NamedTuple):
     obstacle_point: tuple
     segment: int
     bound: str
+    cut: bool = False
 
 
 class Nearest:

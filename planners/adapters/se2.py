@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import time
 
 import numpy as np
 
@@ -61,14 +62,15 @@ class SE2Space:
 
         return state, motion
 
-    def path_clearance(self, path: np.ndarray):
+    def path_clearance(self, path: np.ndarray, deadline: float | None = None):
         """A certified lower bound of the clearance of the ROBOT (body pieces, not inflated)
-        along ``path`` (:func:`cspace.se2.clearance.se2_path_clearance`)."""
+        along ``path`` (:func:`cspace.se2.clearance.se2_path_clearance`; refined until
+        ``deadline``, a ``time.perf_counter()`` value, at most)."""
         from cspace.se2.clearance import se2_path_clearance
         from .frame import obstacle_nearest
 
         return se2_path_clearance(path, self.cspace.body_pieces, self.cspace.obstacle_pieces,
-                                  nearest=obstacle_nearest(self.cspace))
+                                  nearest=obstacle_nearest(self.cspace), deadline=deadline)
 
     def state_space(self):
         from .glue import ompl
@@ -146,6 +148,28 @@ class SE2Space:
         """Every motion certified free, from the start pose exactly to the goal pose exactly."""
         return verify_path(path, self.pose(start), self.pose(goal), self.motion_free, step=self.step,
                            test="certified", ends="the start pose to the goal pose")
+
+    def verify_until(self, path: np.ndarray, start, goal, deadline: float | None) -> tuple[bool, str, int | None]:
+        """:meth:`verify` that stops at ``deadline`` (a ``time.perf_counter()`` value, looked at
+        before each motion): (ok, why, None) when it ran to its end, else (True, why, k) after k
+        motions all free (the rest not checked: the caller says so)."""
+        done = [0]
+
+        class Late(Exception):
+            pass
+
+        def step(a, b) -> bool:
+            if deadline is not None and time.perf_counter() >= deadline:
+                raise Late
+            done[0] += 1
+            return self.motion_free(a, b)
+
+        try:
+            ok, why = verify_path(path, self.pose(start), self.pose(goal), step, step=self.step,
+                                  test="certified", ends="the start pose to the goal pose")
+        except Late:
+            return True, f"{done[0]} of {len(path) - 1} motions re-checked before the time limit", done[0]
+        return ok, why, None
 
     def length(self, path: np.ndarray) -> float:
         """Length travelled by the reference point (the bound of the inscribed disk bounds it)."""

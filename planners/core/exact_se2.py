@@ -170,15 +170,17 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
                           message=f"not decided ({why}; {graph}): {st['statement']}; try a longer --time, or a "
                                   "sampling planner (it may find a path closer to the obstacles)", **base)
     raw = np.asarray(res.path, dtype=np.float64)
-    t1 = time.perf_counter()
-    ok, why = adapter.verify(raw, query.start, query.goal)
+    t1 = time.perf_counter()  # the re-check and the shortening keep --time too (a re-check cut short says so)
+    ok, why, cut = adapter.verify_until(raw, query.start, query.goal, None if time_limit is None else t0 + time_limit)
     timings["verify"] = time.perf_counter() - t1
     found_cpu = time.process_time()
     if not ok:  # the slab graph certifies its path; this re-check is the second opinion
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,
                           message=f"the slab graph's path failed the certified re-check ({why}): not solved", **base)
     path, note = raw, "not shortened (--no-simplify)"
-    if simplify:
+    if cut is not None:  # every motion was checked exactly as the slab graph built it; the second opinion ran out of time
+        note = f"{why} (each motion was checked exactly as the slab graph built it); not shortened: no time left"
+    elif simplify:
         t2 = time.perf_counter()
         left = None if time_limit is None else max(0.0, float(time_limit) - (t2 - t0))
         path, note = shorten(adapter, raw, query, time_limit=left)

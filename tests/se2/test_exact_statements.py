@@ -113,3 +113,42 @@ def test_an_undecided_door_between_disks_states_at_least_its_witness(R, spare, s
     assert res.status != "unsolvable"
     if res.status == "undecided" and wc > clearance:
         assert stated(res) >= wc, (res.stats["statement"], wc)
+
+
+def test_a_time_limit_inside_a_refinement_states_what_the_last_searched_partition_established(monkeypatch):
+    """The time limit comes while FREE of a refined partition is built: its graph was never searched,
+    so D is the last searched partition's (8 slabs, Δ = π/4), not the finer one's; before any FREE
+    graph was searched there is no statement (the clock is the test's: the deadline is set past)."""
+    from conftest import load_script
+    from cspace.se2 import exact
+
+    sc = load_script("se2_families").door(0, 0.003)
+    split = exact._Search._split
+
+    def split_all_then_late(self, _which):
+        done = split(self, set(range(len(self.part))))  # every slab halved: Δ π/8
+        self.deadline = -math.inf  # the time is up while the halves' FREE is built
+        return done
+
+    monkeypatch.setattr(exact._Search, "_split", split_all_then_late)
+    res = from_scenario(sc, time_limit=1e9)
+    assert res.status == "undecided" and res.stats["reason"] == "time limit"
+    assert res.stats["widest_slab"] < 0.4  # the partition was refined ...
+    # ... but D is r·π/4 at least (r >= L/2), where the refined partition's would be r·π/8 <= 0.71·(L/2)·π/4
+    half = float(sc.robot[0].polygon[:, 0].max())
+    assert res.stats["resolution"] >= half * math.pi / 4 and stated(res) >= half * math.pi / 4 * 0.999
+    monkeypatch.setattr(exact._Search, "_split", split)
+    res = from_scenario(sc, time_limit=-1.0)  # no time: no FREE graph searched
+    assert res.status == "undecided" and res.resolution == math.inf
+    assert "no statement" in res.stats["statement"]
+
+
+def test_a_statement_with_disks_names_the_setting_that_narrows_them():
+    from conftest import load_script
+
+    sc = load_script("se2_families").pillars(0)  # the room (0.004) is below the disks' polygon error (0.017)
+    res = from_scenario(sc, refine=False)
+    assert res.status == "undecided" and "disks' polygon error" in res.stats["statement"]
+    assert "a smaller disk_tolerance" in res.stats["statement"]
+    res = from_scenario(rail(1e-3), refine=False)  # no disk: not said
+    assert res.status != "undecided" or "disk_tolerance" not in res.stats["statement"]
