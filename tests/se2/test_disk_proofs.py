@@ -34,6 +34,7 @@ def inside_exactly(p, c, r) -> bool:
                for x, y in p.tolist())
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None)
 @given(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6), st.floats(1e-3, 1e3), st.integers(8, 400))
 @example(1e6, -1e6, 1e-3, 71)
