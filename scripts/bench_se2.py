@@ -311,7 +311,7 @@ def part_p(seeds: int, budget: float, peers: tuple[str, ...], planner: str = "RR
     rows = []
     from benchutil import Progress
 
-    progress = Progress(f"bench_se2 (P): {len(scenes)} scenes x {seeds} seeds, ours and {len(peers)} peers, interleaved",
+    progress = Progress(f"bench_se2 (P): {len(scenes)} scenes x {seeds} seeds, ours and {len(peers)} peer{'' if len(peers) == 1 else 's'}, interleaved",
                         len(scenes) * seeds, most_s=budget * (1 + len(peers)), unit="rounds")
     for sc in scenes:
         cs = build_cspace(sc)

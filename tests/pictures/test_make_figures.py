@@ -25,7 +25,7 @@ def test_basic_group_writes_real_pictures(tmp_path):
     import matplotlib.image as mpimg
 
     names = sorted(os.listdir(out))
-    assert names == ["basic_cspace.png", "basic_exact.png", "basic_plan.png", "theta_cspace.png"]
+    assert names == ["basic_cspace.png", "basic_exact.png", "basic_plan.png", "theta_cspace.png", "u_robot_cspace.png"]
     for n in names:
         path = out / n
         assert path.stat().st_size > 10_000, n  # a drawing, not an empty canvas
