@@ -40,6 +40,7 @@ FAMILIES = ("maze", "bug_trap", "narrow_passage", "random_polygons", "disks", "o
 SEED = 1
 DPI = 130  # the pictures of planners.pictures.plot (the bench, slab and stability charts keep their own 110)
 LEGEND_KEY = "Legend"  # PNG text key holding the legend entries, one a line
+LIBRARIES_KEY = "Libraries"  # numpy, shapely and matplotlib versions: the same ones draw the same pixels
 
 
 @dataclass
@@ -71,7 +72,7 @@ def save_fixed(fig, out: str, fmt: str | None = None) -> None:
     fmt = fmt or os.path.splitext(out)[1].lstrip(".").lower() or "png"
     fig.tight_layout()
     _fit_inside(fig)
-    meta = {LEGEND_KEY: "\n".join(figure_legend(fig))} if fmt == "png" else None
+    meta = {LEGEND_KEY: "\n".join(figure_legend(fig)), LIBRARIES_KEY: libraries()} if fmt == "png" else None
     with atomic_path(out) as tmp:
         fig.savefig(tmp, format=fmt, dpi=DPI, metadata=meta)
     plt.close(fig)
@@ -109,6 +110,27 @@ class fixed_size_saves:
     def __exit__(self, *exc):
         self._plot.save = self._saved
         return False
+
+
+def libraries() -> str:
+    """The versions of the libraries a drawing's pixels depend on (its geometry's and its renderer's).
+
+    >>> libraries().startswith("numpy ")
+    True
+    """
+    import matplotlib
+    import numpy
+    import shapely
+
+    return f"numpy {numpy.__version__}, shapely {shapely.__version__}, matplotlib {matplotlib.__version__}"
+
+
+def drawn_with(png: str) -> str | None:
+    """The libraries recorded in a PNG by :func:`save_fixed` (None when it has none recorded)."""
+    from PIL import Image
+
+    with Image.open(png) as im:
+        return im.info.get(LIBRARIES_KEY)
 
 
 def legend_labels(png: str) -> list[str] | None:
@@ -391,9 +413,25 @@ def select(all_figs: list[Figure], only: str | None) -> list[Figure]:
 
 
 def draw_figure(fig: Figure, path: str) -> str:
-    """Draw one figure to ``path`` at its fixed size; returns its one-line summary."""
+    """Draw one figure to ``path`` at its fixed size; returns its one-line summary. A PNG drawn by
+    a routine of its own (not :func:`save_fixed`) gets the libraries recorded afterwards."""
     with fixed_size_saves():
-        return fig.draw(path)
+        summary = fig.draw(path)
+    if path.endswith(".png") and os.path.exists(path) and drawn_with(path) is None:
+        from PIL import Image, PngImagePlugin
+
+        with Image.open(path) as im:
+            im.load()
+            info = PngImagePlugin.PngInfo()
+            for k, v in im.info.items():
+                if isinstance(v, str):
+                    info.add_text(k, v)
+            info.add_text(LIBRARIES_KEY, libraries())
+            from planners.output import atomic_path
+
+            with atomic_path(path) as tmp:
+                im.save(tmp, format="png", pnginfo=info)
+    return summary
 
 
 def main(argv: list[str] | None = None) -> int:
