@@ -146,27 +146,31 @@ class SE2Space:
 
     def verify(self, path: np.ndarray, start, goal) -> tuple[bool, str]:
         """Every motion certified free, from the start pose exactly to the goal pose exactly."""
-        return verify_path(path, self.pose(start), self.pose(goal), self.motion_free, step=self.step,
+        return self._verify_with(path, start, goal, self.motion_free)
+
+    def _verify_with(self, path: np.ndarray, start, goal, motion_free) -> tuple[bool, str]:
+        return verify_path(path, self.pose(start), self.pose(goal), motion_free, step=self.step,
                            test="certified", ends="the start pose to the goal pose")
 
     def verify_until(self, path: np.ndarray, start, goal, deadline: float | None) -> tuple[bool, str, int | None]:
         """:meth:`verify` that stops at ``deadline`` (a ``time.perf_counter()`` value, looked at
         before each motion): (ok, why, None) when it ran to its end, else (True, why, k) after k
         motions all free (the rest not checked: the caller says so)."""
+        if deadline is None:
+            return (*self.verify(path, start, goal), None)
         done = [0]
 
         class Late(Exception):
             pass
 
-        def step(a, b) -> bool:
-            if deadline is not None and time.perf_counter() >= deadline:
+        def motion_free(a, b) -> bool:
+            if time.perf_counter() >= deadline:
                 raise Late
             done[0] += 1
             return self.motion_free(a, b)
 
         try:
-            ok, why = verify_path(path, self.pose(start), self.pose(goal), step, step=self.step,
-                                  test="certified", ends="the start pose to the goal pose")
+            ok, why = self._verify_with(path, start, goal, motion_free)
         except Late:
             return True, f"{done[0]} of {len(path) - 1} motions re-checked before the time limit", done[0]
         return ok, why, None
