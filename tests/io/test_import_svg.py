@@ -83,6 +83,15 @@ def test_curves_are_refused_in_one_line_naming_the_path(tmp_path, capsys):
     assert code == 2 and len(err) == 1 and "path 'kerb'" in err[0] and "--flatten-curves" in err[0]
 
 
+def test_an_unnamed_path_is_named_by_its_rank_among_paths_and_its_line(tmp_path, capsys):
+    # groups and other elements before it must not shift its number: the user counts paths
+    f = write(tmp_path, '<g>\n<rect/>\n<path d="M 0,0 H 1 V 1 Z"/>\n<g><path d="M 0,0 Q 2,3 4,0 Z"/></g></g>')
+    code = main(["import", f, "--out", str(tmp_path / "o.toml"), "--start", "5,5", "--goal", "6,5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    line = 1 + open(f).read().split("Q 2,3")[0].count("\n")
+    assert code == 2 and len(err) == 1 and f"path #2 (line {line})" in err[0], err
+
+
 @pytest.mark.parametrize("d", ["M 0,0 C 1,2 3,2 4,0 Z", "M 0,0 Q 2,3 4,0 Z", "M 0,0 A 2,1 0 0 1 4,0 Z",
                                "M 0,0 c 1,2 3,2 4,0 s 2,-2 3,0 z", "M 0,0 q 2,3 4,0 t 4,0 z"])
 def test_flattened_curves_contain_the_curve(tmp_path, d):

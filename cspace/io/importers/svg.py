@@ -65,7 +65,7 @@ def read_drawing(raw: bytes, path: str) -> tuple[list[dict], dict]:
     stack: list[tuple[np.ndarray, str, bool]] = [(FLIP, "nonzero", True)]  # matrix, fill rule, drawn
     paths: list[dict] = []
     skipped: dict[str, int] = {}
-    count = [0]
+    count: dict[str, int] = {}  # elements of each kind so far: an unnamed one is named by its rank and line
 
     def doctype(name, *_):
         raise _Refused("<!DOCTYPE>", f"a DOCTYPE (here {name!r}) is refused: entities could expand or read files")
@@ -76,10 +76,10 @@ def read_drawing(raw: bytes, path: str) -> tuple[list[dict], dict]:
     def start(name, attrs):
         ns, _, local = name.rpartition(" ")
         matrix, rule, drawn = stack[-1]
-        count[0] += 1
+        count[local] = count.get(local, 0) + 1
         if len(stack) > MAX_DEPTH:
             raise _Refused(f"<{local}>", f"elements nested over {MAX_DEPTH} deep")
-        label = _label(local, attrs, count[0])
+        label = _label(local, attrs, count[local], parser.CurrentLineNumber)
         drawn = drawn and ns in ("", SVG_NS) and local not in NOT_DRAWN
         if drawn and local == "svg" and len(stack) > 1:
             raise _Refused(label, "a nested <svg> (its own viewport) is not read: draw its paths in the main one")
@@ -114,9 +114,14 @@ def read_drawing(raw: bytes, path: str) -> tuple[list[dict], dict]:
     return paths, skipped
 
 
-def _label(local: str, attrs: dict, n: int) -> str:
+def _label(local: str, attrs: dict, n: int, line: int) -> str:
+    """How a message names an element: by its id, else as the n-th of its kind, at its line.
+
+    >>> _label("path", {"id": "wall"}, 3, 9), _label("path", {}, 3, 9)
+    ("path 'wall'", 'path #3 (line 9)')
+    """
     ident = attrs.get("id")
-    return f"{local} {ident[:60]!r}" if ident else f"{local} #{n}"
+    return f"{local} {ident[:60]!r}" if ident else f"{local} #{n} (line {line})"
 
 
 def _fill_rule(attrs: dict, inherited: str) -> str:
