@@ -40,7 +40,7 @@ from .slab_build import build_slabs, slab_run
 from ..kernel.minkowski.merge import minkowski_sum, reflect
 from ..kernel.polygons.polygon import is_convex, point_in_convex
 from ..io.load import load_scenario
-from ..io.scenario.schema import MAX_ROTATING_VERTICES, Scenario
+from ..io.scenario.schema import MAX_ROTATING_VERTICES, MAX_SLABS, Scenario
 from .motion import SE2Motions, interpolate  # noqa: F401  (interpolate: part of this module's API)
 from ..kernel.slabs.slab import ANGLE_SLACK, edge_planes, typical_gap, default_slabs, robot_radius, slab_hull, slab_inner, slab_of, slab_pad, slab_range
 from ..kernel.polygons.rotation import TWO_PI, rotate_piece, wrap_angle
@@ -97,9 +97,9 @@ class SE2CSpace(SE2Motions):
             gap = typical_gap(self.obstacle_pieces, self.extent)
             self.slabs, self.slabs_reason = default_slabs(self.radius, self.extent, gap)
         else:
-            if isinstance(slabs, bool) or not isinstance(slabs, int) or not slabs >= 4:
-                if not (slabs == 1 and not self.robot_pieces):
-                    raise ValueError(f"SE2CSpace: slabs must be an integer >= 4, got {slabs!r}")
+            if isinstance(slabs, bool) or not isinstance(slabs, int) or not 4 <= slabs <= MAX_SLABS:
+                if not (slabs == 1 and not self.robot_pieces):  # a slab's regions cost work: bounded as a file's
+                    raise ValueError(f"SE2CSpace: slabs must be an integer from 4 to {MAX_SLABS}, got {slabs!r}")
             self.slabs, self.slabs_reason = slabs, f"K = {slabs}: given"
         if not self.robot_pieces:
             self.slabs, self.slabs_reason = 1, "K = 1: a point robot does not turn"

@@ -19,6 +19,7 @@ import numpy as np
 
 from cspace.translation.cspace import CSpace
 from cspace.io.load import Scenario, ScenarioError, load_scenario
+from cspace.io.scenario.schema import MAX_SLABS
 
 from ..adapters.frame import path_length  # noqa: F401  (planners.path_length, the API's name)
 from .result import PlanResult
@@ -139,6 +140,8 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     if slabs is not None and not se2:
         raise ScenarioError("plan()", "slabs", 'applies to a rotating robot only (space = "se2", "dubins" or '
                                                '"reeds-shepp")')
+    if slabs is not None and (isinstance(slabs, bool) or not isinstance(slabs, int) or not 4 <= slabs <= MAX_SLABS):
+        raise ScenarioError("plan()", "slabs", f"must be an integer from 4 to {MAX_SLABS}, got {slabs!r}")
     if name != "exact":
         from ..adapters.glue import ompl
 

@@ -112,3 +112,31 @@ def test_point_robot_stages_skip_the_sum():
     assert res.solved
     ran = {s["stage"]: s["ran"] for s in res.cspace_report["stages"]}
     assert ran["minkowski"] is False and ran["decompose_robot"] is False
+
+
+HOSTILE_ARGUMENTS = [("slabs", 10**9), ("slabs", 3), ("slabs", 4097), ("slabs", True), ("slabs", 2.0),
+                     ("time", -1), ("time", math.nan), ("time", math.inf), ("time", 1e300),
+                     ("seed", -1), ("seed", 2**40), ("iterations", 0), ("iterations", True),
+                     ("clearance", -1.0), ("clearance", math.inf), ("objective", "x")]
+
+
+@pytest.mark.parametrize("field,value", HOSTILE_ARGUMENTS)
+def test_hostile_plan_arguments_are_refused_before_any_work(field, value):
+    """Every bound the command line keeps holds for the Python call too: an argument out of range
+    is one ScenarioError naming plan() and the argument, raised before the C-space is built (the
+    CLI refused --slabs 1e9; plan(slabs=10**9) built slabs without end)."""
+    from cspace.io.load import ScenarioError
+
+    scene = os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "se2", "bar_door.toml")
+    with pytest.raises(ScenarioError) as exc:
+        planners.plan(scene, **{field: value})
+    assert str(exc.value).startswith(f"plan(): {field}:"), str(exc.value)
+
+
+def test_the_se2_cspace_bounds_its_slabs_as_a_file_does():
+    from cspace.io.scenario.schema import MAX_SLABS
+    from cspace.se2.cspace import SE2CSpace
+
+    sc = load_scenario(os.path.join(os.path.dirname(__file__), "..", "..", "scenarios", "se2", "bar_door.toml"))
+    with pytest.raises(ValueError, match=f"from 4 to {MAX_SLABS}"):
+        SE2CSpace.from_scenario(sc, slabs=MAX_SLABS + 1)
