@@ -191,3 +191,18 @@ def test_huge_bounds_plan_quietly(tmp_path):
         text = "\n".join(f"{key} = 1e120" if line.startswith(f"{key} =") else line for line in text.splitlines())
     r = quiet_show(tmp_path, text)
     assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
+def test_a_robot_file_given_as_a_scenario_says_what_it_is(capsys):
+    """A user who plans scenarios/maps/robot.toml (a robot for --robot) is told to pass it with
+    --robot, not only that [bounds] is missing; a scene missing [bounds] still hears the old line."""
+    code = main(["plan", os.path.join(ROOT, "scenarios", "maps", "robot.toml")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--robot FILE" in err[0], err
+
+
+def test_a_scene_without_bounds_is_told_the_table_is_missing(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text('[robot]\npolygon = [[0, 0], [1, 0], [0, 1]]\n[[obstacles]]\npolygon = [[2, 2], [3, 2], [2, 3]]\n')
+    with pytest.raises(ScenarioError, match="bounds: missing \\(a table is required\\)"):
+        load_scenario(str(f))

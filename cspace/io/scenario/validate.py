@@ -42,6 +42,9 @@ def scenario_from_dict(data: dict, path: str = "<scenario>", space: str | None =
         raise v.err("expect", 'must be "solvable" or "unsolvable"')
     tol = v.number(data.get("disk_tolerance", DEFAULT_RELATIVE_ERROR), "disk_tolerance", positive=True)
 
+    if "bounds" not in data and set(data) <= {"robot", "name"}:  # a robot file (--robot), given as a scene
+        raise v.err("bounds", "missing: this file holds a robot only; give it as --robot FILE with a scenario "
+                              "or a map to plan in")
     b = v.table(data, "bounds", required=True)
     v.no_extra(b, "bounds", {"xmin", "xmax", "ymin", "ymax"})  # first: a misspelt key explains a missing one
     xmin, xmax = v.number(b.get("xmin"), "bounds.xmin"), v.number(b.get("xmax"), "bounds.xmax")
