@@ -206,3 +206,14 @@ def test_a_scene_without_bounds_is_told_the_table_is_missing(tmp_path):
     f.write_text('[robot]\npolygon = [[0, 0], [1, 0], [0, 1]]\n[[obstacles]]\npolygon = [[2, 2], [3, 2], [2, 3]]\n')
     with pytest.raises(ScenarioError, match="bounds: missing \\(a table is required\\)"):
         load_scenario(str(f))
+
+
+def test_a_pose_in_collision_names_the_obstacle_by_its_box(capsys):
+    """An imported map's obstacles have no [[obstacles]] table a user could count: the message
+    gives the box of the one the pose touches, and that box holds the pose."""
+    code = main(["plan", os.path.join(ROOT, "scenarios", "maps", "office.yaml"), "--start", "1,1", "--goal", "5,5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    m = re.search(r"goal: \(5.0, 5.0\) .* obstacles\[\d+\] \(the one within x (\S+) to (\S+), y (\S+) to (\S+)\)", err[0])
+    assert code == 2 and len(err) == 1 and m, err
+    x0, x1, y0, y1 = map(float, m.groups())
+    assert x0 <= 5.0 + 0.2 and x1 >= 5.0 - 0.2 and y0 <= 5.0 + 0.2 and y1 >= 5.0 - 0.2  # the robot reaches it

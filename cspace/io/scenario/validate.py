@@ -191,5 +191,8 @@ class _Validator(ShapeChecks):
         where = f"({x}, {y})" if len(pt) == 2 else f"({x}, {y}, theta {theta})"
         if not (xmin <= x <= xmax and ymin <= y <= ymax):
             raise self.err(field, f"{where} is outside the bounds [{xmin}, {xmax}] x [{ymin}, {ymax}]")
-        if hit is not None:
-            raise self.err(field, f"{where} puts the robot in collision with obstacles[{hit}]")
+        if hit is not None:  # named by its index and its box: an imported map's obstacles have no table to count
+            poly = sc.obstacles[hit].polygon
+            (x0, y0), (x1, y1) = poly.min(axis=0), poly.max(axis=0)
+            raise self.err(field, f"{where} puts the robot in collision with obstacles[{hit}] (the one within "
+                                  f"x {x0:.6g} to {x1:.6g}, y {y0:.6g} to {y1:.6g})")
