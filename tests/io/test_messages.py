@@ -217,3 +217,36 @@ def test_a_pose_in_collision_names_the_obstacle_by_its_box(capsys):
     assert code == 2 and len(err) == 1 and m, err
     x0, x1, y0, y1 = map(float, m.groups())
     assert x0 <= 5.0 + 0.2 and x1 >= 5.0 - 0.2 and y0 <= 5.0 + 0.2 and y1 >= 5.0 - 0.2  # the robot reaches it
+
+
+_BASE = {"bounds": "[bounds]\nxmin = -1\nxmax = 5\nymin = -1\nymax = 5\n", "robot": "[robot]\nradius = 0.1\n",
+         "start": "[start]\nx = 1.0\ny = 1.0\n", "goal": "[goal]\nx = 4.0\ny = 4.0\n",
+         "obstacles": "[[obstacles]]\npolygon = [[0, 0], [2, 0], [2, 2], [0, 2]]\n"}
+# the guide's "Some messages, as printed": each line's field, and the file that makes it
+_GUIDE_CASES = {
+    "colour": {"extra": 'colour = "red"\n'},
+    "robot.polgon": {"robot": "[robot]\npolgon = [[0, 0], [1, 0], [0, 1]]\n"},
+    "obstacles[1]": {"obstacles": "[[obstacles]]\npolygon = [[3, 0], [4, 0], [4, 1]]\n[[obstacles]]\n"
+                                  "center = [3, 3]\nradius = 0.5\npolygon = [[0, 0], [1, 0], [0, 1]]\n"},
+    "robot.center": {"robot": "[robot]\ncenter = [0, 0]\nradius = 0.1\n"},
+    "goal.theta": {"start": "[start]\nx = 3.0\ny = 1.0\ntheta = 0.5\n", "goal": "[goal]\nx = 4.0\ny = 4.0\ntheta = 1.0\n"},
+    "obstacles[0].polygon": {"obstacles": "[[obstacles]]\npolygon = [[0, 0], [2, 2], [2, 0], [0, 2]]\n"},
+    "start": {},
+    "planner.seed": {"extra": "[planner]\nseed = -1\n"},
+}
+
+
+def test_the_guides_quoted_messages_are_what_runs(tmp_path, capsys, monkeypatch):
+    """Every line of the guide's "Some messages, as printed" block is what `cspace plan` prints
+    for a file with that fault (the guide quoted a seed message the loader no longer printed)."""
+    guide = open(os.path.join(ROOT, "docs", "guide.md"), encoding="utf-8").read()
+    block = guide.split("Some messages, as printed:", 1)[1].split("```text\n", 1)[1].split("```", 1)[0]
+    lines = block.strip().splitlines()
+    assert len(lines) == len(_GUIDE_CASES)
+    monkeypatch.chdir(tmp_path)
+    for line in lines:
+        field = line.split(": ", 2)[1]
+        case = _GUIDE_CASES[field]
+        (tmp_path / "s.toml").write_text(case.get("extra", "") + "".join(case.get(k, v) for k, v in _BASE.items()))
+        assert main(["plan", "s.toml"]) == 2
+        assert capsys.readouterr().err.strip() == "error: " + line
