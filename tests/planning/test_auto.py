@@ -219,7 +219,7 @@ def _turns(monkeypatch) -> list:
 
 
 @pytest.mark.parametrize("name", ["bug_trap_l", "wide_square"])
-def test_a_small_impossible_scene_is_proven_first_without_sampling(name, monkeypatch):
+def test_a_small_impossible_scene_is_proven_after_half_a_slice(name, monkeypatch):
     # On a small scene the POSSIBLE graph at the first 8 slabs comes before the slice's rest: a scene
     # it separates is answered by the proof, after the slice's first part only.
     from planners.core.auto import FIRST_ITERATIONS, small_scene
