@@ -1,7 +1,7 @@
 """``auto``: the planner that always answers, the default for a rotating robot and a car.
 
 It runs the project's planners as stages of one budget, each only when the ones before it have
-not answered, cheapest first (a rotating robot or a Reeds–Shepp car):
+not answered, in the order of their cost on the scene (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
    :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
@@ -20,6 +20,25 @@ not answered, cheapest first (a rotating robot or a Reeds–Shepp car):
    POSSIBLE disagree (SE(2); a Reeds–Shepp car's path converted as in 1), then sampling again
    with whatever is left; for a translating robot the exact shortest path.
 
+**A small SE(2) scene** (:func:`small_scene`: at most :data:`SMALL_PAIRS` convex pairs, obstacle
+pieces x robot pieces, which is what a slab region sums) orders the same stages by what they cost
+there (:func:`_small_se2`). Its 8 POSSIBLE regions cost a few milliseconds, about a failed slice,
+and every later stage but sampling reuses them, so the **proof** (POSSIBLE at the first 8 slabs,
+not refined: a scene proven impossible pays what RRTConnect's proof before sampling costs) comes
+after the slice's first :data:`FIRST_ITERATIONS` iterations (an open scene's answer, most often)
+and before its rest; then the **slab graph**'s FREE at those 8 slabs; then one
+**sampling** turn of :data:`TURN_ITERATIONS` more iterations of the slice's own search (its trees
+kept: an open scene that needs a few thousand iterations, as a corner to turn, costs what they
+cost once); then the **refinement** (the quick proof's 16 slabs are skipped: the refinement looks
+for the proof too, in the slabs it bisects); then sampling with the rest. Every stage there ends
+by a count (iterations, slabs) well before its share of the limit, so which stage answers, and the
+path, is the same on every machine that answers within ``--time``. The
+turn is a compromise between the scenes that need it (an open corner: 2 000 to 7 000 iterations,
+a few ms each thousand) and those where only the refinement answers (a door 1 % wider than the
+robot), which pay it on top of the exact planner's time. A larger scene (an imported map: a slab
+region costs tens of milliseconds) or a car keeps the order 0-4: a slice answers most queries of a
+large map before any region is built.
+
 The slab regions are kept with the C-space, so stage 4 starts where stage 1 stopped. The result
 says which stage answered (``PlanResult.answered_by``) and the seconds of each stage
 (``timings``: ``proof``, ``slab graph``, ``sampling``, ``refinement``). Every path is certified
@@ -30,6 +49,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 
 import numpy as np
 
@@ -46,7 +66,15 @@ TRANSLATION_SAMPLE_SHARE = 0.5
 # reference point), the largest its start and goal allow first.
 ROOMS = (0.05, 0.01, 0.002)
 BOUNDED_PAST = 32  # poses: a car's path longer than this gets the bounded shortening only  # a translating robot: sampling, then the exact shortest path
+# A small SE(2) scene (obstacle pieces x robot pieces, the convex pairs each slab region sums, at
+# most this): its first 8 slab regions cost a few milliseconds, about a failed slice, and run first.
+SMALL_PAIRS = 16
+FIRST_ITERATIONS = 500  # a small SE(2) scene: the slice's part before the proof (the rest after it)
+TURN_ITERATIONS = 3500  # a small SE(2) scene: sampling's turn after the first slabs, continuing the slice
 STAGES = ("sampling", "slab graph", "proof", "refinement")
+# C-space -> the (start, goal) pairs of a small scene whose POSSIBLE graph at the first slabs joined
+# them: that search is deterministic on the kept regions, so the same query skips it next time.
+_NO_PROOF: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _now() -> float:
@@ -95,6 +123,8 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
 
     if tuple(query.start) == tuple(query.goal):
         return _answer(sample(time_limit, None), "sampling", clock, seed)
+    if turns and small_scene(sc, cspace):
+        return _small_se2(sc, cspace, adapter, query, pair, clock, seed, source, iterations, simplify)
     if turns:  # a slice of sampling: an open scene is answered here, a large map too
         r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
@@ -137,6 +167,68 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         failed = PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, adapter.dim)),
                             length=math.inf, planner="auto", seed=seed, start=tuple(query.start),
                             goal=tuple(query.goal), message=f"not solved within the time limit ({time_limit:g} s)")
+    return _answer(failed, None, clock, seed)
+
+
+def small_scene(sc, cspace) -> bool:
+    """A rotating robot (not a car) in a scene of at most :data:`SMALL_PAIRS` convex pairs
+    (obstacle pieces x robot pieces): its stages run in the order of :func:`_small_se2`."""
+    return sc.space == "se2" and len(cspace.obstacle_pieces) * len(cspace.body_pieces) <= SMALL_PAIRS
+
+
+def _small_se2(sc, cspace, adapter, query, pair, clock: _Clock, seed: int, source: str,
+               iterations: int | None, simplify: bool) -> PlanResult:
+    """A small SE(2) scene, every stage at most as dear as the one after it: the slice's first
+    :data:`FIRST_ITERATIONS`, the proof (POSSIBLE at the first 8 slabs, whose regions the
+    refinement reuses), the rest of the slice, FREE at those slabs, sampling's turn (one search
+    continued throughout), the refinement, sampling again with the rest.
+    Sampling's turns are counted in iterations, the slab graph's in slabs: where each stops, and
+    so which stage answers and the path, is the same on every machine (within ``--time``)."""
+    from .exact_se2 import from_search, search
+    from .routine import run_planner
+
+    keep = [None]  # one RRTConnect search, continued turn after turn
+
+    def sample(n: int | None, budget: float) -> PlanResult:  # given ``iterations``: counted, within the time left
+        budget = clock.left() if iterations is not None else budget
+        return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, seed, iterations=n,
+                                                          simplify=simplify, scenario=sc.name, keep=keep)[0])
+
+    slice_s = min(SLICE_SHARE * clock.limit, clock.left())
+    r = sample(FIRST_ITERATIONS, slice_s)  # the slice's first part: an open scene is answered here
+    if r.solved:
+        return _answer(r, "sampling", clock, seed)
+    key = (tuple(map(float, query.start)), tuple(map(float, query.goal)))
+    tried = _NO_PROOF.setdefault(cspace, set())
+    if key not in tried:  # (deterministic on the kept regions: a query asked again skips it)
+        res = clock.run("proof", lambda: search(cspace, query, min(SLAB_SHARE * clock.limit, clock.left()),
+                                                possible_only=True, refine=False))
+        if res.status == "unsolvable":
+            return _answer(from_search(sc, query, res, clock.spent["proof"]), "proof", clock, seed)
+        if res.stats.get("reason") != "time limit":
+            tried.add(key)
+    r = sample(SLICE_ITERATIONS - FIRST_ITERATIONS, max(0.0, min(slice_s - clock.spent["sampling"], clock.left())))
+    if r.solved:  # the rest of the slice, its search continued
+        return _answer(r, "sampling", clock, seed)
+    failed = r
+    if clock.left() > 0:
+        r = clock.run("slab graph", lambda: _slab_graph(sc, cspace, adapter, query, source,
+                                                       min(SLAB_SHARE * clock.limit, clock.left()), simplify, refine=False))
+        if r is not None and (r.solved or r.proven_unsolvable):
+            return _answer(r, "slab graph", clock, seed)
+    if clock.left() > 0:
+        failed = r = sample(iterations or TURN_ITERATIONS, 0.5 * clock.left())
+        if r.solved:
+            return _answer(r, "sampling", clock, seed)
+    if clock.left() > 0:
+        r = clock.run("refinement", lambda: _refinement(sc, cspace, adapter, query, source, clock, simplify))
+        if r is not None and (r.solved or r.proven_unsolvable):
+            return _answer(r, "refinement", clock, seed)
+        failed = r or failed
+    if clock.left() > 0:  # the refinement reached its floor: sampling goes on with the rest
+        r = sample(iterations, clock.left())
+        if r.solved:
+            return _answer(r, "sampling", clock, seed)
     return _answer(failed, None, clock, seed)
 
 

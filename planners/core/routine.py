@@ -57,7 +57,7 @@ def _now() -> float:
 def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *,
                 iterations: int | None = None, simplify: bool = True, slices: bool = False,
                 on_progress=None, scenario: str = "", until_first: bool = False,
-                objective: str = "length") -> list[PlanResult]:
+                objective: str = "length", keep: list | None = None) -> list[PlanResult]:
     """THE planning routine: one OMPL planner over a state-space adapter, for each query.
 
     ``space`` is an adapter of :mod:`planners.adapters`; ``queries`` is a list of
@@ -79,13 +79,21 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
     ``objective`` (:mod:`planners.adapters.objectives`): ``length`` (OMPL's default, nothing set),
     ``clearance`` (maximise the minimum clearance) or ``balanced``; it matters to the
     optimising planners (RRTstar, PRMstar, BITstar, ...).
+
+    ``keep`` (one query; a list the caller keeps, ``[None]`` at first): the planner's setup is
+    kept there, and a later call with the same list and query continues the same search where
+    the earlier one stopped (its trees, its random stream) instead of starting again: turns of
+    one search (``auto``'s), the second counting only its own iterations.
     """
     key = name.lower()
     out = []
-    held = [None]  # the roadmap planners' setup, kept from query to query
+    if keep is not None and len(queries) != 1:
+        raise ValueError("run_planner: keep continues one query's search; got several queries")
+    held = [None] if keep is None else keep  # the roadmap planners' setup, kept from query to query
     for i, (start, goal) in enumerate(queries):
         args = (space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify,
-                slices and not until_first, on_progress, objective, scenario, until_first)
+                slices and not until_first, on_progress, objective, scenario, until_first,
+                keep is not None and held[0] is not None)
         if tuple(start) == tuple(goal):  # nothing to plan: the one-point path
             out.append(_trivial(space, name, seed, scenario, start, goal))
         elif key == "aorrtc" and space.verify(np.array([start, goal], dtype=np.float64), start, goal)[0]:
@@ -98,11 +106,13 @@ def run_planner(space, name: str, queries: list, time_limit: float, seed: int, *
 
 
 def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterations, simplify, slices,
-                on_progress, objective, scenario, until_first=False) -> PlanResult:
+                on_progress, objective, scenario, until_first=False, resume=False) -> PlanResult:
     from ..adapters.glue import configure, make_setup, set_query, stop_at_first
 
     t0 = _now()
-    if held[0] is None or key not in ROADMAP:
+    if resume:  # the same query's search, continued: its setup, trees and random stream as they are
+        pass
+    elif held[0] is None or key not in ROADMAP:
         held[0] = make_setup(space, name, seed, query=i)
         configure(held[0][0].getPlanner(), name, iterations)
         if until_first and key in ANYTIME:
@@ -116,7 +126,8 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
     else:
         held[0][0].getPlanner().clearQuery()  # keep the roadmap, drop the old start and goal
     ss = held[0][0]
-    set_query(ss, space, start, goal)
+    if not resume:
+        set_query(ss, space, start, goal)
     setup_s = _now() - t0
     c0 = space.counts()
     t1, cpu1 = _now(), time.process_time()

@@ -193,7 +193,7 @@ def test_given_iterations_auto_s_turns_of_sampling_count_them_not_time(monkeypat
     # The short turn of sampling is timed (a share of what is left); with --iterations each turn is
     # bounded by its count alone, so which stage answers does not depend on the machine's speed.
     import planners.core.routine as routine
-    from planners.core.auto import SLICE_ITERATIONS
+    from planners.core.auto import FIRST_ITERATIONS, SLICE_ITERATIONS
 
     seen = []
     real = routine.run_planner
@@ -201,4 +201,90 @@ def test_given_iterations_auto_s_turns_of_sampling_count_them_not_time(monkeypat
     res = planners.plan(os.path.join(SCENARIOS, "se2", "door_tight.toml"), seed=0, iterations=40, time=1000.0)
     assert res.solved and len(seen) >= 2, (res.message, seen)  # the slice and the short turn at least
     assert all(budget > 500 for budget, _ in seen), seen  # the time left, never a short share of it
-    assert [it for _, it in seen][:2] == [SLICE_ITERATIONS, 40], seen
+    # (a small scene: the slice in two parts, the proof between them, then the turn)
+    assert [it for _, it in seen][:3] == [FIRST_ITERATIONS, SLICE_ITERATIONS - FIRST_ITERATIONS, 40], seen
+
+
+SE2 = sorted(glob.glob(os.path.join(SCENARIOS, "se2", "*.toml")))
+
+
+def _turns(monkeypatch) -> list:
+    """The iteration budgets of the sampling turns ``auto`` asks for, in order."""
+    import planners.core.routine as routine
+
+    seen = []
+    real = routine.run_planner
+    monkeypatch.setattr(routine, "run_planner", lambda *a, **k: seen.append(k.get("iterations")) or real(*a, **k))
+    return seen
+
+
+@pytest.mark.parametrize("name", ["bug_trap_l", "wide_square"])
+def test_a_small_impossible_scene_is_proven_after_half_a_slice(name, monkeypatch):
+    # On a small scene the POSSIBLE graph at the first 8 slabs comes before the slice's rest: a scene
+    # it separates is answered by the proof, after the slice's first part only.
+    from planners.core.auto import FIRST_ITERATIONS, small_scene
+    from planners.core.plan import build_cspace
+
+    path = os.path.join(SCENARIOS, "se2", f"{name}.toml")
+    sc = load_scenario(path)
+    assert small_scene(sc, build_cspace(sc))
+    turns = _turns(monkeypatch)
+    res = planners.plan(path, seed=0)
+    assert res.proven_unsolvable and res.answered_by == "proof", res.message
+    assert turns == [FIRST_ITERATIONS] and "slab graph" not in res.timings and "refinement" not in res.timings
+    assert_sound(sc, res)
+
+
+def test_an_open_small_scene_is_answered_by_the_slice_s_first_part_before_any_region(monkeypatch):
+    from planners.core.auto import FIRST_ITERATIONS
+    from planners.core.exact_se2 import built_regions
+
+    turns = _turns(monkeypatch)
+    path = os.path.join(SCENARIOS, "se2", "bar_door.toml")
+    res = planners.plan(path, seed=0)
+    assert res.solved and res.answered_by == "sampling" and turns == [FIRST_ITERATIONS], (res.message, turns)
+    assert set(res.stages) & set(STAGES) == {"sampling"} and built_regions(res.cspace)["regions"] == 0
+    assert_sound(load_scenario(path), res)
+
+
+def test_the_turn_after_the_first_slabs_continues_the_slice_s_search(monkeypatch):
+    # plank_corner at seed 2: RRTConnect needs more than the slice's 1 000 iterations and fewer than
+    # the slice and the turn together; the turn continues the slice's trees, so auto's path is the
+    # path of one RRTConnect run of that many iterations (the same seed), not of a fresh start.
+    from planners.core.auto import FIRST_ITERATIONS, SLICE_ITERATIONS, TURN_ITERATIONS
+
+    path = os.path.join(SCENARIOS, "se2", "plank_corner.toml")
+    alone = planners.plan(path, planner="RRTConnect", seed=2, iterations=SLICE_ITERATIONS + TURN_ITERATIONS,
+                          simplify=False, time=100.0)
+    short = planners.plan(path, planner="RRTConnect", seed=2, iterations=SLICE_ITERATIONS, simplify=False, time=100.0)
+    assert alone.solved and not short.solved  # the scene and seed are as the test needs
+    turns = _turns(monkeypatch)
+    res = planners.plan(path, seed=2, simplify=False, time=100.0)
+    assert res.answered_by == "sampling", (res.message, turns)
+    assert turns == [FIRST_ITERATIONS, SLICE_ITERATIONS - FIRST_ITERATIONS, TURN_ITERATIONS], turns
+    assert np.array_equal(res.path, alone.path)
+    assert set(res.stages) & set(STAGES) == {"proof", "slab graph", "sampling"}
+
+
+# the scenes whose checks take over a second (the sweep of a long path, the exact search) in the slow pass
+SLOW_SE2 = ("car_maze", "door_tight", "hole_turn", "plank_corner_tight", "tee_slot")
+
+
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if os.path.basename(p)[:-5] in SLOW_SE2
+                                  else p for p in SE2], ids=lambda p: os.path.basename(p)[:-5])
+def test_on_every_bundled_se2_scene_auto_answers_where_rrtconnect_or_exact_does(path):
+    # exact's answer, and RRTConnect's within the iterations auto's turns give it: auto answers
+    # too, and before its refinement where RRTConnect alone did within the slice and the turn.
+    from planners.core.auto import SLICE_ITERATIONS, TURN_ITERATIONS
+
+    from cspace.se2.exact import from_scenario
+
+    sc = load_scenario(path)
+    exact = from_scenario(sc, time_limit=100.0).status  # the slab graph's search, no shortening or measure
+    rrt = planners.plan(path, planner="RRTConnect", seed=1, iterations=SLICE_ITERATIONS + TURN_ITERATIONS, time=100.0)
+    res = planners.plan(path, seed=1, time=100.0)
+    assert_sound(sc, res)
+    assert res.solved or not (exact == "solved" or rrt.solved), res.message
+    assert res.proven_unsolvable or not (exact == "unsolvable" or rrt.proven_unsolvable), res.message
+    if rrt.solved:  # every stage before the refinement that could answer did: sampling's turns are enough
+        assert res.answered_by in ("sampling", "slab graph"), res.answered_by
