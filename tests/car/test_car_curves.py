@@ -236,6 +236,8 @@ radii = st.floats(0.05, 20.0)
 @settings(max_examples=150, deadline=None)
 @given(poses, poses, radii)
 @example((0.0, 0.0, 0.0), (1e-06, 0.0, 1e-06), 1.0)  # found in CI: Dubins' one arc ends 5e-13 aside
+@example((2.95e-280, 0.0, 0.0), (0.0, 0.0, 1e-06), 1.0)  # found by hypothesis: a turn of 1e-6 rad, just over
+# NEAR, ends 5e-7 rad short of q1's heading (OMPL's tolerances, as end_tolerance allows for close poses)
 def test_length_bounds_and_symmetry(q0, q1, r):
     dub = curve_length(dubins_segments(q0, q1, r))
     rs = curve_length(reeds_shepp_segments(q0, q1, r))
@@ -254,8 +256,9 @@ def test_length_bounds_and_symmetry(q0, q1, r):
     assert rs >= r * angle_gap(q0[2], q1[2]) - tol
     if not is_close(q0, q1, r):
         assert rs <= dub + tol
-    if not is_near_coincident(q0, q1, r):
-        assert dub >= r * angle_gap(q0[2], q1[2]) - tol
+    if not is_near_coincident(q0, q1, r):  # between close poses the curve may stop short of q1's heading
+        short = end_tolerance(dubins_segments, q0, q1, r)[1]
+        assert dub >= r * (angle_gap(q0[2], q1[2]) - short) - tol
 
 
 @settings(max_examples=150, deadline=None)
