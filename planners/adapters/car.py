@@ -24,6 +24,7 @@ from .se2 import SE2Space
 from .frame import scaled_bounds
 
 SEGMENTS_KEPT = 512
+FREE_KEPT = 4096  # motions certified free, remembered by their exact floats (CarSpace.motion_free)
 SEGMENT_NAMES = {"L": "left", "S": "straight", "R": "right"}
 
 
@@ -47,6 +48,7 @@ class CarSpace(SE2Space):
         # The curves of a path's motions are asked for again and again (its length when it is
         # found, when it is returned, its JSON and picture): the last few hundred are kept.
         self._curve = functools.lru_cache(maxsize=SEGMENTS_KEPT)(lambda q0, q1: curve(q0, q1, r))
+        self._test, self._free = None, {}  # the motion check (made on the first motion); free motions
 
     def state_space(self):
         from .glue import ompl
@@ -77,8 +79,28 @@ class CarSpace(SE2Space):
 
     def motion_free(self, q0, q1) -> bool:
         """Whether the car, driven along the shortest curve from q0 to q1, touches nothing
-        (certified: :meth:`cspace.car.motion.CarCSpace.car_motion_free`)."""
-        return self.cspace.car_motion_free(q0, q1, self.name, self.radius)
+        (certified: :meth:`cspace.car.motion.CarCSpace.car_motion_free`, through its
+        :meth:`~cspace.car.motion.CarCSpace.car_motion_test`).
+
+        A motion certified free is remembered (up to :data:`FREE_KEPT`, by its exact floats,
+        none with a zero): the same floats get the same certificate, so the path's re-check
+        (:meth:`verify`) of the motions the planner asked costs a look-up each. Only "free"
+        is kept; a motion in collision is checked each time it is asked."""
+        known, key = self._free, None
+        # a key with a zero is not kept: 0.0 == -0.0, and their curves may differ (an angle of ±π)
+        if type(q0) is tuple and type(q1) is tuple and 0.0 not in q0 and 0.0 not in q1:
+            key = (q0, q1)
+            if key in known:
+                return True
+        test = self._test
+        if test is None:
+            test = self._test = self.cspace.car_motion_test(self.name, self.radius)
+        ok = test(q0, q1)
+        if ok and key is not None:
+            if len(known) >= FREE_KEPT:
+                known.clear()
+            known[key] = True
+        return ok
 
     def counts(self) -> tuple[int, int]:
         """Checks made so far: (state checks, motion checks), a car's motion being a curve (the
