@@ -202,3 +202,17 @@ def test_given_iterations_auto_s_turns_of_sampling_count_them_not_time(monkeypat
     assert res.solved and len(seen) >= 2, (res.message, seen)  # the slice and the short turn at least
     assert all(budget > 500 for budget, _ in seen), seen  # the time left, never a short share of it
     assert [it for _, it in seen][:2] == [SLICE_ITERATIONS, 40], seen
+
+
+@pytest.mark.parametrize("name, direct", [("u_turn_cusps.toml", True), ("parking.toml", False)])
+def test_a_car_tries_its_direct_curve_first(name, direct):
+    """A car whose one shortest curve from start to goal is free is answered by it (stage 0, one
+    curve check, no sampling); the path passes the sweep. Where that curve is not free, the
+    slice of sampling answers as before."""
+    sc = load_scenario(os.path.join(SCENARIOS, "car", name))
+    res = planners.plan(sc, seed=0, time=10.0, simplify=False)
+    assert res.solved and res.answered_by == "sampling"
+    assert ("direct curve" in res.message) == direct, res.message
+    if direct:
+        assert len(res.path) == 2 and tuple(res.path[0]) == tuple(sc.start) and tuple(res.path[-1]) == tuple(sc.goal)
+    assert judged_free(sc, np.asarray(res.path))
