@@ -49,6 +49,7 @@ class CarSpace(SE2Space):
         # found, when it is returned, its JSON and picture): the last few hundred are kept.
         self._curve = functools.lru_cache(maxsize=SEGMENTS_KEPT)(lambda q0, q1: curve(q0, q1, r))
         self._test, self._free = None, {}  # the motion check (made on the first motion); free motions
+        self._last_length = (None, 0.0)  # the last path measured (its rows) and its length
 
     def state_space(self):
         from .glue import ompl
@@ -126,7 +127,12 @@ class CarSpace(SE2Space):
         3.5
         """
         rows = [tuple(r) for r in np.asarray(path, dtype=np.float64).tolist()]  # Python floats: the fast paths
-        return float(sum(self._len_of(self.segments(a, b)) for a, b in zip(rows[:-1], rows[1:])))
+        if rows == self._last_length[0]:  # a path is measured when it is found and when it is returned
+            return self._last_length[1]
+        total = float(sum(self._len_of(self.segments(a, b)) for a, b in zip(rows[:-1], rows[1:])))
+        if not any(0.0 in r for r in rows):  # 0.0 == -0.0: such rows could be another path's
+            self._last_length = (rows, total)
+        return total
 
     @staticmethod
     def _len_of(segments) -> float:

@@ -163,3 +163,19 @@ def test_free_motions_are_remembered_and_collisions_are_not():
     assert len(calls) == 5 and all(0.0 not in a + b for a, b in car._free)
     ok, why = car.verify(np.array([s, free, hit]), s, hit)
     assert not ok and "1" in why
+
+
+def test_the_last_length_is_remembered_for_that_path_only():
+    """A path measured twice (when found, when returned) is measured once; another path, or the
+    same numbers with a signed zero (0.0 == -0.0, another curve: a heading of ±π), is measured
+    afresh: the length is always the one a fresh adapter gives."""
+    from planners.adapters.car import CarSpace
+
+    sc, cs, _ = scene("parking.toml")
+    car, fresh = (CarSpace(cs, "reeds-shepp", sc.turning_radius) for _ in range(2))
+    a = np.array([[2.0, 2.2, 0.05], [2.5, 2.25, 0.06], [3.0, 2.3, 1.0]])
+    b = np.array([[2.0, 2.2, 0.05], [2.5, 2.25, 0.06], [3.0, 2.3, -math.pi]])
+    c = np.array([[2.0, 2.2, 0.0], [2.5, 2.25, 0.06], [3.0, 2.3, math.pi]])
+    for p in (a, a, b, a, c, c * np.array([1, 1, -1]), c):
+        assert car.length(p) == fresh.length(p)
+        fresh._last_length = (None, 0.0)
