@@ -78,6 +78,14 @@ class CarSpace(SE2Space):
             return list(self._curve(q0, q1))
         return self._curve.__wrapped__(q0, q1)
 
+    def motion_validator(self, si):
+        """The certified validator of :class:`SE2Space`, for a new planning run: what this adapter
+        remembered of the last run (free motions, the last length) is dropped, so a run repeated
+        on the same adapter (a benchmark's rounds) costs what the first did."""
+        self._free.clear()
+        self._last_length = (None, 0.0)
+        return super().motion_validator(si)
+
     def motion_free(self, q0, q1) -> bool:
         """Whether the car, driven along the shortest curve from q0 to q1, touches nothing
         (certified: :meth:`cspace.car.motion.CarCSpace.car_motion_free`, through its
@@ -86,7 +94,8 @@ class CarSpace(SE2Space):
         A motion certified free is remembered (up to :data:`FREE_KEPT`, by its exact floats,
         none with a zero): the same floats get the same certificate, so the path's re-check
         (:meth:`verify`) of the motions the planner asked costs a look-up each. Only "free"
-        is kept; a motion in collision is checked each time it is asked."""
+        is kept; a motion in collision is checked each time it is asked. A new planning run
+        (:meth:`motion_validator`) starts with nothing remembered."""
         known, key = self._free, None
         # a key with a zero is not kept: 0.0 == -0.0, and their curves may differ (an angle of ±π)
         if type(q0) is tuple and type(q1) is tuple and 0.0 not in q0 and 0.0 not in q1:

@@ -179,3 +179,21 @@ def test_the_last_length_is_remembered_for_that_path_only():
     for p in (a, a, b, a, c, c * np.array([1, 1, -1]), c):
         assert car.length(p) == fresh.length(p)
         fresh._last_length = (None, 0.0)
+
+
+def test_a_new_planning_run_starts_with_nothing_remembered():
+    """What the adapter remembers (free motions, the last length) belongs to one planning run: a
+    run repeated on the same adapter (a benchmark's rounds) checks its motions again."""
+    from planners.adapters.car import CarSpace
+    from planners.adapters.glue import ompl_available
+
+    if not ompl_available():
+        pytest.skip("OMPL is not installed")
+    sc, cs, _ = scene("parking.toml")
+    car = CarSpace(cs, "reeds-shepp", sc.turning_radius)
+    a, b = (2.0, 2.2, 0.05), (2.5, 2.25, 0.06)
+    assert car.motion_free(a, b) and car._free and car.length(np.array([a, b])) > 0
+    from planners.adapters.glue import make_setup
+
+    keep = make_setup(car, "RRTConnect", 0)  # a new run: its validator
+    assert not car._free and car._last_length == (None, 0.0) and keep[3] is not None
