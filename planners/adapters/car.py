@@ -78,12 +78,16 @@ class CarSpace(SE2Space):
             return list(self._curve(q0, q1))
         return self._curve.__wrapped__(q0, q1)
 
-    def motion_validator(self, si):
-        """The certified validator of :class:`SE2Space`, for a new planning run: what this adapter
-        remembered of the last run (free motions, the last length) is dropped, so a run repeated
-        on the same adapter (a benchmark's rounds) costs what the first did."""
+    def forget(self) -> None:
+        """A new planning run: what this adapter remembered of the last one (free motions, the
+        last length) is dropped, so a run repeated on the same adapter (a benchmark's rounds)
+        costs what the first did."""
         self._free.clear()
         self._last_length = (None, 0.0)
+
+    def motion_validator(self, si):
+        """The certified validator of :class:`SE2Space`, for a new planning run (:meth:`forget`)."""
+        self.forget()
         return super().motion_validator(si)
 
     def motion_free(self, q0, q1) -> bool:

@@ -149,6 +149,7 @@ def _direct(sc, adapter, query, pair, seed: int) -> PlanResult | None:
     """Stage 0's first try for a car: the shortest curve from start to goal, the whole path when
     the car's motion validator certifies it free (one curve check; None otherwise)."""
     t = _now()
+    adapter.forget()  # a new run: nothing remembered from the last query's
     if not adapter.motion_free(*pair):
         return None
     found_cpu = time.process_time()

@@ -197,3 +197,6 @@ def test_a_new_planning_run_starts_with_nothing_remembered():
 
     keep = make_setup(car, "RRTConnect", 0)  # a new run: its validator
     assert not car._free and car._last_length == (None, 0.0) and keep[3] is not None
+    assert car.motion_free(a, b) and car._free
+    car.forget()  # auto's direct curve, before any validator: a new run too
+    assert not car._free
