@@ -123,6 +123,38 @@ class CarCSpace(SE2CSpace):
         segments = (dubins_segments if dubins else reeds_shepp_segments)(q0, q1, radius)
         return self.curve_free(q0, segments, radius, q1=q1)
 
+    def car_motion_test(self, kind: str, radius: float):
+        """``(q0, q1) -> bool``: :meth:`car_motion_free` for one kind and radius, checked once
+        here (the planners' motion validator calls it for every motion). Poses that are tuples
+        go to the compiled motion (cspace/compiled/_carmotion.c: non-finite values decline);
+        whatever it does not decide, the curve and its join to q1 both, takes the full path.
+
+        >>> sq = np.array([[4., 4], [6, 4], [6, 6], [4, 6]])
+        >>> box = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
+        >>> test = CarCSpace((0, 10, 0, 10), [sq], [box], slabs=16).car_motion_test("reeds-shepp", 1.0)
+        >>> test((1.0, 1.0, 0.0), (8.0, 1.0, 0.0)), test((1.0, 5.0, 0.0), (8.0, 5.0, 0.0))
+        (True, False)
+        """
+        if kind not in ("dubins", "reeds-shepp"):
+            raise ValueError(f"kind: 'dubins' or 'reeds-shepp', got {kind!r}")
+        radius, dubins, full = curve_radius(radius, self.extent), kind == "dubins", self.car_motion_free
+        if self._car_fast is False:
+            self._compile_car()
+        if self._car_fast is None:
+            return lambda q0, q1: full(q0, q1, kind, radius)
+        motion, grids, checks = self._car_motion, self._car_grids, self.checks
+        longest, turns = MAX_SEGMENT_EXTENTS * self.extent, MAX_ARC_TURNS * 2.0 * math.pi * radius
+
+        def test(q0, q1) -> bool:
+            if type(q0) is tuple and type(q1) is tuple and len(q0) == len(q1) == 3:
+                r = motion(grids, *q0, *q1, radius, dubins, longest, turns, True)[0]
+                if r == 2 or r == 0:  # decided, the join included (else: the full path, from scratch)
+                    checks["curves"] += 1
+                    return r == 2
+            return full(q0, q1, kind, radius)
+
+        return test
+
     def _car_motion_call(self, q0, q1, dubins: bool, radius):
         """:meth:`car_motion_free` in one compiled call (motions.car_motion), or None when it
         cannot decide (or the arguments are not the usual floats: the full path checks them)."""
@@ -133,7 +165,7 @@ class CarCSpace(SE2CSpace):
         self.checks["curves"] += 1
         motion, longest = self._car_motion, MAX_SEGMENT_EXTENTS * self.extent
         turns = MAX_ARC_TURNS * 2.0 * math.pi * radius
-        got = self._compiled(lambda grids: motion(grids, *q0, *q1, radius, dubins, longest, turns), q1)
+        got = self._compiled(lambda grids: motion(grids, *q0, *q1, radius, dubins, longest, turns, True), q1)
         if got is None:
             self.checks["curves"] -= 1  # the full path counts it
         return got
@@ -186,13 +218,16 @@ class CarCSpace(SE2CSpace):
 
     def _compiled(self, call, q1):
         """A compiled car call (``grids -> (r, x, y, th)``: 1 free, 0 not, -1 undecided, -2 - k slab
-        k not built) run to its answer, building the slabs it asks for; a free chain's end
-        (x, y, th) is then joined to q1 by a certified SE(2) motion. None: undecided."""
+        k not built, 2 free and joined to q1 in the call) run to its answer, building the slabs
+        it asks for; a free chain's end (x, y, th) is then joined to q1 by a certified SE(2)
+        motion. None: undecided."""
         grids = self._car_grids
         while True:  # one call; a slab not built yet is built and the call repeated
             r, x, y, th = call(grids)
             if r == 0:
                 return False
+            if r == 2:
+                return True
             if r == 1:
                 break
             if r == -1 or (handle := self.slab(-2 - r)._fast) is None:

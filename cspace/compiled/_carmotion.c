@@ -1,8 +1,9 @@
 /* The compiled car curve check: CarMotions.curve_free's loop (cspace/car/motion.py)
    in one call per curve, answering 1 free, 0 not free, -1 undecided (the Python path, the
    oracle, then decides the curve from scratch), or -2 - k: slab k's C-space is not built
-   yet (Python builds it and calls again). The join of the curve's end to q1 stays with
-   the caller (an SE(2) motion, itself compiled: _se2motion.c).
+   yet (Python builds it and calls again). The join of the curve's end to q1 (an SE(2)
+   motion, within rounding) is the caller's (itself compiled: _se2motion.c), except where
+   car_motion is asked to join and one slab's segment test certifies it (join_end: 2).
 
    The caller has taken the start pose as floats, its angle wrapped. Then, as the Python
    path does, with the same float operations in the same order (so the same doubles):
@@ -492,8 +493,36 @@ static int64_t link_segment(Link *chain, int *nl, double *p, char kind, double l
 
 /* The chain from q (res 1 so far) certified: the probe, straight segments, then arcs, counted
    as the Python path counts; (r, x, y, th) with (x, y, th) = p, the chain's end. */
+/* The join of a free chain's end p to q1 (both angles wrapped), as the caller would certify it
+   (SE2CSpace.motion_free): 1 when p is q1, or when the motion, its angles between p's and
+   q1's, stays within one slab's hull interval and the slab C-space's segment test (the grid
+   walk) certifies its reference segment free -- free at every angle of the interval, so at
+   every pose of the motion; 0 otherwise (the caller joins them), R_ERROR. The caller's
+   counts of that motion are made here. */
+static int64_t join_end(Car *h, PyObject *grids, const double *p, const double *q1)
+{
+    if (p[0] == q1[0] && p[1] == q1[1] && p[2] == q1[2]) return 1;
+    double a0 = p[2], a1 = q1[2];
+    if (!(fabs(a1 - a0) <= PI)) return 0; /* across the wrap (or not finite): the caller's */
+    if (!(h->xmin <= p[0] && p[0] <= h->xmax && h->ymin <= p[1] && p[1] <= h->ymax && h->xmin <= q1[0]
+          && q1[0] <= h->xmax && h->ymin <= q1[1] && q1[1] <= h->ymax))
+        return 0;
+    int64_t k = slab_index(h->slab_lo, h->slab_hi, h->K, a0);
+    if (k < 0 || !(h->slab_lo[k] <= a1 && a1 <= h->slab_hi[k])) return 0;
+    PyObject *g = PyList_GET_ITEM(grids, k);
+    if (g == Py_None) return 0;
+    int r = fast_grid_segment(g, p[0], p[1], q1[0], q1[1]);
+    if (r == -2) return R_ERROR;
+    if (!(r == 1 || r == 3)) return 0;
+    PyObject *d = h->checks;
+    if (fast_add_count(d, "motions", 1) < 0 || fast_add_count(d, "submotions", 1) < 0
+        || fast_add_count(d, "slab_certified", 1) < 0)
+        return R_ERROR;
+    return 1;
+}
+
 static PyObject *check_chain(Car *h, PyObject *grids, const double *q, const Link *chain, int nl, int64_t res,
-                             const double *p, double radius)
+                             const double *p, double radius, const double *q1)
 {
     long n_arcs = 0, n_sweeps = 0, n_coll = 0;
     if (res == 1) {
@@ -530,6 +559,11 @@ static PyObject *check_chain(Car *h, PyObject *grids, const double *q, const Lin
             return NULL;
     }
     long code = res >= 0 ? (long)res : (res == R_UNDECIDED ? -1 : (long)(-2 - (-3 - res)));
+    if (code == 1 && q1) { /* 2: the join to q1 is certified too */
+        int64_t j = join_end(h, grids, p, q1);
+        if (j == R_ERROR) return NULL;
+        if (j == 1) code = 2;
+    }
     return Py_BuildValue("(lddd)", code, p[0], p[1], p[2]);
 }
 
@@ -599,19 +633,21 @@ PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs
         res = link_segment(chain, &nl, p, ks[0], length, radius);
     }
     Py_DECREF(seq);
-    return check_chain(h, args[1], q, chain, nl, res, p, radius);
+    return check_chain(h, args[1], q, chain, nl, res, p, radius, NULL);
 }
 
-/* car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns) -> (r, x, y, th):
+/* car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns[, join]) -> (r, x, y, th):
    the car's shortest curve from q0 to q1 (fast_car_segments: car_curves' segments, the same
    doubles) checked as car_curve checks it from q0 with its angle wrapped. -1 (undecided) also
    where the Python segments would differ in branch or fail pose_checks.curve_segments' bounds
-   (a length above `longest`, an arc above `turns`): the caller runs the Python path. */
+   (a length above `longest`, an arc above `turns`): the caller runs the Python path. With
+   `join` true, r is 2 where the chain is free and its end's join to q1 is certified here too
+   (join_end: one slab's segment test), 1 where the chain is free and the join is the caller's. */
 PyObject *fast_car_motion(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
-    if (nargs != 12) {
+    if (nargs != 12 && nargs != 13) {
         PyErr_SetString(PyExc_TypeError,
-                        "car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns)");
+                        "car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns[, join])");
         return NULL;
     }
     Car *h = car_args(args, "car_motion");
@@ -620,6 +656,8 @@ PyObject *fast_car_motion(PyObject *self, PyObject *const *args, Py_ssize_t narg
     if (doubles(args + 2, 7, v) < 0 || doubles(args + 10, 2, v + 7) < 0) return NULL;
     int dubins = PyObject_IsTrue(args[9]);
     if (dubins < 0) return NULL;
+    int joined = nargs == 13 ? PyObject_IsTrue(args[12]) : 0;
+    if (joined < 0) return NULL;
     const double *q0 = v, *q1 = v + 3;
     double radius = v[6], longest = v[7], turns = v[8];
     char kinds[5];
@@ -641,5 +679,6 @@ PyObject *fast_car_motion(PyObject *self, PyObject *const *args, Py_ssize_t narg
         }
         res = link_segment(chain, &nl, p, kinds[i], lengths[i], radius);
     }
-    return check_chain(h, args[1], q, chain, nl, res, p, radius);
+    double q1w[3] = {q1[0], q1[1], wrap_angle(q1[2])};
+    return check_chain(h, args[1], q, chain, nl, res, p, radius, joined ? q1w : NULL);
 }

@@ -20,13 +20,43 @@ static inline double angle_pi(double x)
     return v;
 }
 
-/* Each formula: 1 with (t, u, v) written, 0 for None. */
-static int rs_lsl(double x, double y, double phi, double *o)
+/* One argument triple (x, y, phi) of the formulas, with what several of them compute alike
+   from it, computed once: sin(phi) and cos(phi); the start's left centre to the goal's left
+   centre (X, Y) = (x - sin phi, y - 1 + cos phi) in polar form (_lsl, _lrl, _lrsl); the
+   goal's right centre (xi, eta) = (x + sin phi, y - 1 - cos phi) and its norm (_lsr, the
+   CCCC pair, _lrsr, _lrslr: -eta squared is eta squared and a sum of two squares does not
+   depend on their order, so _lrsr's norm is this one too); the angle of (xi, eta) when
+   _lsr asks for it. The same expressions as the Python formulas, so the same doubles. */
+typedef struct {
+    double x, y, phi, sp, cp;
+    double X, Y, rhoA, thA;
+    double xi, eta, rhoB, thB;
+    int have_thB;
+} Triple;
+
+static void triple(Triple *T, double x, double y, double phi, double sp, double cp)
 {
-    double X = x - sin(phi), Y = y - 1.0 + cos(phi);
-    double u = sqrt(X * X + Y * Y), t = atan2(Y, X);
+    T->x = x, T->y = y, T->phi = phi, T->sp = sp, T->cp = cp;
+    T->X = x - sp, T->Y = y - 1.0 + cp;
+    T->rhoA = sqrt(T->X * T->X + T->Y * T->Y), T->thA = atan2(T->Y, T->X);
+    T->xi = x + sp, T->eta = y - 1.0 - cp;
+    T->rhoB = sqrt(T->xi * T->xi + T->eta * T->eta);
+    T->have_thB = 0;
+}
+
+/* A candidate whose |u| alone is at least the bound cannot be taken: its cost |t| + |u| + |v|,
+   summed in floats, is at least |u| (each rounding is monotone and |u| a float), and a
+   candidate replaces the best only when its cost is below the bound. Finite u only: a
+   non-finite length is the caller's to see (it declines the word). */
+#define UNBEATEN(u, bound) (isfinite(u) && fabs(u) >= (bound))
+
+/* Each formula: 1 with (t, u, v) written, 0 for None (or, given the bound to beat, where
+   UNBEATEN says it cannot be taken: the caller would drop it). */
+static int rs_lsl(Triple *T, double bound, double *o)
+{
+    double u = T->rhoA, t = T->thA;
     if (t >= -RS_ZERO) {
-        double v = angle_pi(phi - t);
+        double v = angle_pi(T->phi - t);
         if (v >= -RS_ZERO) {
             o[0] = t, o[1] = u, o[2] = v;
             return 1;
@@ -35,28 +65,28 @@ static int rs_lsl(double x, double y, double phi, double *o)
     return 0;
 }
 
-static int rs_lsr(double x, double y, double phi, double *o)
+static int rs_lsr(Triple *T, double bound, double *o)
 {
-    double X = x + sin(phi), Y = y - 1.0 - cos(phi);
-    double d = sqrt(X * X + Y * Y), t1 = atan2(Y, X);
+    double d = T->rhoB;
     double d2 = d * d;
     if (d2 < 4.0) return 0;
     double u = sqrt(d2 - 4.0);
-    double t = angle_pi(t1 + atan2(2.0, u));
-    double v = angle_pi(t - phi);
+    if (UNBEATEN(u, bound)) return 0;
+    if (!T->have_thB) T->thB = atan2(T->eta, T->xi), T->have_thB = 1;
+    double t = angle_pi(T->thB + atan2(2.0, u));
+    double v = angle_pi(t - T->phi);
     if (!(t >= -RS_ZERO && v >= -RS_ZERO)) return 0;
     o[0] = t, o[1] = u, o[2] = v;
     return 1;
 }
 
-static int rs_lrl(double x, double y, double phi, double *o)
+static int rs_lrl(Triple *T, double bound, double *o)
 {
-    double X = x - sin(phi), Y = y - 1.0 + cos(phi);
-    double rho = sqrt(X * X + Y * Y), theta = atan2(Y, X);
+    double rho = T->rhoA, theta = T->thA;
     if (rho > 4.0) return 0;
     double u = -2.0 * asin(0.25 * rho);
     double t = angle_pi(theta + 0.5 * u + PI);
-    double v = angle_pi(phi - t + u);
+    double v = angle_pi(T->phi - t + u);
     if (!(t >= -RS_ZERO && u <= RS_ZERO)) return 0;
     o[0] = t, o[1] = u, o[2] = v;
     return 1;
@@ -74,73 +104,71 @@ static void tau_omega(double u, double v, double xi, double eta, double phi, dou
     *omega = angle_pi(t - u + v - phi);
 }
 
-static int rs_lrlr_a(double x, double y, double phi, double *o)
+static int rs_lrlr_a(Triple *T, double bound, double *o)
 {
-    double xi = x + sin(phi), eta = y - 1.0 - cos(phi);
-    double rho = 0.25 * (2.0 + sqrt(xi * xi + eta * eta));
+    double rho = 0.25 * (2.0 + T->rhoB);
     if (rho > 1.0) return 0;
     double u = acos(rho), t, v;
-    tau_omega(u, -u, xi, eta, phi, &t, &v);
+    tau_omega(u, -u, T->xi, T->eta, T->phi, &t, &v);
     if (!(t >= -RS_ZERO && v <= RS_ZERO)) return 0;
     o[0] = t, o[1] = u, o[2] = v;
     return 1;
 }
 
-static int rs_lrlr_b(double x, double y, double phi, double *o)
+static int rs_lrlr_b(Triple *T, double bound, double *o)
 {
-    double xi = x + sin(phi), eta = y - 1.0 - cos(phi);
+    double xi = T->xi, eta = T->eta;
     double rho = (20.0 - xi * xi - eta * eta) / 16.0;
     if (!(0.0 <= rho && rho <= 1.0)) return 0;
     double u = -acos(rho), t, v;
     if (u < -HALF_PI) return 0;
-    tau_omega(u, u, xi, eta, phi, &t, &v);
+    tau_omega(u, u, xi, eta, T->phi, &t, &v);
     if (!(t >= -RS_ZERO && v >= -RS_ZERO)) return 0;
     o[0] = t, o[1] = u, o[2] = v;
     return 1;
 }
 
-static int rs_lrsl(double x, double y, double phi, double *o)
+static int rs_lrsl(Triple *T, double bound, double *o)
 {
-    double X = x - sin(phi), Y = y - 1.0 + cos(phi);
-    double rho = sqrt(X * X + Y * Y), theta = atan2(Y, X);
+    double rho = T->rhoA, theta = T->thA;
     if (rho < 2.0) return 0;
     double r = sqrt(rho * rho - 4.0);
     double u = 2.0 - r;
+    if (UNBEATEN(u, bound)) return 0;
     double t = angle_pi(theta + atan2(r, -2.0));
-    double v = angle_pi(phi - HALF_PI - t);
+    double v = angle_pi(T->phi - HALF_PI - t);
     if (!(t >= -RS_ZERO && u <= RS_ZERO && v <= RS_ZERO)) return 0;
     o[0] = t, o[1] = u, o[2] = v;
     return 1;
 }
 
-static int rs_lrsr(double x, double y, double phi, double *o)
+static int rs_lrsr(Triple *T, double bound, double *o)
 {
-    double X = -(y - 1.0 - cos(phi)), Y = x + sin(phi);
-    double rho = sqrt(X * X + Y * Y), t = atan2(Y, X);
+    double rho = T->rhoB; /* the norm of (-eta, xi) */
     if (rho < 2.0) return 0;
     double u = 2.0 - rho;
-    double v = angle_pi(t + HALF_PI - phi);
+    if (UNBEATEN(u, bound)) return 0;
+    double t = atan2(T->xi, -T->eta);
+    double v = angle_pi(t + HALF_PI - T->phi);
     if (!(t >= -RS_ZERO && u <= RS_ZERO && v <= RS_ZERO)) return 0;
     o[0] = t, o[1] = u, o[2] = v;
     return 1;
 }
 
-static int rs_lrslr(double x, double y, double phi, double *o)
+static int rs_lrslr(Triple *T, double bound, double *o)
 {
-    double xi = x + sin(phi), eta = y - 1.0 - cos(phi);
-    double rho = sqrt(xi * xi + eta * eta);
-    (void)atan2(eta, xi);
+    double xi = T->xi, eta = T->eta, rho = T->rhoB; /* (the Python formula's unused angle: not computed) */
     if (rho < 2.0) return 0;
     double u = 4.0 - sqrt(rho * rho - 4.0);
-    if (u > RS_ZERO) return 0;
+    if (u > RS_ZERO || UNBEATEN(u, bound)) return 0;
     double t = angle_pi(atan2((4.0 - u) * xi - 2.0 * eta, -2.0 * xi + (u - 4.0) * eta));
-    double v = angle_pi(t - phi);
+    double v = angle_pi(t - T->phi);
     if (!(t >= -RS_ZERO && v >= -RS_ZERO)) return 0;
     o[0] = t, o[1] = u, o[2] = v;
     return 1;
 }
 
-typedef int (*rs_solve)(double, double, double, double *);
+typedef int (*rs_solve)(Triple *, double, double *);
 
 /* Layouts of GROUPS: the lengths from (t, u, v). */
 enum { L_TUV, L_VUT, L_LRLR_A, L_LRLR_B, L_CCSC, L_CSCC, L_CCSCC };
@@ -180,23 +208,32 @@ static int layout(int kind, const double *tuv, double *out)
     }
 }
 
-/* reeds_shepp_word: 1 with the word and lengths written, 0 none, -1 not finite. */
+/* reeds_shepp_word: 1 with the word and lengths written, 0 none, -1 not finite. The formulas
+   see 8 argument triples (4 symmetries, read forwards or backwards), each prepared once. */
 static int rs_word(double x, double y, double phi, const char **word, double *best, int *nbest)
 {
     const Group groups[5] = {{0.0, F_G0, 2}, {0.0, F_G1, 2}, {0.0, F_G2, 2}, {HALF_PI, F_G3, 4}, {PI, F_G4, 1}};
     double total = HUGE_VAL;
     int found = 0;
+    double cp = cos(phi), sp = sin(phi), cm = cos(-phi), sm = sin(-phi);
+    double bx = x * cp + y * sp, by = x * sp - y * cp;
+    Triple tri[8];
+    int ready[8] = {0};
     for (int g = 0; g < 5; g++) {
         double bound = total - groups[g].fixed;
-        double cp = cos(phi), sp = sin(phi);
         for (int k = 0; k < groups[g].n; k++) {
             const Formula *F = groups[g].f + k;
-            double bx = x, by = y;
-            if (F->backwards) bx = x * cp + y * sp, by = x * sp - y * cp;
-            const double gx[4] = {bx, -bx, bx, -bx}, gy[4] = {by, by, -by, -by}, gp[4] = {phi, -phi, -phi, phi};
+            double fx = F->backwards ? bx : x, fy = F->backwards ? by : y;
+            const double gx[4] = {fx, -fx, fx, -fx}, gy[4] = {fy, fy, -fy, -fy}, gp[4] = {phi, -phi, -phi, phi};
             for (int s = 0; s < 4; s++) {
                 double tuv[3];
-                if (!F->solve(gx[s], gy[s], gp[s], tuv)) continue;
+                Triple *T = tri + 4 * F->backwards + s;
+                if (!ready[4 * F->backwards + s]) {
+                    int neg = s == 1 || s == 2;
+                    triple(T, gx[s], gy[s], gp[s], neg ? sm : sp, neg ? cm : cp);
+                    ready[4 * F->backwards + s] = 1;
+                }
+                if (!F->solve(T, bound, tuv)) continue;
                 double t = tuv[0], u = tuv[1], v = tuv[2];
                 if (!(isfinite(t) && isfinite(u) && isfinite(v))) return -1;
                 double cost = F->lrlr ? fabs(t) + 2.0 * fabs(u) + fabs(v) : fabs(t) + fabs(u) + fabs(v);

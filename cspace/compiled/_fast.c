@@ -125,17 +125,46 @@ void *fast_copy_buffer(PyObject *obj, Py_ssize_t size, Py_ssize_t count, const c
     return out;
 }
 
+/* The counters' keys as interned strings, made once per key (the callers pass string
+   literals: the same pointer at every call), so that a count makes no string of its own. */
+#define KEY_CACHE 32
+static const char *key_names[KEY_CACHE];
+static PyObject *key_objs[KEY_CACHE];
+
+/* The key's string: borrowed from the cache, or (*owned = 1) a new reference when it is full. */
+static PyObject *count_key(const char *key, int *owned)
+{
+    int i = 0;
+    *owned = 0;
+    for (; i < KEY_CACHE && key_names[i]; i++)
+        if (key_names[i] == key) return key_objs[i];
+    PyObject *k = PyUnicode_InternFromString(key);
+    if (k && i < KEY_CACHE) { /* kept for the life of the process, as the literal is */
+        key_names[i] = key;
+        key_objs[i] = k;
+    } else if (k) {
+        *owned = 1;
+    }
+    return k;
+}
+
 /* d[key] += delta (a counter of the C-space's checks dict, 0 when absent); 0, or -1 on error. */
 int fast_add_count(PyObject *d, const char *key, long delta)
 {
     if (!delta) return 0;
-    PyObject *old = PyDict_GetItemString(d, key); /* borrowed */
+    int owned, r = -1;
+    PyObject *k = count_key(key, &owned);
+    if (!k) return -1;
+    PyObject *old = PyDict_GetItemWithError(d, k); /* borrowed */
     long v = old ? PyLong_AsLong(old) : 0;
-    if (v == -1 && PyErr_Occurred()) return -1;
-    PyObject *n = PyLong_FromLong(v + delta);
-    if (!n) return -1;
-    int r = PyDict_SetItemString(d, key, n);
-    Py_DECREF(n);
+    if (!(PyErr_Occurred() || (old && v == -1 && PyErr_Occurred()))) {
+        PyObject *n = PyLong_FromLong(v + delta);
+        if (n) {
+            r = PyDict_SetItem(d, k, n);
+            Py_DECREF(n);
+        }
+    }
+    if (owned) Py_DECREF(k);
     return r;
 }
 

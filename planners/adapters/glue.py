@@ -135,8 +135,9 @@ def make_setup(space, planner: str, seed: int, query: int = 0):
     ob, og, ou = ompl()
     # OMPL ignores seed 0, so user seeds map to seed + 1 (see :func:`ompl_seed`).
     # Re-seeding before any RNG is created makes every plan with the same seed draw
-    # the same samples.
-    with _quiet_fd(2):
+    # the same samples. (Re-seeding later logs an OMPL error, silenced: at LOG_NONE, the
+    # level set on import, OMPL writes nothing, and the descriptor is left alone.)
+    with _quiet_fd(2) if ou.getLogLevel() != ou.LOG_NONE else contextlib.nullcontext():
         ou.RNG.setSeed(ompl_seed(seed, query))
     ospace = adapter.state_space()
     ss = og.SimpleSetup(ospace)

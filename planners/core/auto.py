@@ -3,7 +3,8 @@
 It runs the project's planners as stages of one budget, each only when the ones before it have
 not answered, in the order of their cost on the scene (a rotating robot or a Reeds–Shepp car):
 
-0. **sampling**, a slice -- RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
+0. **sampling**, a slice -- a car first tries its one shortest curve from start to goal (the
+   path when it is free: :func:`_direct`); then RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
    :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
    scene, or a query on a large map, is answered here in milliseconds, before any region of the
    slab graph is built (every rotating robot and car: a Dubins car too);
@@ -125,6 +126,10 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         return _answer(sample(time_limit, None), "sampling", clock, seed)
     if turns and small_scene(sc, cspace):
         return _small_se2(sc, cspace, adapter, query, pair, clock, seed, source, iterations, simplify)
+    if turns and kind in ("dubins", "reeds-shepp"):  # a car: its one curve from start to goal, if free
+        r = clock.run("sampling", lambda: _direct(sc, adapter, query, pair, seed))
+        if r is not None:
+            return _answer(r, "sampling", clock, seed)
     if turns:  # a slice of sampling: an open scene is answered here, a large map too
         r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
@@ -230,6 +235,24 @@ def _small_se2(sc, cspace, adapter, query, pair, clock: _Clock, seed: int, sourc
         if r.solved:
             return _answer(r, "sampling", clock, seed)
     return _answer(failed, None, clock, seed)
+def _direct(sc, adapter, query, pair, seed: int) -> PlanResult | None:
+    """Stage 0's first try for a car: the shortest curve from start to goal, the whole path when
+    the car's motion validator certifies it free (one curve check; None otherwise)."""
+    t = _now()
+    adapter.forget()  # a new run: nothing remembered from the last query's
+    if not adapter.motion_free(*pair):
+        return None
+    found_cpu = time.process_time()
+    path = np.array(pair, dtype=np.float64)
+    ok, _ = adapter.verify(path, query.start, query.goal)
+    if not ok:  # certified a moment ago: a fault, left to the stages after
+        return None
+    length = adapter.length(path)
+    return PlanResult(scenario=sc.name, solved=True, exact=True, path=path, length=length, planner="auto",
+                      seed=seed, timings={"solve": _now() - t}, checks={"states": 0, "motions": 1},
+                      stages=["direct curve"], start=tuple(query.start), goal=tuple(query.goal),
+                      message="certified solution: the direct curve from start to goal is free",
+                      length_unsimplified=length, first_path_cpu=found_cpu)
 
 
 def sampling_slice(sample, cspace, clock, time_limit: float) -> PlanResult:

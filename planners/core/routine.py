@@ -146,7 +146,7 @@ def _plan_query(space, name, key, held, i, start, goal, time_limit, seed, iterat
     if found and simplify:
         ss.simplifySolution()
     simp_s = _now() - t2 if found and simplify else 0.0
-    path = _snap(space.path_array(ss.getSolutionPath()), goal) if found else None
+    path = (_snap(space.path_array(ss.getSolutionPath()), goal) if simplify else raw) if found else None
     t3 = _now()
     ok, message = space.verify(path, start, goal) if found else (False, failure_message(status, space, objective))
     if found and not ok:

@@ -201,14 +201,19 @@ def test_a_real_plan_replayed_both_ways(scenes):
     sc, _, pure = scenes["parking.toml"]
     fresh = CarCSpace.from_scenario(sc)
     asked = []
-    inner = fresh.car_motion_free
+    make = fresh.car_motion_test
 
-    def logged(q0, q1, kind, radius):
-        r = inner(q0, q1, kind, radius)
-        asked.append((tuple(q0), tuple(q1), kind, radius, r))
-        return r
+    def logged_test(kind, radius):  # the adapter's motion check: every motion it is asked
+        inner = make(kind, radius)
 
-    fresh.car_motion_free = logged
+        def test(q0, q1):
+            r = inner(q0, q1)
+            asked.append((tuple(q0), tuple(q1), kind, radius, r))
+            return r
+
+        return test
+
+    fresh.car_motion_test = logged_test
     res = plan(sc, planner="RRTConnect", seed=1, time=10.0, cspace=fresh)
     assert res.solved and len(asked) > 50
     assert any(r for *_, r in asked) and not all(r for *_, r in asked)

@@ -288,3 +288,17 @@ def test_on_every_bundled_se2_scene_auto_answers_where_rrtconnect_or_exact_does(
     assert res.proven_unsolvable or not (exact == "unsolvable" or rrt.proven_unsolvable), res.message
     if rrt.solved:  # every stage before the refinement that could answer did: sampling's turns are enough
         assert res.answered_by in ("sampling", "slab graph"), res.answered_by
+
+
+@pytest.mark.parametrize("name, direct", [("u_turn_cusps.toml", True), ("parking.toml", False)])
+def test_a_car_tries_its_direct_curve_first(name, direct):
+    """A car whose one shortest curve from start to goal is free is answered by it (stage 0, one
+    curve check, no sampling); the path passes the sweep. Where that curve is not free, the
+    slice of sampling answers as before."""
+    sc = load_scenario(os.path.join(SCENARIOS, "car", name))
+    res = planners.plan(sc, seed=0, time=10.0, simplify=False)
+    assert res.solved and res.answered_by == "sampling"
+    assert ("direct curve" in res.message) == direct, res.message
+    if direct:
+        assert len(res.path) == 2 and tuple(res.path[0]) == tuple(sc.start) and tuple(res.path[-1]) == tuple(sc.goal)
+    assert judged_free(sc, np.asarray(res.path))
