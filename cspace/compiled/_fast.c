@@ -710,7 +710,16 @@ static PyMethodDef methods[] = {
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_fast", "cspace's optional compiled fast path.", -1,
                                     methods};
 
+#ifndef CSPACE_SOURCE_HASH
+#define CSPACE_SOURCE_HASH ""  /* built without setup.py's fingerprint: fastpath treats it as stale */
+#endif
+
 PyMODINIT_FUNC PyInit__fast(void)
 {
-    return PyModule_Create(&module);
+    PyObject *m = PyModule_Create(&module);
+    if (m != NULL && PyModule_AddStringConstant(m, "source_hash", CSPACE_SOURCE_HASH) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
 }

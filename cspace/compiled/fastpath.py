@@ -17,15 +17,24 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import warnings
 
 import numpy as np
 
+from .fingerprint import stale
+
 _fast = None
+STALE: str | None = None  # why a built extension is not used (its sources changed since the build)
 if os.environ.get("CSPACE_PURE", "") in ("", "0"):
     try:
         from . import _fast  # type: ignore[attr-defined,no-redef]
     except ImportError:  # not built (no compiler): the pure path
         _fast = None
+    if _fast is not None:
+        STALE = stale(_fast, os.path.dirname(os.path.abspath(__file__)))
+        if STALE is not None:  # the pure path, with the same answers, rather than stale code
+            _fast = None
+            warnings.warn(f"cspace's compiled fast path is {STALE}; running the pure Python path", stacklevel=2)
 
 ENABLED: bool = _fast is not None
 

@@ -110,6 +110,8 @@ def fast_path() -> str:
         return "compiled fast path: on"
     if os.environ.get("CSPACE_PURE", "") not in ("", "0"):
         return "pure Python path: CSPACE_PURE is set; slower"
+    if fastpath.STALE:
+        return f"pure Python path: the compiled extension is {fastpath.STALE}; slower"
     return "pure Python path: not compiled at install (no C compiler?); slower"
 
 

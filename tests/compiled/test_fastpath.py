@@ -365,3 +365,38 @@ def test_nearly_vertical_segments_never_come_out_free_wrongly():
                     assert cs.segment_free((x, y0), (x + dx, y1)) == want
                     checked += 1
     assert checked > 1000
+
+
+def test_the_built_extension_is_the_build_of_these_sources():
+    """setup.py compiles the C sources' fingerprint in; the suite must run the build of the
+    sources it tests (after a pull that changed them, rebuild: pip install -e .)."""
+    import importlib.util
+
+    from cspace.compiled.fingerprint import fingerprint
+
+    if importlib.util.find_spec("cspace.compiled._fast") is None:
+        pytest.skip("the compiled fast path is not built")
+    import cspace.compiled._fast as ext
+
+    assert ext.source_hash == fingerprint(os.path.dirname(fastpath.__file__))
+
+
+def test_an_extension_built_from_other_sources_is_not_run(tmp_path):
+    """A copy of the package whose C source changed after the build: its fast path is off, with a
+    warning and --version saying why (a car_motion taking a new argument ran stale code that
+    raised TypeError mid-plan)."""
+    import importlib.util
+    import shutil
+
+    if importlib.util.find_spec("cspace.compiled._fast") is None:
+        pytest.skip("the compiled fast path is not built")
+    src = os.path.dirname(os.path.dirname(fastpath.__file__))
+    shutil.copytree(src, tmp_path / "cspace", ignore=shutil.ignore_patterns("__pycache__"))
+    code = ("import warnings, cspace.compiled.fastpath as f; print(f.compiled(), f.STALE is not None)")
+    env = {**os.environ, "PYTHONPATH": str(tmp_path), "CSPACE_PURE": "0"}
+    fresh = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert fresh.stdout.split() == ["True", "False"], fresh.stderr
+    with open(tmp_path / "cspace" / "compiled" / "_carmotion.c", "a") as fh:
+        fh.write("\n/* edited after the build */\n")
+    edited = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert edited.stdout.split() == ["False", "True"] and "pip install -e ." in edited.stderr, edited.stderr
