@@ -1,6 +1,6 @@
 """``cspace check-proof SCENARIO PROOF``: re-check a proof that no path exists (written by
-``cspace plan --planner exact --proof FILE``) with the independent checker
-:mod:`planners.core.proof_check`. Exit 0 valid, 1 invalid (the first failed step named),
+``cspace plan --proof FILE``) with the independent checker :mod:`planners.core.proof_check`
+(a Dubins car's reach proof, format ``cspace-dubins-proof/1``: :mod:`planners.core.dubins_check`). Exit 0 valid, 1 invalid (the first failed step named),
 2 bad input (a proof asking for more work than any the planner writes among it)."""
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from cspace.io.load import load_scenario
 
+    from ..core.dubins_check import FORMAT as DUBINS_FORMAT, check_dubins_proof
     from ..core.proof_check import TooBig, check_proof, load_proof
 
     from ..errors import InputError
@@ -29,6 +30,8 @@ def run(args) -> int:
     if not 0 <= args.query < count:  # a query the scenario does not have is a bad option, not a bad proof
         raise InputError(args.scenario, "--query", f"must be from 0 to {count - 1}, got {args.query}")
     proof = load_proof(args.proof)
+    if proof.get("format") == DUBINS_FORMAT:  # a Dubins car's reach proof: its own checker
+        check_proof = check_dubins_proof
     try:
         result = check_proof(scenario, proof, args.query)
     except TooBig as exc:  # more work than any proof the planner writes: refused, not judged
