@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 
 import numpy as np
 import shapely
@@ -123,20 +124,50 @@ def in_slab(t: float, a: float, b: float, slack: float) -> bool:
     return d <= (b - a) + 2.0 * slack
 
 
-class _Blocked:
-    """Slab j's certainly blocked cells: a cell is blocked when its centre lies in (window minus
-    POSSIBLE_j) eroded by the cell's half diagonal (the whole cell then lies outside POSSIBLE_j)."""
+class _Lazy(dict):
+    """A dict that computes a missing key's value by ``make(key)`` and keeps it."""
 
-    def __init__(self, region, window_box, h: float, scale: float):
+    def __init__(self, make):
+        super().__init__()
+        self.make = make
+
+    def __missing__(self, key):
+        self[key] = value = self.make(key)
+        return value
+
+
+# SlabRegions -> {(a, b, h): the slab's certainly blocked cells' test}, kept with the regions
+_BLOCKED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+class _Blocked:
+    """Slab j's certainly blocked cells: a cell is blocked when its centre lies in (the bounds,
+    grown by a cell, minus POSSIBLE_j) eroded by the cell's half diagonal (the whole cell then
+    lies outside POSSIBLE_j or outside the bounds)."""
+
+    def __init__(self, region, bounds, h: float, scale: float):
+        xmin, xmax, ymin, ymax = bounds
         comps = region.components
         free = shapely.union_all(comps) if comps else shapely.Polygon()
-        blocked = shapely.difference(window_box, free)
+        blocked = shapely.difference(shapely.box(xmin - 2 * h, ymin - 2 * h, xmax + 2 * h, ymax + 2 * h), free)
         d = (0.5 * math.sqrt(2.0) * h) * ERODE * (1.0 + 1e-6) + 1e-9 * scale
         self.core = shapely.buffer(blocked, -d, quad_segs=8)
         shapely.prepare(self.core)
+        self.box = (xmin - h, xmax + h, ymin - h, ymax + h)
 
     def of(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return shapely.contains_xy(self.core, x, y)
+        """Whether the cells centred at (x, y) are certainly blocked (outside the grown bounds: yes)."""
+        x0, x1, y0, y1 = self.box
+        return shapely.contains_xy(self.core, x, y) | (x < x0) | (x > x1) | (y < y0) | (y > y1)
+
+
+def _blocked(regions, slab, h: float) -> _Blocked:
+    kept = _BLOCKED.setdefault(regions, {})
+    key = (float(slab[0]), float(slab[1]), float(h))
+    if key not in kept:
+        scale = max([abs(v) for v in regions.bounds] + [regions.radius])
+        kept[key] = _Blocked(regions.possible(*slab), regions.bounds, h, scale)
+    return kept[key]
 
 
 def reach_proof(regions, start, goal, radius: float, *, backward: bool = False, deadline: float | None = None,
@@ -166,21 +197,20 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
     i0 = int(math.floor((seed[0] - half - o[0]) / h))
     j0 = int(math.floor((seed[1] - half - o[1]) / h))
     n = int(math.ceil(2 * half / h)) + 1
-    box = shapely.box(o[0] + i0 * h - h, o[1] + j0 * h - h, o[0] + (i0 + n + 1) * h, o[1] + (j0 + n + 1) * h)
     slabs = initial_partition(K)  # the last ends one ulp past pi: the cover is closed in exact arithmetic
-    sten = [stencil(displacements(a, b, s, r, True, sign), h) for a, b in slabs]
+    sten = _Lazy(lambda k: stencil(displacements(*slabs[k], s, r, True, sign), h))
     # the slabs a step's heading can end in: those [a_k - s/r, b_k + s/r] meets (padded)
     turn = s / r + 1e-9
-    targets = [[j for j, (c, d) in enumerate(slabs) if in_slab(c, a - turn, b + turn, 0.0)
-                or in_slab(a - turn, c, d, 0.0)] for a, b in slabs]
-    border = int(max(np.abs(st).max() for st in sten)) + 1
+    targets = _Lazy(lambda k: [j for j, (c, d) in enumerate(slabs) if in_slab(c, slabs[k][0] - turn, slabs[k][1] + turn, 0.0)
+                               or in_slab(slabs[k][0] - turn, c, d, 0.0)])
+    # the widest stencil's reach (a slab's hull is its first slab's turned: the same extent up to rounding)
+    border = int(np.abs(sten[0]).max()) + 2
     R = {}
     tested = {}
     front = {}
     blocked = {}
     cx = o[0] + (i0 + np.arange(n) + 0.5) * h
     cy = o[1] + (j0 + np.arange(n) + 0.5) * h
-    scale = max(abs(v) for v in regions.bounds)
     for k, (a, b) in enumerate(slabs):
         if in_slab(seed[2], a, b, 1e-9):
             R[k] = np.zeros((n, n), bool)
@@ -188,28 +218,32 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
                 for jj in _cells_at(seed[1], o[1], h):
                     R[k][ii - i0, jj - j0] = True
             tested[k] = R[k].copy()
-            front[k] = R[k].copy()
+            front[k] = [np.nonzero(R[k])]
     # (c), checked as cells arrive: the cells from which a last step of at most s reaches the other end
     near = _near_cells(other, slabs, s, r, sign, h, o, (i0, j0), n)
     if any((R[k] & near[k]).any() for k in R if k in near):
         return None
     total = sum(int(x.sum()) for x in R.values())
-    while front:
+    count = {k: int(R[k].sum()) for k in front}
+    while front:  # the smallest front first (its cells as index arrays: no pass over the window)
         if deadline is not None and time.perf_counter() > deadline:
             return None
-        k = min(front, key=lambda key: (int(front[key].sum()), key))
-        f = front.pop(k)
-        idx = np.argwhere(f)
-        lo, hi = idx.min(axis=0), idx.max(axis=0)
+        k = min(front, key=lambda key: (count[key], key))
+        parts = front.pop(k)
+        fi, fj = np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+        lo = np.array([fi.min(), fj.min()])
+        hi = np.array([fi.max(), fj.max()])
         if lo.min() < border or hi.max() >= n - border:
             return None  # the reach leaves its window: not confined enough to prove
         b0, b1 = lo - border, hi + border + 1
-        grown = dilate(f[b0[0]:b1[0], b0[1]:b1[1]], sten[k])
+        f = np.zeros(tuple(b1 - b0), bool)
+        f[fi - b0[0], fj - b0[1]] = True
+        grown = dilate(f, sten[k])
         for j in targets[k]:
             if j not in R:
                 R[j], tested[j] = np.zeros((n, n), bool), np.zeros((n, n), bool)
             if j not in blocked:
-                blocked[j] = _Blocked(regions.possible(*slabs[j]), box, h, scale)
+                blocked[j] = _blocked(regions, slabs[j], h)
             view_t = tested[j][b0[0]:b1[0], b0[1]:b1[1]]
             cand = grown & ~view_t
             if not cand.any():
@@ -222,9 +256,9 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
                 if j in near and near[j][ai, aj].any():
                     return None  # the other end is within reach
                 R[j][ai, aj] = True
-                fr = front.setdefault(j, np.zeros((n, n), bool))
-                fr[ai, aj] = True
-                total += int(ok.sum())
+                count[j] = (count[j] if j in front else 0) + len(ai)
+                front.setdefault(j, []).append((ai, aj))
+                total += len(ai)
                 if total > max_cells:
                     return None
     return _json(regions, start, goal, r, s, h, o, i0, j0, slabs, R, targets, backward)
