@@ -9,15 +9,16 @@ checker's steps, :mod:`planners.core.proof_check`), each slab's POSSIBLE from th
 stencils. Steps, in order (the first that fails is reported): format, query, robot, cover, cores,
 parameters, seed, closure, other end.
 
-- parameters: 0 < s <= r (a step turns the heading by at most 1 rad < pi/2), h > 0, stencils and
-  cell arrays within :data:`LIMITS`;
+- parameters: a Dubins scenario of radius r; 0 < s <= r (a step turns the heading by at most
+  1 rad < pi/2); h >= 2^-30 S (S, u: the SE(2) checker's scale and unit); stencils and cell
+  arrays within :data:`LIMITS`;
 - seed: the start (``direction`` forward; backward: the goal) lies in R_k for every slab k whose
-  interval, widened by 1e-9 rad, holds its heading: every cell whose box grown by 1e-9 h holds it;
+  interval, widened by 1e-9 rad, holds its heading: every cell whose box grown by 1e-9 h + u holds it;
 - closure: for every slab k with cells and every slab j that [a_k - s/r, b_k + s/r] (widened by
   1e-9 rad) meets, the cells of dilate(R_k, stencil_k) outside R_j meet no component of slab j's
   POSSIBLE (their boxes grown by 2^-30 S); slab j must carry its cores;
 - other end: for every slab k with cells whose interval widened by s/r + 1e-9 holds the other end's
-  heading, no cell of R_k meets (other end - Disp<=_k).
+  heading, no cell of R_k (grown by 1e-9 h + u) meets (other end - Disp<=_k).
 
 Displacements (:func:`disp_hull`): the box [r sin(s/r), s] x [-c, c] (c = r (1 - cos(s/r));
 [0, s] for the last step) in the heading's frame, turned by the slab's ends and its middle (the
@@ -105,6 +106,11 @@ def check_parameters(p: dict, scenario):
          f"turning_radius {p['r']} is not the scenario's {scenario.turning_radius}")
     need(0.0 < p["s"] <= p["r"], "parameters", f"step {p['s']} is not in (0, r]")
     need(p["h"] > 0.0, "parameters", f"grid cell {p['h']} is not positive")
+
+
+def check_grid(p: dict, unit: float):
+    """Step "parameters": cells far above the coordinates' rounding (h >= 2^10 u = 2^-30 S)."""
+    need(p["h"] >= 1024.0 * unit, "parameters", f"grid cell {p['h']} is below 2^-30 of the scene's scale")
 
 
 def disp_hull(a: float, b: float, s: float, r: float, exact: bool, sign: float):
@@ -230,6 +236,7 @@ def check_dubins_proof(scenario, proof: dict, query_index: int = 0) -> CheckResu
         check_cores([s for s in p["slabs"] if s["cores"] is not None], p["pieces"], unit)
         step = "parameters"
         check_parameters(p, scenario)
+        check_grid(p, unit)
         detail = _regions(scenario, p, q, unit, obstacles)
         return CheckResult(True, "ok", detail)
     except TooBig:
@@ -252,8 +259,8 @@ def _regions(scenario, p, q, unit, obstacles) -> str:
     stencils = [offsets(hl, h) if x["cells"] else None for hl, x in zip(hulls, slabs)]
     border = max(int(np.abs(st).max()) for st in stencils if st is not None) + 1
     maps = Bitmaps(slabs, stencils, border)
-    # seed
-    tol = 1e-9 * h
+    # seed (cells within 1e-9 h + u of it: their corners' rounding is a few ulps of S, far below u)
+    tol = 1e-9 * h + unit
     for k, x in enumerate(slabs):
         if holds(seed[2], x["a"], x["b"], ANGLE_SLACK):
             cells = [(i, j) for i in _spans(seed[0], o[0], h, tol) for j in _spans(seed[1], o[1], h, tol)]

@@ -115,6 +115,7 @@ def swell_core(p):
     (lambda p: p.update(turning_radius=2.0), "parameters"),   # a wider car turns less: not this scene's
     (lambda p: p["grid"].update(cell=p["grid"]["cell"] * 1.25), "seed"),  # the cells move
     (lambda p: p["grid"]["origin"].__setitem__(0, p["grid"]["origin"][0] + 0.3), "seed"),
+    (lambda p: p["grid"].update(cell=1e-12), "parameters"),  # cells below the coordinates' rounding
     (lambda p: p.update(direction="backward"), "seed"),       # the goal is no seed of it
     (lambda p: p["goal"].__setitem__(0, 9.6), "query"),       # not the scenario's goal
     (lambda p: p["slabs"].pop(), "cover"),
