@@ -47,12 +47,12 @@ from ..se2.critical import initial_partition
 FORMAT = "cspace-dubins-proof/1"
 # Resolutions tried in turn (step s as a fraction of r; cell side h = FACTOR s^2 / r, the two
 # leaks per unit length balanced): coarse first, so a car that is not confined pays little.
-STEPS = (0.07,)
+STEPS = (0.07, 0.05)
 CELL_FACTOR = 1.0
 SLAB_OVER = 1.08   # slab width = this x s / r: a step reaches its own slab and its two neighbours
 WINDOW = 2.0       # the window's half side, in turning radii (at least 3 robot radii)
 WINDOW_CELLS = 256  # ... and at most this many cells
-MAX_CELLS = 60_000  # region cells summed over the slabs: past this, no proof
+MAX_CELLS = 60_000  # region cells summed over the slabs at the first step: past this, no proof
 ERODE = 1.0 / math.cos(math.pi / 32)  # a round buffer's chords (8 per quarter) lie inside its circle
 
 
@@ -180,7 +180,9 @@ def reach_proof(regions, start, goal, radius: float, *, backward: bool = False, 
     for frac in steps:
         if deadline is not None and time.perf_counter() > deadline:
             return None
-        got = _attempt(regions, start, goal, radius, frac * radius, backward, deadline, max_cells)
+        # a finer grid holds (s / s')^4 as many cells for the same reach: the cap grows with it
+        cap = int(max_cells * (steps[0] / frac) ** 4)
+        got = _attempt(regions, start, goal, radius, frac * radius, backward, deadline, cap)
         if got is not None:
             return got
     return None
