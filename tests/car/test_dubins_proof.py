@@ -208,6 +208,18 @@ def test_check_proof_command_on_a_dubins_scene(alley, tmp_path, capsys):
         assert err.startswith(f"error: {tmp_path / name}: ") and err.count("\n") == 1, err
 
 
+def test_check_proof_takes_the_space_the_plan_had(alley, tmp_path, capsys):
+    """The alley's file says reeds-shepp: planned with --space dubins, checked with it too."""
+    sc, proof = alley
+    good = tmp_path / "good.json"
+    good.write_text(json.dumps(proof))
+    assert cli_main(["check-proof", ALLEY, str(good)]) == 1
+    assert "step parameters: the scenario's space is 'reeds-shepp'" in capsys.readouterr().out
+    assert cli_main(["check-proof", ALLEY, str(good), "--space", "dubins"]) == 0
+    assert cli_main(["check-proof", ALLEY, str(good), "--space", "dubins", "--turning-radius", "1.5"]) == 1
+    assert "turning_radius 1.0 is not the scenario's 1.5" in capsys.readouterr().out
+
+
 def test_checker_is_independent_of_the_builder():
     tree = ast.parse(open(dubins_check.__file__).read())
     modules = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
