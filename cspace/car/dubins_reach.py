@@ -203,10 +203,11 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
     sten = _Lazy(lambda k: stencil(displacements(*slabs[k], s, r, True, sign), h))
     # the slabs a step's heading can end in: those [a_k - s/r, b_k + s/r] meets (padded)
     turn = s / r + 1e-9
-    targets = _Lazy(lambda k: [j for j, (c, d) in enumerate(slabs) if in_slab(c, slabs[k][0] - turn, slabs[k][1] + turn, 0.0)
+    targets = _Lazy(lambda k: [j for j, (c, d) in enumerate(slabs)
+                               if in_slab(c, slabs[k][0] - turn, slabs[k][1] + turn, 0.0)
                                or in_slab(slabs[k][0] - turn, c, d, 0.0)])
-    # the widest stencil's reach (a slab's hull is its first slab's turned: the same extent up to rounding)
-    border = int(np.abs(sten[0]).max()) + 2
+    # every stencil's reach: a step moves at most s / cos(D/2) (< 1.01 s), a cell's neighbours one more
+    border = int(math.ceil(1.01 * s / h)) + 3
     R = {}
     tested = {}
     front = {}
