@@ -346,3 +346,37 @@ def test_every_resolution_writes_proofs_the_checker_accepts(alley, frac):
     assert proof is not None and proof["step"] == frac
     r = check_dubins_proof(sc, proof)
     assert r.valid, r
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-math.pi, math.pi), st.floats(0.0, 0.5), st.floats(0.01, 1.0), st.floats(0.0, 1.0),
+       st.lists(st.floats(-1.0, 1.0), min_size=1, max_size=6), st.booleans(), st.booleans())
+def test_displacement_hulls_hold_every_curvature_bounded_step(a, width, frac, at, controls, exact, backward):
+    """The lemma both sides rest on, against integration: a forward (or backward) path of length s
+    (exactly s, or at most s) from a heading in [a, a + width], its curvature any piecewise constant
+    in [-1/r, 1/r] (r = 2), ends inside the builder's hull and the checker's."""
+    from cspace.car.dubins_reach import displacements
+    from planners.core.dubins_check import disp_hull
+    import numpy as np
+    import shapely
+
+    r = 2.0
+    s = frac * r
+    b, theta = a + width, a + at * width
+    length = s if exact else s * at
+    sign = -1.0 if backward else 1.0
+    x = y = 0.0
+    n = 60
+    dt = length / n
+    for i in range(n):  # each piece an exact arc (or segment) of constant curvature
+        k = controls[i * len(controls) // n] / r
+        if abs(k) < 1e-12:
+            dx, dy = dt * math.cos(theta), dt * math.sin(theta)
+        else:
+            dx, dy = (math.sin(theta + k * dt) - math.sin(theta)) / k, (math.cos(theta) - math.cos(theta + k * dt)) / k
+        x, y, theta = x + sign * dx, y + sign * dy, theta + k * dt
+    point = shapely.Point(x, y)
+    mine = shapely.Polygon(displacements(a, b, s, r, exact, sign))
+    theirs = disp_hull(a, b, s, r, exact, sign)
+    assert mine.buffer(1e-9).covers(point) and theirs.buffer(1e-9).covers(point), (x, y)
+    assert abs(theta - (a + at * width)) <= length / r + 1e-12
