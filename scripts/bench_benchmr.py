@@ -232,10 +232,10 @@ def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
     """cspace's first certified path, in the order of the default planner (``auto``): a slice of
     sampling first (``auto.SLICE_ITERATIONS`` iterations, ``auto.SLICE_SHARE`` of the limit), the
     proof before sampling only where that slice found nothing (on a city map the proof's POSSIBLE
-    regions cost seconds, and a solvable query needs none; a Dubins car: then the reach proof of
-    either end), then the planner with the rest: (path or None, CPU seconds, of which the proofs,
-    the proof where one found the query unsolvable, else None)."""
-    from planners.core.auto import SLICE_ITERATIONS, SLICE_SHARE
+    regions cost seconds, and a solvable query needs none; a Dubins car: then, as ``auto``, a short
+    turn of the planner and the reach proof of either end), then the planner with the rest: (path or
+    None, CPU seconds, of which the proofs, the proof where one found the query unsolvable, else None)."""
+    from planners.core.auto import SAMPLE_MIN, SAMPLE_SHARE, SLICE_ITERATIONS, SLICE_SHARE
     from planners.core.dubins_proof import reach_budget, reach_result
     from planners.core.exact_se2 import quick_proof, slab_regions_of
     from planners.core.routine import run_planner
@@ -248,11 +248,17 @@ def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
         return res.path, time.process_time() - c0, 0.0, None
     c1 = time.process_time()
     proof = quick_proof(sc, cs, query, limit)
-    if proof is None and sc.space == "dubins":  # auto's next proof: the reach of either end
-        proof = reach_result(sc, cs, slab_regions_of(cs), query, reach_budget(limit))
     c2 = time.process_time()
+    if proof is None and sc.space == "dubins":  # as auto: a short turn of sampling, then the reach proof
+        turn = min(SAMPLE_SHARE * (limit - (time.perf_counter() - w0)), max(SAMPLE_MIN, time.perf_counter() - w0))
+        res = run_planner(adapter, planner, pair, max(turn, 0.0), seed, simplify=False, until_first=True)[0]
+        if res.solved:
+            return res.path, time.process_time() - c0, c2 - c1, None
+        c3 = time.process_time()
+        proof = reach_result(sc, cs, slab_regions_of(cs), query, reach_budget(limit))
+        c2 += time.process_time() - c3  # the proofs' CPU: the SE(2) one and the reach
     if proof is not None:
-        return None, c2 - c0, c2 - c1, proof.proof
+        return None, time.process_time() - c0, c2 - c1, proof.proof
     left = limit - (time.perf_counter() - w0)
     res = run_planner(adapter, planner, pair, max(left, 0.0), seed, simplify=False, until_first=True)[0]
     return (res.path if res.solved else None), time.process_time() - c0, c2 - c1, None
