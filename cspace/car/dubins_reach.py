@@ -161,6 +161,27 @@ class _Blocked:
         return shapely.contains_xy(self.core, x, y) | (x < x0) | (x > x1) | (y < y0) | (y > y1)
 
 
+_LOCAL: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # SlabRegions -> {window: local regions}
+
+
+def _local(regions, box):
+    """Slab regions of the obstacles within the robot's reach of ``box`` (x0, y0, x1, y1) only,
+    with the full regions' bounds, robot and proof unit (so the same cores): their POSSIBLE holds
+    the full one's inside the box (fewer obstacles: more possible, never less)."""
+    from ..se2.slab_graph import SlabRegions
+
+    kept = _LOCAL.setdefault(regions, {})
+    if box not in kept:
+        g = regions.radius
+        x0, y0, x1, y1 = box[0] - g, box[1] - g, box[2] + g, box[3] + g
+        close = [ob for ob in regions.core_obstacles if len(ob) and ob[:, 0].max() >= x0 and ob[:, 0].min() <= x1
+                 and ob[:, 1].max() >= y0 and ob[:, 1].min() <= y1]
+        local = SlabRegions(close, regions.core_robot, regions.bounds)
+        local.unit, local.pad, local.eps = regions.unit, regions.pad, regions.eps
+        kept[box] = local
+    return kept[box]
+
+
 def _blocked(regions, slab, h: float) -> _Blocked:
     kept = _BLOCKED.setdefault(regions, {})
     key = (float(slab[0]), float(slab[1]), float(h))
@@ -199,6 +220,9 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
     i0 = int(math.floor((seed[0] - half - o[0]) / h))
     j0 = int(math.floor((seed[1] - half - o[1]) / h))
     n = int(math.ceil(2 * half / h)) + 1
+    # POSSIBLE of the obstacles near the window only (a reference point in it touches no other):
+    # on a large map a slab's region is then milliseconds; the cores are the full regions' own
+    near = _local(regions, (o[0] + i0 * h, o[1] + j0 * h, o[0] + (i0 + n) * h, o[1] + (j0 + n) * h))
     slabs = initial_partition(K)  # the last ends one ulp past pi: the cover is closed in exact arithmetic
     sten = _Lazy(lambda k: stencil(displacements(*slabs[k], s, r, True, sign), h))
     # the slabs a step's heading can end in: those [a_k - s/r, b_k + s/r] meets (padded)
@@ -223,8 +247,8 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
             tested[k] = R[k].copy()
             front[k] = [np.nonzero(R[k])]
     # (c), checked as cells arrive: the cells from which a last step of at most s reaches the other end
-    near = _near_cells(other, slabs, s, r, sign, h, o, (i0, j0), n)
-    if any((R[k] & near[k]).any() for k in R if k in near):
+    ends = _near_cells(other, slabs, s, r, sign, h, o, (i0, j0), n)
+    if any((R[k] & ends[k]).any() for k in R if k in ends):
         return None
     total = sum(int(x.sum()) for x in R.values())
     count = {k: int(R[k].sum()) for k in front}
@@ -246,7 +270,7 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
             if j not in R:
                 R[j], tested[j] = np.zeros((n, n), bool), np.zeros((n, n), bool)
             if j not in blocked:
-                blocked[j] = _blocked(regions, slabs[j], h)
+                blocked[j] = _blocked(near, slabs[j], h)
             view_t = tested[j][b0[0]:b1[0], b0[1]:b1[1]]
             cand = grown & ~view_t
             if not cand.any():
@@ -256,7 +280,7 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
             view_t |= cand
             if ok.any():
                 ai, aj = ci[ok] + b0[0], cj[ok] + b0[1]
-                if j in near and near[j][ai, aj].any():
+                if j in ends and ends[j][ai, aj].any():
                     return None  # the other end is within reach
                 R[j][ai, aj] = True
                 count[j] = (count[j] if j in front else 0) + len(ai)
@@ -264,7 +288,7 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
                 total += len(ai)
                 if total > max_cells:
                     return None
-    return _json(regions, start, goal, r, s, h, o, i0, j0, slabs, R, targets, backward)
+    return _json(near, start, goal, r, s, h, o, i0, j0, slabs, R, targets, backward)
 
 
 def _near_cells(other, slabs, s: float, r: float, sign: float, h: float, o, corner, n: int) -> dict:
