@@ -91,8 +91,8 @@ def stencil(disp: np.ndarray, h: float) -> np.ndarray:
 
     >>> len(stencil(np.array([[0.0, 0.0], [0.5, 0.0], [0.5, 0.5]]), 1.0))  # the 3 x 3 around (0, 0)
     9
-    >>> stencil(np.array([[2.5, 0.1], [3.5, 0.1], [3.5, 0.4]]), 1.0)[:, 0].tolist()  # 1.5 .. 4.5: cells 1 .. 4
-    [1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4]
+    >>> stencil(np.array([[2.5, 0.1], [3.5, 0.1], [3.5, 0.4]]), 1.0).tolist()  # x 2.5 .. 4.5, y 0.1 .. 1.4
+    [[2, 0], [2, 1], [3, 0], [3, 1], [4, 0], [4, 1]]
     """
     lo, hi = np.floor(disp.min(axis=0) / h) - 1, np.ceil(disp.max(axis=0) / h) + 1
     di, dj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
