@@ -31,9 +31,13 @@ discrete motion check at Bench-MR's step, 0.005 of its box's extent (``se2_peers
 The C-space's slabs are built once per world and car model before its queries (the column "C-space
 (once)"), as the peer's checker is. Every path either returns is judged by the independent shapely
 sweep along its curves (``sweep_oracle.car_sweep_check``). A Dubins query with neither a path nor
-a proof is probed by a lattice (``boxed_in``): when the poses a forward-only car reaches from the
-start, or reaches the goal from, run out without coming near the other end, the script says so --
-evidence, not a proof: cspace has no proof method for a Dubins car. The table: solved, undecided, colliding, median and mean time to
+an SE(2) proof gets auto's reach proof (``planners.core.dubins_proof``: the reach of either end,
+closed under the forward car's steps); every proof either way is re-checked by ``cspace
+check-proof``'s independent checker (the count it accepts is printed). A Dubins query with
+neither a path nor a proof is probed by a lattice (``boxed_in``): when the poses a forward-only
+car reaches from the start, or reaches the goal from, run out without coming near the other end,
+the script says so -- evidence, not a proof (the reach proof's cap or its over-approximation
+stopped short). The table: solved, undecided, colliding, median and mean time to
 the first path, and ours / peer over the runs both solve with the peer's path sound (medians and
 means), per row and per world (target <= 0.5x). Then the peer's paths are written in Bench-MR's
 results format and re-checked by ``cspace recheck``'s routine
@@ -205,9 +209,11 @@ def run_problem(p: dict, seeds: int, limit: float, peer: bool) -> dict:
     runs, boxed = [], {}
     for qi, q in enumerate(sc.all_queries()):
         for seed in range(seeds):
-            path, cpu, proof_cpu, proven = ours_first(sc, cs, adapter, q, seed, limit, planner)
+            path, cpu, proof_cpu, proof = ours_first(sc, cs, adapter, q, seed, limit, planner)
             row = {"query": qi, "seed": seed, "ours_s": cpu if path is not None else None, "ours_proof_s": proof_cpu,
-                   "proven_unsolvable": proven, "ours_colliding": bool(path is not None and collides(path))}
+                   "proven_unsolvable": proof is not None, "ours_colliding": bool(path is not None and collides(path))}
+            if proof is not None:  # re-checked by check-proof's independent checker
+                row["proof_format"], row["proof_accepted"] = proof["format"], accepted(sc, proof, qi)
             if peer:
                 path, cpu = se2_peers.peer_first(adapter, checker, adapter.pose(q.start), adapter.pose(q.goal), seed,
                                                  limit, planner, resolution=p.get("peer_resolution", RESOLUTION))
@@ -226,10 +232,12 @@ def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
     """cspace's first certified path, in the order of the default planner (``auto``): a slice of
     sampling first (``auto.SLICE_ITERATIONS`` iterations, ``auto.SLICE_SHARE`` of the limit), the
     proof before sampling only where that slice found nothing (on a city map the proof's POSSIBLE
-    regions cost seconds, and a solvable query needs none), then the planner with the rest:
-    (path or None, CPU seconds, of which the proof, whether the proof found the query unsolvable)."""
-    from planners.core.auto import SLICE_ITERATIONS, SLICE_SHARE
-    from planners.core.exact_se2 import quick_proof
+    regions cost seconds, and a solvable query needs none; a Dubins car: then, as ``auto``, a short
+    turn of the planner and the reach proof of either end), then the planner with the rest: (path or
+    None, CPU seconds, of which the proofs, the proof where one found the query unsolvable, else None)."""
+    from planners.core.auto import SAMPLE_MIN, SAMPLE_SHARE, SLICE_ITERATIONS, SLICE_SHARE
+    from planners.core.dubins_proof import reach_budget, reach_result
+    from planners.core.exact_se2 import quick_proof, slab_regions_of
     from planners.core.routine import run_planner
 
     c0, w0 = time.process_time(), time.perf_counter()
@@ -237,15 +245,32 @@ def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
     res = run_planner(adapter, planner, pair, SLICE_SHARE * limit, seed, iterations=SLICE_ITERATIONS,
                       simplify=False, until_first=True)[0]
     if res.solved:
-        return res.path, time.process_time() - c0, 0.0, False
+        return res.path, time.process_time() - c0, 0.0, None
     c1 = time.process_time()
     proof = quick_proof(sc, cs, query, limit)
     c2 = time.process_time()
+    if proof is None and sc.space == "dubins":  # as auto: a short turn of sampling, then the reach proof
+        turn = min(SAMPLE_SHARE * (limit - (time.perf_counter() - w0)), max(SAMPLE_MIN, time.perf_counter() - w0))
+        res = run_planner(adapter, planner, pair, max(turn, 0.0), seed, simplify=False, until_first=True)[0]
+        if res.solved:
+            return res.path, time.process_time() - c0, c2 - c1, None
+        c3 = time.process_time()
+        proof = reach_result(sc, cs, slab_regions_of(cs), query, reach_budget(limit))
+        c2 += time.process_time() - c3  # the proofs' CPU: the SE(2) one and the reach
     if proof is not None:
-        return None, c2 - c0, c2 - c1, True
+        return None, time.process_time() - c0, c2 - c1, proof.proof
     left = limit - (time.perf_counter() - w0)
     res = run_planner(adapter, planner, pair, max(left, 0.0), seed, simplify=False, until_first=True)[0]
-    return (res.path if res.solved else None), time.process_time() - c0, c2 - c1, False
+    return (res.path if res.solved else None), time.process_time() - c0, c2 - c1, None
+
+
+def accepted(sc, proof: dict, query_index: int) -> bool:
+    """Whether ``cspace check-proof``'s independent checker accepts the proof (either format)."""
+    from planners.core.dubins_check import FORMAT, check_dubins_proof
+    from planners.core.proof_check import check_proof
+
+    check = check_dubins_proof if proof.get("format") == FORMAT else check_proof
+    return check(sc, proof, query_index).valid
 
 
 def boxed_in(adapter, query, step: float = LATTICE_STEP, cap: int = LATTICE_CAP) -> str | None:
@@ -339,6 +364,9 @@ def summary(r: dict, peer: bool) -> dict:
     row = {"world": r["world"], "space": r["space"], "runs": len(runs), "left_out": r["left_out"],
            "prep_s": r["build_s"], "ours_solved": len(ours), "ours_colliding": sum(x["ours_colliding"] for x in runs),
            "proven_unsolvable": sum(x["proven_unsolvable"] for x in runs),
+           "proofs_accepted": sum(bool(x.get("proof_accepted")) for x in runs),
+           "proven_proof_median_s": statistics.median(p) if (p := [x["ours_proof_s"] for x in runs
+                                                                    if x["proven_unsolvable"]]) else None,
            "boxed_in": {str(k): v for k, v in r["boxed_in"].items() if v},
            "undecided_queries": sorted(r["boxed_in"]),
            "ours_proof_median_s": statistics.median(proofs) if proofs else None,
@@ -438,7 +466,9 @@ def main(argv=None) -> int:
         r = run_problem(p, args.seeds, args.time, peer)
         results.append(r)
         s = summary(r, peer)
-        print(f"{s['world']} {s['space']}: ours {s['ours_solved']}/{s['runs']} solved, {s['ours_colliding']} colliding"
+        proven = (f", {s['proven_unsolvable']} proven unsolvable ({s['proofs_accepted']} proofs accepted by check-proof's "
+                  f"checker; median {s['proven_proof_median_s'] * 1e3:.0f} ms of proofs)" if s["proven_unsolvable"] else "")
+        print(f"{s['world']} {s['space']}: ours {s['ours_solved']}/{s['runs']} solved{proven}, {s['ours_colliding']} colliding"
               + (f"; peer {s['peer_solved']}/{s['runs']}, {s['peer_colliding']} colliding" if peer else ""),
               flush=True)
     rows = [summary(r, peer) for r in results]

@@ -233,12 +233,18 @@ def benchmr_lines(rec: dict) -> list[str]:
             str(r["ours_colliding"]), ms(r["ours_median_s"]), ms(r["ours_mean_s"]), str(r.get("peer_solved", "-")),
             str(r.get("peer_colliding", "-")), ms(r.get("peer_median_s")), ms(r.get("peer_mean_s")),
             x(r.get("ratio")), x(r.get("ratio_mean"))]) + " |")
+    proven = [r for r in data["rows"] if r.get("proven_unsolvable")]
+    if proven:
+        lines += ["", "Proven unsolvable (runs; every proof re-checked by `cspace check-proof`'s independent checker; "
+                  "a Dubins car's is the reach proof of one end, closed under its forward steps):", ""]
+        lines += [f"- {r['world']} {r['space']}: {r['proven_unsolvable']} runs, {r.get('proofs_accepted', '-')} proofs "
+                  f"accepted, median {ms(r.get('proven_proof_median_s'))} CPU for the proofs" for r in proven]
     undecided = [(r["world"], r["space"], q, r.get("boxed_in", {}).get(str(q))) for r in data["rows"]
                  for q in r.get("undecided_queries", [])]
     if undecided:
-        lines += ["", "Undecided: neither a path nor a proof within the time limit. cspace has no proof method for a "
-                  "Dubins (forward-only) car; where a lattice of certified steps shows the start's reach, or the goal's, "
-                  "ending away from the other end, it is named "
+        lines += ["", "Undecided: neither a path nor a proof within the time limit (for a Dubins car, neither the SE(2) "
+                  "proof nor the reach proof of either end, within its cap); where a lattice of certified steps shows "
+                  "the start's reach, or the goal's, ending away from the other end, it is named "
                   "(evidence, not a proof):", ""]
         lines += [f"- {w} {sp} query {q}: {why or 'no lattice evidence either'}" for w, sp, q, why in undecided]
     lines += ["", "Ours / the peer per world (both car models; the runs both solve with the peer's path sound), "

@@ -14,7 +14,9 @@ not answered, in the order of their cost on the scene (a rotating robot or a Ree
    :func:`cspace.car.laumond.to_reeds_shepp`), else a proof where POSSIBLE separates them;
 2. **proof** -- the proof before sampling (a rotating robot: those slabs refined once,
    :func:`planners.core.exact_se2.quick_proof`; a translating one, where it comes first: start
-   and goal in different free components, :func:`planners.core.exact.separated_proof`);
+   and goal in different free components, :func:`planners.core.exact.separated_proof`; a Dubins
+   car where that finds none: a short turn of sampling (as in 3), then the reach of one end
+   closed under the car's steps, :func:`planners.core.dubins_proof.reach_result`);
 3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`; all of it for a
    Dubins car, which has no complete method here and goes from the slice to the proof);
 4. **refinement** -- the exact planner with the rest: the slab graph refined where FREE and
@@ -146,6 +148,19 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
 
         prove = quick_proof if turns else separated_proof
         r = clock.run("proof", lambda: prove(sc, cspace, query, time_limit))
+        if r is not None:
+            return _answer(r, "proof", clock, seed)
+    if turns and kind == "dubins" and clock.left() > 0:
+        # No SE(2) proof: a short turn of sampling (as stage 3's), then the reach of either end,
+        # closed under the car's steps (its regions cost a solvable query more than the turn)
+        from .dubins_proof import reach_budget, reach_result
+        from .exact_se2 import slab_regions_of
+
+        r = sample(min(SAMPLE_SHARE * clock.left(), max(SAMPLE_MIN, clock.elapsed())))
+        if r.solved:
+            return _answer(r, "sampling", clock, seed)
+        r = clock.run("proof", lambda: reach_result(sc, cspace, slab_regions_of(cspace), query,
+                                                    reach_budget(time_limit)))
         if r is not None:
             return _answer(r, "proof", clock, seed)
     share = 1.0 if kind == "dubins" or not turns and sc.rotates else \

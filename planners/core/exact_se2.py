@@ -118,6 +118,12 @@ def built_regions(cspace) -> dict:
     return {"regions": len(made), "region_s": sum(r.seconds for r in made)}
 
 
+def slab_regions_of(cspace):
+    """The C-space's POSSIBLE and FREE regions (a :class:`cspace.se2.slab_graph.SlabRegions`), the
+    ones the slab graph's search reads and keeps (a Dubins car's reach proof reads them too)."""
+    return _regions_of(cspace)
+
+
 def _regions_of(cspace, room: float = 0.0):
     """The C-space's :class:`cspace.se2.slab_graph.SlabRegions` (with the extra clearance
     ``room``, see :func:`search`), made on first use and kept."""
@@ -156,14 +162,23 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     graph = f"{st['slabs']} slabs, {st['refinements']} refinements"
     if res.status == "unsolvable":
         return from_search(sc, query, res, search_s)
+    if car and sc.space == "dubins":  # a forward-only car: the reach of one end, closed under its steps
+        from .dubins_proof import REACH_MAX, reach_result
+
+        reach = reach_result(sc, cspace, _regions_of(cspace), query, REACH_MAX if time_limit is None else
+                             min(REACH_MAX, max(float(time_limit) - search_s, 0.0)))
+        if reach is not None:
+            reach.planner, reach.timings = "exact", {**timings, **reach.timings}
+            return reach
     if car:
         from ..adapters.glue import ompl_available
 
+        reach = ", nor the reach of either end (a forward-only car)" if sc.space == "dubins" else ""
         then = ("use a sampling planner such as RRTConnect" if ompl_available() else
                 "a car's path needs OMPL's sampling planners (not installed)")
         raise ScenarioError(source, "planner", f"a car (space = \"{sc.space}\") cannot turn in place, so exact answers "
                                                f"it only with a proof that no path exists, and the slab graph found "
-                                               f"none ({graph}): {then}")
+                                               f"none ({graph}){reach}: {then}")
     if res.status == "undecided":
         why = st.get("error") or st.get("reason", "")
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,

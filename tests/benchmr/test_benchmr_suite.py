@@ -70,6 +70,12 @@ def test_the_page_section_shows_the_table_ratios_and_recheck_counts(tmp_path):
         in text
     assert "| parking1 | 4 | 0.20x | 0.15x |" in text and "| parking1 | dubins | 5 | 2 |" in text
     assert "2.50, 2.00, 1.50" in text  # the load beside the figures
+    proven = dict(row, space="reeds-shepp", proven_unsolvable=2, proofs_accepted=2, proven_proof_median_s=0.18)
+    doc["rows"] = [row, proven]
+    (tmp_path / "b.json").write_text(json.dumps(doc))
+    text = "\n".join(PAGE.benchmr_lines({"json": str(tmp_path / "b.json"), "stdout": ""}))
+    assert "- parking1 reeds-shepp: 2 runs, 2 proofs accepted, median 180 ms CPU for the proofs" in text
+    assert "- parking1 dubins:" not in text.split("Proven unsolvable")[1].split("Undecided")[0]  # none proven
 
 
 def test_without_a_checkout_the_page_runs_nothing_of_bench_mr_and_says_how(tmp_path, monkeypatch):
