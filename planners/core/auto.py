@@ -83,13 +83,15 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     kind = sc.space if sc.rotates else "translation"
     turns = sc.rotates and bool(cspace.body_pieces)  # a point robot does not turn: nothing to prove
 
-    def sample(budget: float, budget_iterations: int | None = iterations) -> PlanResult:
+    def sample(budget: float, budget_iterations: int | None = iterations, turn: int = 0) -> PlanResult:
         """One turn of the sampler on this query (its stage's seconds counted as ``sampling``).
         Given ``iterations`` (the caller's), a turn is bounded by its count alone, within the
-        time left: where it ends, and so which stage answers, does not depend on the machine."""
+        time left: where it ends, and so which stage answers, does not depend on the machine.
+        A car's later turns (``turn`` > 0) draw samples of their own (:func:`turn_seed`)."""
         if iterations is not None:
             budget = clock.left()
-        return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, seed,
+        s = turn_seed(seed, turn) if turn and kind in ("reeds-shepp", "dubins") else seed
+        return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, s,
                                                           iterations=budget_iterations, simplify=simplify,
                                                           scenario=sc.name)[0])
 
@@ -120,7 +122,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         # Where a refinement follows, sampling gets a short turn: long enough for an open scene
         # (as long as the first slabs and the proof took), short of the refinement's time.
         budget = clock.left() if share == 1.0 else min(share * clock.left(), max(SAMPLE_MIN, clock.elapsed()))
-        sampled = sample(budget)
+        sampled = sample(budget, turn=1)
         if sampled.solved:
             return _answer(sampled, "sampling", clock, seed)
     failed = sampled
@@ -130,7 +132,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
             return _answer(r, "refinement", clock, seed)
         failed = r or failed  # its "not decided" statement says more than sampling's "no path found"
         if kind != "translation" and clock.left() > 0:  # refinement ended early: sample with the rest
-            again = sample(clock.left())
+            again = sample(clock.left(), turn=2)
             if again.solved:
                 return _answer(again, "sampling", clock, seed)
     if failed is None:  # the earlier stages used the whole limit
@@ -138,6 +140,17 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
                             length=math.inf, planner="auto", seed=seed, start=tuple(query.start),
                             goal=tuple(query.goal), message=f"not solved within the time limit ({time_limit:g} s)")
     return _answer(failed, None, clock, seed)
+
+
+def turn_seed(seed: int, turn: int) -> int:
+    """The seed of a car's ``turn``-th sampling turn after its slice: run with the query's own
+    seed, a later turn would first replay the slice's samples (the same tree, the same failure:
+    a turn about as long as the slice added nothing); derived, so the same every run.
+
+    >>> turn_seed(7, 0), turn_seed(7, 1) != turn_seed(7, 2) != 7
+    (7, True)
+    """
+    return int(seed) if turn == 0 else (int(seed) * 0x9E3779B1 + int(turn) * 0x85EBCA77) % (2**31 - 1)
 
 
 def sampling_slice(sample, cspace, clock, time_limit: float) -> PlanResult:

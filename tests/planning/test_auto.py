@@ -202,3 +202,26 @@ def test_given_iterations_auto_s_turns_of_sampling_count_them_not_time(monkeypat
     assert res.solved and len(seen) >= 2, (res.message, seen)  # the slice and the short turn at least
     assert all(budget > 500 for budget, _ in seen), seen  # the time left, never a short share of it
     assert [it for _, it in seen][:2] == [SLICE_ITERATIONS, 40], seen
+
+
+def test_a_car_s_later_turns_of_sampling_draw_their_own_samples(monkeypatch):
+    # Run with the query's seed, the short turn after a failed slice replayed the slice's first
+    # iterations (the same tree, the same failure) before it drew anything new: a car's later turns
+    # get seeds of their own, derived from the query's, so the same seed still gives the same path.
+    import planners.core.auto as auto
+    import planners.core.routine as routine
+
+    seeds = []
+    real = routine.run_planner
+    monkeypatch.setattr(routine, "run_planner", lambda *a, **k: seeds.append(a[4]) or real(*a, **k))
+    monkeypatch.setattr(auto, "SLICE_ITERATIONS", 2)  # a slice that cannot answer
+    scene = os.path.join(SCENARIOS, "car", "maze.toml")  # a Dubins car: the slice, the proof, then sampling
+    paths = []
+    for _ in range(2):
+        seeds.clear()
+        res = planners.plan(scene, seed=3, iterations=3000, time=1000.0)
+        assert res.solved and res.answered_by == "sampling" and res.seed == 3, res.message
+        assert seeds[0] == 3 and seeds[1:] and all(s != 3 for s in seeds[1:]), seeds
+        assert seeds[1:] == [auto.turn_seed(3, t) for t in range(1, len(seeds))], seeds
+        paths.append(res.path)
+    assert np.array_equal(*paths)
