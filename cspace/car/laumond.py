@@ -83,8 +83,10 @@ def _convert(cspace, a, b, radius: float, depth: int, budget: list, deadline, ou
 
 def shortcut(cspace, poses, radius: float, *, deadline=None) -> np.ndarray:
     """Fewer poses along a path of certified Reeds–Shepp curves: from each kept pose, the farthest
-    later pose that one certified curve reaches (tried at strides 1, 2, 4, ... then bisected back;
-    stride 1 is the curve the path already has), so a path of many short curves from
+    later pose that one certified curve reaches (tried from the far end: the last pose, then halfway
+    to it, ..., then bisected back between the first reached and the last refused; which poses one
+    curve reaches is not monotone: a sideways shift is one S-shaped curve where its short pieces
+    are tiny parking manoeuvres), so a path of many short curves from
     :func:`to_reeds_shepp` becomes one of a few long ones before a costlier shortening. Every
     curve of the result is certified; ``deadline()`` True keeps the rest as it is.
 
@@ -107,11 +109,14 @@ def shortcut(cspace, poses, radius: float, *, deadline=None) -> np.ndarray:
         if deadline is not None and deadline():
             out.extend(rows[i + 1:])
             break
-        good, stride = i + 1, 2
-        while i + stride < n and free(i, i + stride):  # gallop while one curve reaches
-            good, stride = i + stride, 2 * stride
-        bad = min(i + stride, n)  # the first stride refused (or past the end)
-        while bad - good > 1:  # the farthest reachable pose between them
+        # long jumps first: the last pose, then halfway to it, ...
+        good, bad, j = i + 1, None, n - 1
+        while j > i + 1:
+            if free(i, j):
+                good = j
+                break
+            bad, j = j, i + (j - i) // 2
+        while bad is not None and bad - good > 1:  # back between the reached and the refused
             mid = (good + bad) // 2
             good, bad = (mid, bad) if free(i, mid) else (good, mid)
         out.append(rows[good])

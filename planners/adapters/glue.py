@@ -146,8 +146,17 @@ def make_setup(space, planner: str, seed: int, query: int = 0):
     ss.setStateValidityChecker(checker)
     validator = adapter.motion_validator(si)
     si.setMotionValidator(validator)
-    ss.setPlanner(getattr(og, planner)(si))
+    chosen = getattr(og, planner)(si)
+    cap = getattr(adapter, "max_range", None)
+    if cap is not None and hasattr(chosen, "setRange"):
+        # OMPL's own range is a fifth of the space's extent (SelfConfig); an adapter may bound it
+        if cap < RANGE_SHARE * si.getMaximumExtent():
+            chosen.setRange(cap)
+    ss.setPlanner(chosen)
     return ss, ospace, checker, validator
+
+
+RANGE_SHARE = 0.2  # OMPL's default range: this share of the space's maximum extent
 
 
 SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit and must not be 0

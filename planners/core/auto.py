@@ -114,13 +114,15 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     kind = sc.space if sc.rotates else "translation"
     turns = sc.rotates and bool(cspace.body_pieces)  # a point robot does not turn: nothing to prove
 
-    def sample(budget: float, budget_iterations: int | None = iterations) -> PlanResult:
+    def sample(budget: float, budget_iterations: int | None = iterations, turn: int = 0) -> PlanResult:
         """One turn of the sampler on this query (its stage's seconds counted as ``sampling``).
         Given ``iterations`` (the caller's), a turn is bounded by its count alone, within the
-        time left: where it ends, and so which stage answers, does not depend on the machine."""
+        time left: where it ends, and so which stage answers, does not depend on the machine.
+        A car's later turns (``turn`` > 0) draw samples of their own (:func:`turn_seed`)."""
         if iterations is not None:
             budget = clock.left()
-        return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, seed,
+        s = turn_seed(seed, turn) if turn and kind in ("reeds-shepp", "dubins") else seed
+        return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, s,
                                                           iterations=budget_iterations, simplify=simplify,
                                                           scenario=sc.name)[0])
 
@@ -156,7 +158,8 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         from .dubins_proof import reach_budget, reach_result
         from .exact_se2 import slab_regions_of
 
-        r = sample(min(SAMPLE_SHARE * clock.left(), max(SAMPLE_MIN, clock.elapsed())))
+        # (samples of its own: turn 3, after the slice's 0 and before stage 3's 1 and 2)
+        r = sample(min(SAMPLE_SHARE * clock.left(), max(SAMPLE_MIN, clock.elapsed())), turn=3)
         if r.solved:
             return _answer(r, "sampling", clock, seed)
         r = clock.run("proof", lambda: reach_result(sc, cspace, slab_regions_of(cspace), query,
@@ -170,7 +173,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         # Where a refinement follows, sampling gets a short turn: long enough for an open scene
         # (as long as the first slabs and the proof took), short of the refinement's time.
         budget = clock.left() if share == 1.0 else min(share * clock.left(), max(SAMPLE_MIN, clock.elapsed()))
-        sampled = sample(budget)
+        sampled = sample(budget, turn=1)
         if sampled.solved:
             return _answer(sampled, "sampling", clock, seed)
     failed = sampled
@@ -180,7 +183,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
             return _answer(r, "refinement", clock, seed)
         failed = r or failed  # its "not decided" statement says more than sampling's "no path found"
         if kind != "translation" and clock.left() > 0:  # refinement ended early: sample with the rest
-            again = sample(clock.left())
+            again = sample(clock.left(), turn=2)
             if again.solved:
                 return _answer(again, "sampling", clock, seed)
     if failed is None:  # the earlier stages used the whole limit
@@ -250,6 +253,8 @@ def _small_se2(sc, cspace, adapter, query, pair, clock: _Clock, seed: int, sourc
         if r.solved:
             return _answer(r, "sampling", clock, seed)
     return _answer(failed, None, clock, seed)
+
+
 def _direct(sc, adapter, query, pair, seed: int) -> PlanResult | None:
     """Stage 0's first try for a car: the shortest curve from start to goal, the whole path when
     the car's motion validator certifies it free (one curve check; None otherwise)."""
@@ -268,6 +273,17 @@ def _direct(sc, adapter, query, pair, seed: int) -> PlanResult | None:
                       stages=["direct curve"], start=tuple(query.start), goal=tuple(query.goal),
                       message="certified solution: the direct curve from start to goal is free",
                       length_unsimplified=length, first_path_cpu=found_cpu)
+
+
+def turn_seed(seed: int, turn: int) -> int:
+    """The seed of a car's ``turn``-th sampling turn after its slice: run with the query's own
+    seed, a later turn would first replay the slice's samples (the same tree, the same failure:
+    a turn about as long as the slice added nothing); derived, so the same every run.
+
+    >>> turn_seed(7, 0), turn_seed(7, 1) != turn_seed(7, 2) != 7
+    (7, True)
+    """
+    return int(seed) if turn == 0 else (int(seed) * 0x9E3779B1 + int(turn) * 0x85EBCA77) % (2**31 - 1)
 
 
 def sampling_slice(sample, cspace, clock, time_limit: float) -> PlanResult:

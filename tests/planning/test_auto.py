@@ -302,3 +302,48 @@ def test_a_car_tries_its_direct_curve_first(name, direct):
     if direct:
         assert len(res.path) == 2 and tuple(res.path[0]) == tuple(sc.start) and tuple(res.path[-1]) == tuple(sc.goal)
     assert judged_free(sc, np.asarray(res.path))
+
+
+def test_a_car_s_later_turns_of_sampling_draw_their_own_samples(monkeypatch):
+    # Run with the query's seed, the short turn after a failed slice replayed the slice's first
+    # iterations (the same tree, the same failure) before it drew anything new: a car's later turns
+    # get seeds of their own, derived from the query's, so the same seed still gives the same path.
+    import planners.core.auto as auto
+    import planners.core.routine as routine
+
+    seeds = []
+    real = routine.run_planner
+    monkeypatch.setattr(routine, "run_planner", lambda *a, **k: seeds.append(a[4]) or real(*a, **k))
+    monkeypatch.setattr(auto, "SLICE_ITERATIONS", 2)  # a slice that cannot answer
+    scene = os.path.join(SCENARIOS, "car", "maze.toml")  # a Dubins car: the slice, the proof, then sampling
+    paths = []
+    for _ in range(2):
+        seeds.clear()
+        res = planners.plan(scene, seed=3, iterations=3000, time=1000.0)
+        assert res.solved and res.answered_by == "sampling" and res.seed == 3, res.message
+        assert seeds[0] == 3 and seeds[1:] and all(s != 3 for s in seeds[1:]), seeds
+        # each later turn its own seed (a Dubins car: turn 3 before the reach proof, then 1, 2)
+        assert len(set(seeds[1:])) == len(seeds) - 1 and set(seeds[1:]) <= {auto.turn_seed(3, t) for t in (1, 2, 3)}, seeds
+        paths.append(res.path)
+    assert np.array_equal(*paths)
+
+
+def test_the_shortcut_finds_a_far_pose_one_curve_reaches_past_refused_near_ones():
+    # Which later poses one curve reaches is not monotone: a sideways shift is one S-shaped curve
+    # end to end where its short pieces are tiny parking manoeuvres that graze a wall (the
+    # warehouse's pair 60: 2 125 curves of 6 mm kept 2 068 when the search galloped up from the
+    # nearest pose and stopped at the first refusal). A stand-in C-space answers which are free.
+    from cspace.car.laumond import shortcut
+
+    poses = np.array([[0.1 * k, 0.0, 0.0] for k in range(41)])
+    asked = []
+
+    class Stub:
+        def car_motion_free(self, a, b, kind, radius):
+            i, j = round(a[0] * 10), round(b[0] * 10)
+            asked.append((i, j))
+            return j - i == 1 or (i == 0 and 15 <= j <= 35) or (i == 35 and j == 40)
+
+    out = shortcut(Stub(), poses, 0.5)
+    assert out.tolist() == [poses[0].tolist(), poses[35].tolist(), poses[40].tolist()]
+    assert len(asked) < 40  # from the far end down, then bisected: a few checks per kept pose
