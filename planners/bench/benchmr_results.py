@@ -118,17 +118,35 @@ def recheck(doc: dict, path: str, steering: str | None = None) -> list[dict]:
         raise InputError(path, "settings.steer.car_turning_radius", f"a positive radius for {steer}, got {radius!r}")
     robot = [_polygon(p, path, "settings.env.collision.robot_shape") for p in parts] \
         if coll.get("collision_model", 1) else []
-    out = []
+    runs = []
     for i, run in enumerate(doc["runs"]):
         if not isinstance(run, dict) or not isinstance(run.get("plans"), dict):
             raise InputError(path, f"runs[{i}]", "a run has an environment and plans")
-        out += _recheck_run(run, i, robot, kind, radius, path)
+        runs.append(_read_run(run, i, path))
+    # One C-space per distinct environment (a results file repeats its world in every run), its
+    # bounds holding every run's obstacles and paths, grown by the robot's reach and two radii.
+    reach = max((float(np.hypot(*r.T).max()) for r in robot), default=0.0) + 2 * float(radius or 0.0) + 1.0
+    boxes: dict = {}
+    for obstacles, holes, plans, key in runs:
+        pts = np.concatenate([o for o in obstacles] + [p[:, :2] for p, _ in plans.values()] or [np.zeros((0, 2))])
+        if len(pts):
+            lo, hi = pts.min(axis=0), pts.max(axis=0)
+            old = boxes.get(key)
+            boxes[key] = (lo, hi) if old is None else (np.minimum(old[0], lo), np.maximum(old[1], hi))
+    spaces: dict = {}
+    out = []
+    for i, (obstacles, holes, plans, key) in enumerate(runs):
+        if key not in boxes:
+            continue
+        if key not in spaces:
+            spaces[key] = _cspace(obstacles, holes, robot, boxes[key], reach, path, i)
+        out += _check_plans(spaces[key], plans, i, kind, radius)
     return out
 
 
-def _recheck_run(run: dict, i: int, robot: list, kind: str | None, radius, path: str) -> list[dict]:
-    from cspace.car.motion import CarCSpace
-
+def _read_run(run: dict, i: int, path: str):
+    """A run's obstacles, holes and solved plans ``{name: (poses, stats)}``, and its environment's
+    identity (its obstacles' and holes' floats: runs of one world share a C-space)."""
     env = run.get("environment") or {}
     if env.get("type", "polygon") != "polygon":
         raise InputError(path, f"runs[{i}].environment.type", f"{env.get('type')!r}: only polygon environments "
@@ -144,17 +162,24 @@ def _recheck_run(run: dict, i: int, robot: list, kind: str | None, radius, path:
         stats = plan.get("stats") or {}
         if stats.get("path_found") and plan.get("path"):
             plans[name] = (_poses(plan["path"], path, f"runs[{i}].plans.{name}.path"), stats)
-    pts = [o for o in obstacles] + [p[:, :2] for p, _ in plans.values()]
-    if not pts:
-        return []
-    allp = np.concatenate(pts)
-    reach = max((float(np.hypot(*r.T).max()) for r in robot), default=0.0) + 2 * float(radius or 0.0) + 1.0
-    lo, hi = allp.min(axis=0) - reach, allp.max(axis=0) + reach
+    key = (tuple(o.tobytes() + b"|" + str(o.shape).encode() for o in obstacles),
+           tuple(tuple(h.tobytes() + b"|" + str(h.shape).encode() for h in hs) for hs in holes))
+    return obstacles, holes, plans, key
+
+
+def _cspace(obstacles, holes, robot, box, reach: float, path: str, i: int):
+    from cspace.car.motion import CarCSpace
+
+    lo, hi = box[0] - reach, box[1] + reach
     try:
-        cs = CarCSpace((lo[0], hi[0], lo[1], hi[1]), obstacles, robot or None, obstacle_holes=holes)
+        return CarCSpace((lo[0], hi[0], lo[1], hi[1]), obstacles, robot or None, obstacle_holes=holes)
     except (ValueError, TypeError) as exc:
         raise InputError(path, f"runs[{i}].environment", f"not a polygon scene cspace reads ({str(exc)[:100]})"
                          ) from None
+
+
+def _check_plans(cs, plans: dict, i: int, kind: str | None, radius) -> list[dict]:
+    """Each plan's path along its curves: the first colliding pose, or None."""
     out = []
     for name, (poses, stats) in plans.items():
         first = None
