@@ -27,10 +27,11 @@ SEGMENTS_KEPT = 512
 FREE_KEPT = 4096  # motions certified free, remembered by their exact floats (CarSpace.motion_free)
 # A sampling planner's step (its range) for a car, at most this many turning radii. OMPL's default,
 # a fifth of the space's extent, is 20-30 m on a building's map: curves that long between random
-# poses nearly always meet a rack or a wall, and the trees stop growing (the warehouse's long
-# routes: RRTConnect joined 80 of 100 pairs in 1000 iterations at OMPL's range, 90 at 10 radii).
-# A scene smaller than about 50 radii keeps OMPL's range.
-RANGE_RADII = 10.0
+# poses nearly always meet a rack or a wall, and the trees stop growing. 40 of the warehouse's
+# Reeds-Shepp pairs, plan()'s mean CPU: 159 ms at OMPL's range, 111 ms at 20 radii, 91 ms at 10;
+# but 10 radii made Bench-MR's open city grids (Berlin_0_256, r = 4: OMPL's range about 18 radii)
+# 2-7x slower. A scene smaller than about 100 radii keeps OMPL's range.
+RANGE_RADII = 20.0
 SEGMENT_NAMES = {"L": "left", "S": "straight", "R": "right"}
 
 

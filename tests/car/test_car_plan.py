@@ -235,10 +235,10 @@ def test_a_car_plan_counts_its_curves_as_motions():
     assert res.checks["motions"] == asked >= len(res.path) - 1
 
 
-def test_a_car_samples_at_most_ten_turning_radii_per_step_on_a_large_map():
+def test_a_car_samples_at_most_twenty_turning_radii_per_step_on_a_large_map():
     """OMPL's default range (a fifth of the space's extent: 28 m on a 100 m map) draws curves that
-    almost always meet a rack or a wall: a car's planners step at most 10 turning radii there, and
-    keep OMPL's own range on every bundled scene (smaller than about 50 radii)."""
+    almost always meet a rack or a wall: a car's planners step at most 20 turning radii there, and
+    keep OMPL's own range on every bundled scene (smaller than about 100 radii)."""
     from cspace.io.load import scenario_from_dict
     from planners.adapters.glue import RANGE_SHARE, make_setup
     from planners.core.plan import build_cspace, make_adapter
@@ -252,10 +252,10 @@ def test_a_car_samples_at_most_ten_turning_radii_per_step_on_a_large_map():
         adapter = make_adapter(sc, build_cspace(sc))
         ss = make_setup(adapter, "RRTConnect", 0)[0]
         got = math.ldexp(ss.getPlanner().getRange(), -adapter.k)
-        assert got == pytest.approx(5.0, rel=1e-12)
+        assert got == pytest.approx(20 * 0.5, rel=1e-12)
         assert got < math.ldexp(RANGE_SHARE * ss.getSpaceInformation().getMaximumExtent(), -adapter.k)
         res = planners.plan(sc, planner="RRTConnect", seed=0, iterations=2000, time=30.0, simplify=False)
-        assert res.solved and np.hypot(*np.diff(res.path[:, :2], axis=0).T).max() <= 5.0 * (1 + 1e-9) + 1e-9
+        assert res.solved and np.hypot(*np.diff(res.path[:, :2], axis=0).T).max() <= 10.0 * (1 + 1e-9) + 1e-9
     for path in CARS:  # a small scene: the range OMPL's setup picks (unset before it)
         sc = load_scenario(path)
         ss = make_setup(make_adapter(sc, build_cspace(sc)), "RRTConnect", 0)[0]
