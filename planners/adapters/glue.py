@@ -149,14 +149,19 @@ def make_setup(space, planner: str, seed: int, query: int = 0):
     chosen = getattr(og, planner)(si)
     cap = getattr(adapter, "max_range", None)
     if cap is not None and hasattr(chosen, "setRange"):
-        # OMPL's own range is a fifth of the space's extent (SelfConfig); an adapter may bound it
-        if cap < RANGE_SHARE * si.getMaximumExtent():
-            chosen.setRange(cap)
+        # OMPL's own range is a fifth of the space's extent (SelfConfig); an adapter may bound it,
+        # never below RANGE_FLOOR of it: OMPL's connect step walks to its target in range-long
+        # steps without looking at the clock (a car of turning radius 1e-8 in a 10 m scene, its
+        # range 2e-7, walked for minutes past a 2 s limit)
+        own = RANGE_SHARE * si.getMaximumExtent()
+        if cap < own:
+            chosen.setRange(max(cap, RANGE_FLOOR * own))
     ss.setPlanner(chosen)
     return ss, ospace, checker, validator
 
 
 RANGE_SHARE = 0.2  # OMPL's default range: this share of the space's maximum extent
+RANGE_FLOOR = 0.25  # an adapter's bound on the range: at least this share of OMPL's own
 
 
 SEED_LIMIT = 2**32 - 1  # OMPL's seeds are 32-bit and must not be 0

@@ -240,7 +240,7 @@ def test_a_car_samples_at_most_twenty_turning_radii_per_step_on_a_large_map():
     almost always meet a rack or a wall: a car's planners step at most 20 turning radii there, and
     keep OMPL's own range on every bundled scene (smaller than about 100 radii)."""
     from cspace.io.load import scenario_from_dict
-    from planners.adapters.glue import RANGE_SHARE, make_setup
+    from planners.adapters.glue import RANGE_FLOOR, RANGE_SHARE, make_setup
     from planners.core.plan import build_cspace, make_adapter
 
     box = [[-0.45, -0.31], [0.45, -0.31], [0.45, 0.31], [-0.45, 0.31]]
@@ -256,6 +256,11 @@ def test_a_car_samples_at_most_twenty_turning_radii_per_step_on_a_large_map():
         assert got < math.ldexp(RANGE_SHARE * ss.getSpaceInformation().getMaximumExtent(), -adapter.k)
         res = planners.plan(sc, planner="RRTConnect", seed=0, iterations=2000, time=30.0, simplify=False)
         assert res.solved and np.hypot(*np.diff(res.path[:, :2], axis=0).T).max() <= 10.0 * (1 + 1e-9) + 1e-9
+    data["turning_radius"] = 2e-7  # a tiny radius: the bound stops at a quarter of OMPL's range (its
+    sc = scenario_from_dict(data, "<large>", space="reeds-shepp", turning_radius=2e-7)  # connect walks in range steps
+    ss = make_setup(make_adapter(sc, build_cspace(sc)), "RRTConnect", 0)[0]
+    own = RANGE_SHARE * ss.getSpaceInformation().getMaximumExtent()
+    assert ss.getPlanner().getRange() == pytest.approx(RANGE_FLOOR * own, rel=1e-12)
     for path in CARS:  # a small scene: the range OMPL's setup picks (unset before it)
         sc = load_scenario(path)
         ss = make_setup(make_adapter(sc, build_cspace(sc)), "RRTConnect", 0)[0]
