@@ -34,9 +34,8 @@ import math
 import numpy as np
 import shapely
 
-from .proof_check import (CheckResult, Refused, TooBig, check_cores, check_cover, check_query, check_robot, need,
-                          num, ring)
-from .proof_geometry import Obstacles, SHRINK_UNITS, convex_obstacles, possible_components, scene_unit
+from .proof_check import CheckResult, Refused, TooBig, need, num, parse_header, ring, run_steps, shared_steps
+from .proof_geometry import Obstacles, SHRINK_UNITS, convex_obstacles, possible_components
 
 FORMAT = "cspace-dubins-proof/1"
 KEYS = ("format", "start", "goal", "bounds", "robot_pieces", "turning_radius", "direction", "step", "grid", "slabs")
@@ -52,13 +51,7 @@ LIMITS = {"slabs": 2048, "runs": 1_000_000, "stencil": 20_000, "cells": 50_000_0
 
 def parse(proof) -> dict:
     """Step "format": the proof's fields as floats, rings and integer runs."""
-    need(isinstance(proof, dict), "format", "the proof is not a JSON object")
-    need(set(proof) == set(KEYS), "format", f"keys {sorted(map(str, proof))} are not {sorted(KEYS)}")
-    need(proof["format"] == FORMAT, "format", f"format is not {FORMAT!r}")
-    out = {}
-    for key, n in (("start", 3), ("goal", 3), ("bounds", 4)):
-        need(isinstance(proof[key], list) and len(proof[key]) == n, "format", f"{key}: not a list of {n} numbers")
-        out[key] = [num(v, key) for v in proof[key]]
+    out = parse_header(proof, KEYS, FORMAT)
     out["r"], out["s"] = num(proof["turning_radius"], "turning_radius"), num(proof["step"], "step")
     need(proof["direction"] in ("forward", "backward"), "format", "direction: not 'forward' or 'backward'")
     out["backward"] = proof["direction"] == "backward"
@@ -66,9 +59,6 @@ def parse(proof) -> dict:
     need(isinstance(g, dict) and set(g) == {"origin", "cell"} and isinstance(g["origin"], list)
          and len(g["origin"]) == 2, "format", "grid: not an object of origin [x, y] and cell")
     out["o"], out["h"] = [num(v, "grid.origin") for v in g["origin"]], num(g["cell"], "grid.cell")
-    pieces = proof["robot_pieces"]
-    need(isinstance(pieces, list) and pieces, "format", "robot_pieces: not a non-empty list")
-    out["pieces"] = [ring(p, f"robot_pieces[{i}]") for i, p in enumerate(pieces)]
     need(isinstance(proof["slabs"], list) and proof["slabs"], "format", "slabs: not a non-empty list")
     if len(proof["slabs"]) > LIMITS["slabs"]:
         raise TooBig(f"{len(proof['slabs'])} slabs (the builder writes at most {LIMITS['slabs']})")
@@ -79,7 +69,7 @@ def parse(proof) -> dict:
              f"{w}: not an object of a, b, cores, cells")
         cores = None
         if s["cores"] is not None:
-            need(isinstance(s["cores"], list) and len(s["cores"]) == len(pieces), "format",
+            need(isinstance(s["cores"], list) and len(s["cores"]) == len(out["pieces"]), "format",
                  f"{w}.cores: not null or one core per robot piece")
             cores = [ring(c, f"{w}.cores[{i}]", True) for i, c in enumerate(s["cores"])]
             for i, c in enumerate(cores):
@@ -217,36 +207,21 @@ class Bitmaps:
 def check_dubins_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
     """Check a Dubins reach proof that no forward path joins query ``query_index`` of
     ``scenario``: the first failing step, or ``valid``. Past :data:`LIMITS`: :class:`TooBig`."""
-    step = "format"
-    try:
+    def steps(at: list) -> CheckResult:
         p = parse(proof)
         obstacles = convex_obstacles(scenario)
         n_obs = sum(map(len, obstacles))
         work = sum(n_obs + sum(map(len, s["cores"])) + 64 for s in p["slabs"] if s["cores"] is not None)
         if work > LIMITS["work"]:
             raise TooBig(f"{work} units of POSSIBLE work (at most {LIMITS['work']})")
-        step = "query"
-        q = check_query(scenario, p, query_index)
-        step = "robot"
-        check_robot(scenario, p["pieces"])
-        step = "cover"
-        check_cover(p["slabs"])
-        unit = scene_unit(scenario.bounds, obstacles, p["pieces"])
-        step = "cores"
-        check_cores([s for s in p["slabs"] if s["cores"] is not None], p["pieces"], unit)
-        step = "parameters"
+        q, unit = shared_steps(scenario, p, query_index, obstacles, [s for s in p["slabs"] if s["cores"] is not None],
+                               at)
+        at[0] = "parameters"
         check_parameters(p, scenario)
         check_grid(p, unit)
-        detail = _regions(scenario, p, q, unit, obstacles)
-        return CheckResult(True, "ok", detail)
-    except TooBig:
-        raise
-    except Refused as r:
-        return CheckResult(False, r.step, r.detail)
-    except MemoryError:
-        raise TooBig("more memory than the machine has") from None
-    except Exception as exc:  # a checker never accepts what it could not check
-        return CheckResult(False, step, f"could not be checked ({type(exc).__name__}: {exc})"[:300])
+        return CheckResult(True, "ok", _regions(scenario, p, q, unit, obstacles))
+
+    return run_steps(steps)
 
 
 def _regions(scenario, p, q, unit, obstacles) -> str:

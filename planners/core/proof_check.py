@@ -155,11 +155,12 @@ def index_list(items, what: str, width: int, sizes) -> list:
     return [tuple(t) for t in items]
 
 
-def parse(proof) -> dict:
-    """Step "format": the proof's fields as floats, point tuples and index tuples."""
+def parse_header(proof, keys, fmt: str) -> dict:
+    """Step "format", what every proof format shares: a JSON object of exactly ``keys`` in format
+    ``fmt``; its start, goal and bounds as floats, its robot pieces as rings."""
     need(isinstance(proof, dict), "format", "the proof is not a JSON object")
-    need(set(proof) == set(KEYS), "format", f"keys {sorted(map(str, proof))} are not {sorted(KEYS)}")
-    need(proof["format"] == FORMAT, "format", f"format is not {FORMAT!r}")
+    need(set(proof) == set(keys), "format", f"keys {sorted(map(str, proof))} are not {sorted(keys)}")
+    need(proof["format"] == fmt, "format", f"format is not {fmt!r}")
     out = {}
     for key, n in (("start", 3), ("goal", 3), ("bounds", 4)):
         need(isinstance(proof[key], list) and len(proof[key]) == n, "format", f"{key}: not a list of {n} numbers")
@@ -167,6 +168,13 @@ def parse(proof) -> dict:
     pieces = proof["robot_pieces"]
     need(isinstance(pieces, list) and pieces, "format", "robot_pieces: not a non-empty list")
     out["pieces"] = [ring(p, f"robot_pieces[{i}]") for i, p in enumerate(pieces)]
+    return out
+
+
+def parse(proof) -> dict:
+    """Step "format": the proof's fields as floats, point tuples and index tuples."""
+    out = parse_header(proof, KEYS, FORMAT)
+    pieces = proof["robot_pieces"]
     big = max(len(p) for p in out["pieces"])
     if big > LIMITS["piece_vertices"]:
         raise TooBig(f"a robot piece of {big} vertices (the planner's have at most {LIMITS['piece_vertices']})")
@@ -342,32 +350,24 @@ def check_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
     """Check a proof that no path joins query ``query_index`` of ``scenario`` (a loaded
     :class:`cspace.io.load.Scenario`): the first failing step, or ``valid`` (step ``"ok"``).
     A proof asking for more work than the planner's can (:data:`LIMITS`) raises :class:`TooBig`."""
-    step = "format"
-    try:
+    def steps(at: list) -> CheckResult:
         p = parse(proof)
         obstacles = convex_obstacles(scenario)
         work = proof_work(obstacles, p["slabs"])
         if work > LIMITS["work"]:
             raise TooBig(f"{len(p['slabs'])} slabs over {sum(map(len, obstacles))} obstacle vertices: {work} units "
                          f"of work (at most {LIMITS['work']})")
-        step = "query"
-        q = check_query(scenario, p, query_index)
-        step = "robot"
-        check_robot(scenario, p["pieces"])
-        step = "cover"
-        check_cover(p["slabs"])
-        unit = scene_unit(scenario.bounds, obstacles, p["pieces"])
-        step = "cores"
-        check_cores(p["slabs"], p["pieces"], unit)
-        step = "regions"
+        q, unit = shared_steps(scenario, p, query_index, obstacles, p["slabs"], at)
+        at[0] = "regions"
         graph = regions(scenario, p, q, unit)
-        step = "nodes"
+        at[0] = "nodes"
         for key in ("start", "goal"):
             need(graph.ends[key], "nodes", f"the {key} lies in no component of POSSIBLE")
         for step in ("nodes", "edges"):
+            at[0] = step
             need(step not in graph.faults, step, graph.faults.get(step, ""))
         ends = {key: set(p[f"{key}_nodes"]) | graph.ends[key] for key in ("start", "goal")}
-        step, adj = "separation", {}
+        at[0], adj = "separation", {}
         for u, v in graph.extra + [((k, c), (k2, c2)) for k, c, k2, c2 in graph.given]:
             adj.setdefault(u, set()).add(v)
             adj.setdefault(v, set()).add(u)
@@ -382,14 +382,40 @@ def check_proof(scenario, proof: dict, query_index: int = 0) -> CheckResult:
         n_comps = sum(len(s["components"]) for s in p["slabs"])
         return CheckResult(True, "ok", f"{len(p['slabs'])} slabs, {n_comps} components, {len(graph.given)} "
                                        "edges; no start node reaches a goal node")
+
+    return run_steps(steps)
+
+
+def shared_steps(scenario, p: dict, query_index: int, obstacles, cored: list, at: list) -> tuple:
+    """Steps "query", "robot", "cover" and "cores", as every proof format has them (``cored``: the
+    slabs whose cores are given); ``at[0]`` follows the step. The query's poses and the unit."""
+    at[0] = "query"
+    q = check_query(scenario, p, query_index)
+    at[0] = "robot"
+    check_robot(scenario, p["pieces"])
+    at[0] = "cover"
+    check_cover(p["slabs"])
+    unit = scene_unit(scenario.bounds, obstacles, p["pieces"])
+    at[0] = "cores"
+    check_cores(cored, p["pieces"], unit)
+    return q, unit
+
+
+def run_steps(steps) -> CheckResult:
+    """A checker's steps, ``steps(at)`` (``at[0]``: the step it is at): a refusal names its step,
+    a proof past the limits raises :class:`TooBig`, and anything else it could not check is not
+    accepted (a checker never accepts what it could not check)."""
+    at = ["format"]
+    try:
+        return steps(at)
     except TooBig:
         raise
     except Refused as r:
         return CheckResult(False, r.step, r.detail)
     except MemoryError:
         raise TooBig("more memory than the machine has") from None
-    except Exception as exc:  # a checker never accepts what it could not check
-        return CheckResult(False, step, f"could not be checked ({type(exc).__name__}: {exc})"[:300])
+    except Exception as exc:
+        return CheckResult(False, at[0], f"could not be checked ({type(exc).__name__}: {exc})"[:300])
 
 
 def load_proof(path) -> dict:
