@@ -14,11 +14,10 @@ not answered, in the order of their cost on the scene (a rotating robot or a Ree
    :func:`cspace.car.laumond.to_reeds_shepp`), else a proof where POSSIBLE separates them;
 2. **proof** -- the proof before sampling (a rotating robot: those slabs refined once,
    :func:`planners.core.exact_se2.quick_proof`; a translating one, where it comes first: start
-   and goal in different free components, :func:`planners.core.exact.separated_proof`; a Dubins
-   car where that finds none: a short turn of sampling (as in 3), then the reach of one end
-   closed under the car's steps, :func:`planners.core.dubins_proof.reach_result`);
-3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`; all of it for a
-   Dubins car, which has no complete method here and goes from the slice to the proof);
+   and goal in different free components, :func:`planners.core.exact.separated_proof`);
+3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`). A Dubins car,
+   which has no complete method here, goes from the slice to restarts of sampling with the
+   reach proof and this proof between them (:func:`planners.core.auto_dubins.dubins_stages`);
 4. **refinement** -- the exact planner with the rest: the slab graph refined where FREE and
    POSSIBLE disagree (SE(2); a Reeds–Shepp car's path converted as in 1), then sampling again
    with whatever is left; for a translating robot the exact shortest path.

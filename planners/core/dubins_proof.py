@@ -1,9 +1,9 @@
 """A Dubins car's proof that no path exists, as a PlanResult: the reach of one end closed under
 the forward car's steps (:func:`cspace.car.dubins_reach.reach_proof`), grown from the start and
 from the goal (driving backward), each at the coarse step before either at the fine one, within
-a share of the time limit. ``auto`` runs it where a
-Dubins query has neither a path nor an SE(2) proof, and ``exact`` before it gives up on a car;
-``cspace check-proof`` re-checks the proof (:mod:`planners.core.dubins_check`)."""
+a share of the time limit. ``auto`` runs it after a Dubins query's third restart of sampling
+(:mod:`planners.core.auto_dubins`), and ``exact`` before it gives up on a car; ``cspace
+check-proof`` re-checks the proof (:mod:`planners.core.dubins_check`)."""
 from __future__ import annotations
 
 import math
