@@ -7,8 +7,9 @@ turning radii, not the slice's 20) and an iteration count that doubles from one 
 (:data:`FIRST_RESTART`). On a large map a Dubins query that the slice does not answer most often
 starts or ends close to a wall: long curves from there nearly always meet it, a tree that happened
 to grow the wrong way stays stuck, and one long search has a heavy tail (the warehouse's hard
-pairs: seconds at 20 radii where a restart at 7 answers in milliseconds). Between the first
-restart and the second run the proofs, cheapest first: the reach of either end closed under the
+pairs: seconds at 20 radii where a restart at 7 answers in milliseconds; the range stops at
+:data:`RESTART_FLOOR` of OMPL's own, so a car of tiny radius keeps useful steps). After the third
+restart and the fourth run the proofs, cheapest first: the reach of either end closed under the
 car's steps (:func:`planners.core.dubins_proof.reach_result`: local regions, about 0.1 s), then
 the SE(2) proof before sampling (:func:`planners.core.exact_se2.quick_proof`: the whole map's
 first slabs, built once per C-space; a Nav2-sized map pays a second or more for them). Every
@@ -20,7 +21,7 @@ from __future__ import annotations
 import math
 
 RESTART_RADII = 7.0     # a restart's range, in turning radii
-RESTART_FLOOR = 1 / 64  # ... never below this share of OMPL's own range (its connect walks are bounded)
+RESTART_FLOOR = 1 / 8   # ... never below this share of OMPL's own range (a tiny radius: OMPL's steps)
 FIRST_RESTART = 2000    # iterations of the first restart (about 20 ms where the trees stay small)
 RESTART_GROWTH = 2      # each restart counts this many times the last one's iterations
 # The proofs run after these restarts: the reach once sampling has spent about what it costs

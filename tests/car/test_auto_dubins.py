@@ -40,12 +40,21 @@ def _range(adapter) -> float:
     return ss.getPlanner().getRange()
 
 
+def _own(adapter) -> float:
+    """OMPL's own range on this adapter's space (a fifth of its extent)."""
+    from planners.adapters.glue import RANGE_SHARE, make_setup
+
+    return RANGE_SHARE * make_setup(adapter, "RRTConnect", 0)[0].getSpaceInformation().getMaximumExtent()
+
+
 def test_with_range_sets_the_restart_range_below_the_usual_floor_and_restores_it():
+    from planners.adapters.glue import RANGE_FLOOR
+
     sc = _hall()
     adapter = make_adapter(sc, build_cspace(sc))
-    usual, cap = _range(adapter), adapter.max_range
-    short = math.ldexp(auto_dubins.RESTART_RADII * adapter.radius, adapter.k)
-    assert short < 0.5 * usual  # the usual floor (a quarter of OMPL's own range) would not allow it
+    usual, cap, own = _range(adapter), adapter.max_range, _own(adapter)
+    short = max(math.ldexp(auto_dubins.RESTART_RADII * adapter.radius, adapter.k), auto_dubins.RESTART_FLOOR * own)
+    assert short < 0.6 * RANGE_FLOOR * own < usual  # the usual floor (a quarter of OMPL's range) would not allow it
     assert auto_dubins.with_range(adapter, auto_dubins.RESTART_RADII, lambda: _range(adapter)) == pytest.approx(short)
     assert adapter.max_range == cap and not hasattr(adapter, "range_floor") and _range(adapter) == usual
     with pytest.raises(RuntimeError):  # restored when the call fails too
@@ -123,3 +132,19 @@ def test_the_reach_proof_runs_after_the_restarts_even_when_the_caller_s_iteratio
     assert res.proven_unsolvable and res.answered_by == "proof", res.message
     assert "forward-only car cannot" in res.message
     assert check_dubins_proof(sc, res.proof).valid
+
+
+def test_a_tiny_turning_radius_keeps_a_restart_range_of_an_eighth_of_ompl_s(monkeypatch):
+    # A car of radius 1e-6 in the maze: 7 radii would be 7e-6; the restarts' range stops at an
+    # eighth of OMPL's own (at 1/64 the maze was not solved in 30 000 iterations, 7 s; at 1/8 in 6 000).
+    import dataclasses
+
+    sc = dataclasses.replace(load_scenario(MAZE), turning_radius=1e-6)
+    cs = build_cspace(sc)
+    adapter = make_adapter(sc, cs)
+    own = _own(adapter)
+    assert auto_dubins.with_range(adapter, auto_dubins.RESTART_RADII, lambda: _range(adapter)) == \
+        pytest.approx(auto_dubins.RESTART_FLOOR * own)
+    monkeypatch.setattr(auto, "SLICE_ITERATIONS", 2)  # a slice that cannot answer: the restarts do
+    res = planners.plan(sc, cspace=cs, seed=0, iterations=6000, time=1000.0)
+    assert res.solved and res.answered_by == "sampling", res.message
