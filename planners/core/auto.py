@@ -413,9 +413,10 @@ def exact_reeds_shepp(sc, cspace, adapter, query, source: str, time_limit: float
     r = _slab_graph(sc, cspace, adapter, query, source, time_limit, simplify, refine=True)
     if r is None:
         r = PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,
-                       planner="exact", seed=0, start=tuple(query.start), goal=tuple(query.goal), timings={"solve": _now() - t0},
-                       message=f"not decided within the time limit ({time_limit:g} s): the slab graph found no "
-                               "SE(2) path that the car's curves could follow, nor a proof that none exists; try "
-                               "a longer --time")
+                       planner="exact", seed=0, start=tuple(query.start), goal=tuple(query.goal),
+                       timings={"solve": _now() - t0},
+                       message=f"not decided within the time limit ({time_limit:.3g} s left of it after the "
+                               "C-space): the slab graph found no SE(2) path that the car's curves could follow, "
+                               "nor a proof that none exists; try a longer --time")
     r.planner, r.seed = "exact", 0
     return r
