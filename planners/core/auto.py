@@ -399,3 +399,22 @@ def _answer(r: PlanResult, stage: str | None, clock: _Clock, seed: int) -> PlanR
     r.timings = {**{s: clock.spent[s] for s in STAGES if s in clock.spent}, **inner, "solve": clock.elapsed()}
     r.stages = [s for s in STAGES if s in clock.spent]
     return r
+
+
+def exact_reeds_shepp(sc, cspace, adapter, query, source: str, time_limit: float,
+                      simplify: bool = True) -> PlanResult:
+    """``planner = "exact"`` for a Reeds–Shepp car: the refinement stage alone, with the whole
+    limit (the slab graph refined, its SE(2) path driven as certified curves; a proof where
+    POSSIBLE separates start and goal), else "not decided". It needs no OMPL: the curves, their
+    certificates and the shortcuts are the project's (OMPL shortens the path where installed)."""
+    t0 = _now()
+    r = _slab_graph(sc, cspace, adapter, query, source, time_limit, simplify, refine=True)
+    if r is None:
+        r = PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf,
+                       planner="exact", seed=0, start=tuple(query.start), goal=tuple(query.goal),
+                       timings={"solve": _now() - t0},
+                       message=f"not decided within the time limit ({time_limit:.3g} s left of it after the "
+                               "C-space): the slab graph found no SE(2) path that the car's curves could follow, "
+                               "nor a proof that none exists; try a longer --time")
+    r.planner, r.seed = "exact", 0
+    return r

@@ -173,12 +173,13 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
     if car:
         from ..adapters.glue import ompl_available
 
-        reach = ", nor the reach of either end (a forward-only car)" if sc.space == "dubins" else ""
+        # (a Reeds-Shepp car's exact is planners.core.auto.exact_reeds_shepp: the slab graph's path as curves)
+        who, reach = (('a Dubins car (space = "dubins") cannot turn in place', "; reach of either end")
+                      if sc.space == "dubins" else (f'a car (space = "{sc.space}") cannot turn in place', ""))
         then = ("use a sampling planner such as RRTConnect" if ompl_available() else
                 "a car's path needs OMPL's sampling planners (not installed)")
-        raise ScenarioError(source, "planner", f"a car (space = \"{sc.space}\") cannot turn in place, so exact answers "
-                                               f"it only with a proof that no path exists, and the slab graph found "
-                                               f"none ({graph}){reach}: {then}")
+        raise ScenarioError(source, "planner", f"{who}: exact only proves there is no path, and found no "
+                                               f"proof (slab graph: {graph}{reach}): {then}")
     if res.status == "undecided":
         why = st.get("error") or st.get("reason", "")
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,

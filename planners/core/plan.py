@@ -180,6 +180,10 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
     deadline = _now() + max(tlim, 0.0) * len(queries) if sc.space == "se2" and name == "exact" else None
     if tlim <= 0:
         results = [_out_of_time(sc, name, sd, q, built_s) for q in queries]
+    elif name == "exact" and sc.space == "reeds-shepp":
+        from .auto import exact_reeds_shepp
+
+        results = [exact_reeds_shepp(sc, cspace, adapter, q, src, tlim, simplify) for q in queries]
     elif name == "exact" and se2:
         from .exact_se2 import exact_se2
 
@@ -207,7 +211,7 @@ def plan(scenario, planner: str | None = None, time: float | None = None, seed: 
         # (No inscribed-disk rule after a failure: the proof before sampling is at least as strong,
         # since every POSSIBLE region lies in the disk's free space, and the rule's C-space build,
         # seconds on a large map, would run past --time.)
-    if hasattr(adapter, "curves") and name != "exact":
+    if hasattr(adapter, "curves"):  # a car's path, whichever planner found it
         for r in results:
             r.curves = adapter.curves(r.path) if r.solved else []
     for r in results:

@@ -124,8 +124,9 @@ def test_with_ompl_the_api_warns_of_nothing():
         assert planners.plan(os.path.join(SCENARIOS, "basic.toml")).planner == "RRTConnect"
 
 
-def test_a_car_without_ompl_says_once_that_it_needs_ompl():
-    r = run(HIDE_OMPL, "plan", os.path.join(SCENARIOS, "car", "u_turn.toml"))
+def test_a_dubins_car_without_ompl_says_once_that_it_needs_ompl():
+    # (a Reeds-Shepp car is planned by exact without OMPL: tests/car/test_exact_car.py)
+    r = run(HIDE_OMPL, "plan", os.path.join(SCENARIOS, "car", "maze.toml"))
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 2 and lines[0].startswith("note: OMPL is not installed") and "pip install" in lines[0]
