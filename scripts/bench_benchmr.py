@@ -30,9 +30,10 @@ peer, the same OMPL planner on the same state space with a shapely state checker
 discrete motion check at Bench-MR's step, 0.005 of its box's extent (``se2_peers.peer_first``).
 The C-space's slabs are built once per world and car model before its queries (the column "C-space
 (once)"), as the peer's checker is. Every path either returns is judged by the independent shapely
-sweep along its curves (``sweep_oracle.car_sweep_check``). A Dubins query with neither a path nor
-an SE(2) proof gets auto's reach proof (``planners.core.dubins_proof``: the reach of either end,
-closed under the forward car's steps); every proof either way is re-checked by ``cspace
+sweep along its curves (``sweep_oracle.car_sweep_check``). A Dubins query that the slice does not
+answer goes on as in ``auto`` (``planners.core.auto_dubins``): restarts of the planner at a shorter
+range, the reach proof (``planners.core.dubins_proof``: the reach of either end, closed under the
+forward car's steps) and the SE(2) proof between them; every proof is re-checked by ``cspace
 check-proof``'s independent checker (the count it accepts is printed). A Dubins query with
 neither a path nor a proof is probed by a lattice (``boxed_in``): when the poses a forward-only
 car reaches from the start, or reaches the goal from, run out without coming near the other end,
@@ -232,12 +233,12 @@ def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
     """cspace's first certified path, in the order of the default planner (``auto``): a slice of
     sampling first (``auto.SLICE_ITERATIONS`` iterations, ``auto.SLICE_SHARE`` of the limit), the
     proof before sampling only where that slice found nothing (on a city map the proof's POSSIBLE
-    regions cost seconds, and a solvable query needs none; a Dubins car: then, as ``auto``, a short
-    turn of the planner and the reach proof of either end), then the planner with the rest: (path or
-    None, CPU seconds, of which the proofs, the proof where one found the query unsolvable, else None)."""
-    from planners.core.auto import SAMPLE_MIN, SAMPLE_SHARE, SLICE_ITERATIONS, SLICE_SHARE
-    from planners.core.dubins_proof import reach_budget, reach_result
-    from planners.core.exact_se2 import quick_proof, slab_regions_of
+    regions cost seconds, and a solvable query needs none), then the planner with the rest; a
+    Dubins car after its slice: ``auto``'s restarts and proofs (``planners.core.auto_dubins``),
+    with this planner: (path or None, CPU seconds, of which the proofs, the proof where one found
+    the query unsolvable, else None)."""
+    from planners.core.auto import SLICE_ITERATIONS, SLICE_SHARE
+    from planners.core.exact_se2 import quick_proof
     from planners.core.routine import run_planner
 
     c0, w0 = time.process_time(), time.perf_counter()
@@ -246,22 +247,48 @@ def ours_first(sc, cs, adapter, query, seed: int, limit: float, planner: str):
                       simplify=False, until_first=True)[0]
     if res.solved:
         return res.path, time.process_time() - c0, 0.0, None
+    if sc.space == "dubins":
+        return _dubins_first(sc, cs, adapter, query, pair, seed, limit, planner, c0, w0)
     c1 = time.process_time()
     proof = quick_proof(sc, cs, query, limit)
     c2 = time.process_time()
-    if proof is None and sc.space == "dubins":  # as auto: a short turn of sampling, then the reach proof
-        turn = min(SAMPLE_SHARE * (limit - (time.perf_counter() - w0)), max(SAMPLE_MIN, time.perf_counter() - w0))
-        res = run_planner(adapter, planner, pair, max(turn, 0.0), seed, simplify=False, until_first=True)[0]
-        if res.solved:
-            return res.path, time.process_time() - c0, c2 - c1, None
-        c3 = time.process_time()
-        proof = reach_result(sc, cs, slab_regions_of(cs), query, reach_budget(limit))
-        c2 += time.process_time() - c3  # the proofs' CPU: the SE(2) one and the reach
     if proof is not None:
         return None, time.process_time() - c0, c2 - c1, proof.proof
     left = limit - (time.perf_counter() - w0)
     res = run_planner(adapter, planner, pair, max(left, 0.0), seed, simplify=False, until_first=True)[0]
     return (res.path if res.solved else None), time.process_time() - c0, c2 - c1, None
+
+
+def _dubins_first(sc, cs, adapter, query, pair, seed: int, limit: float, planner: str, c0: float, w0: float):
+    """ours_first's Dubins car after its slice: ``auto``'s stages (``auto_dubins.dubins_stages``)."""
+    from planners.core.auto import turn_seed
+    from planners.core.auto_dubins import dubins_stages, with_range
+    from planners.core.routine import run_planner
+
+    class Clock:  # auto's budget, as dubins_stages reads it; the proofs' CPU counted apart
+        proof_cpu = 0.0
+
+        def left(self):
+            return limit - (time.perf_counter() - w0)
+
+        def run(self, stage, call):
+            c = time.process_time()
+            try:
+                return call()
+            finally:
+                self.proof_cpu += time.process_time() - c
+
+    def sample(budget, n, turn, radii):
+        return with_range(adapter, radii, lambda: run_planner(adapter, planner, pair, max(budget, 0.0),
+                                                              turn_seed(seed, turn), iterations=n, simplify=False,
+                                                              until_first=True)[0])
+
+    clock = Clock()
+    r, stage = dubins_stages(sc, cs, query, sample, clock, limit, None)
+    cpu = time.process_time() - c0
+    if stage == "proof":
+        return None, cpu, clock.proof_cpu, r.proof
+    return (r.path if stage == "sampling" else None), cpu, clock.proof_cpu, None
 
 
 def accepted(sc, proof: dict, query_index: int) -> bool:

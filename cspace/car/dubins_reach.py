@@ -35,6 +35,7 @@ new), capped in cells and in the window around the seed: past the cap there is n
 """
 from __future__ import annotations
 
+import functools
 import math
 import time
 import weakref
@@ -209,6 +210,15 @@ def reach_proof(regions, start, goal, radius: float, *, backward: bool = False, 
     return None
 
 
+@functools.lru_cache(maxsize=1024)
+def _stencil_of(K: int, k: int, s: float, r: float, sign: float, h: float) -> np.ndarray:
+    """Slab k of K's stencil (the same for every query of a car: kept)."""
+    a, b = initial_partition(K)[k]
+    out = stencil(displacements(a, b, s, r, True, sign), h)
+    out.flags.writeable = False
+    return out
+
+
 def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline, max_cells: int):
     K = int(math.ceil(2.0 * math.pi / (SLAB_OVER * s / r)))
     h = CELL_FACTOR * s * s / r
@@ -224,7 +234,7 @@ def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline,
     # on a large map a slab's region is then milliseconds; the cores are the full regions' own
     near = _local(regions, (o[0] + i0 * h, o[1] + j0 * h, o[0] + (i0 + n) * h, o[1] + (j0 + n) * h))
     slabs = initial_partition(K)  # the last ends one ulp past pi: the cover is closed in exact arithmetic
-    sten = _Lazy(lambda k: stencil(displacements(*slabs[k], s, r, True, sign), h))
+    sten = _Lazy(lambda k: _stencil_of(K, k, s, r, sign, h))
     # the slabs a step's heading can end in: those [a_k - s/r, b_k + s/r] meets (padded)
     turn = s / r + 1e-9
     targets = _Lazy(lambda k: [j for j, (c, d) in enumerate(slabs)
@@ -328,13 +338,15 @@ def runs(cells: np.ndarray, i0: int, j0: int) -> list:
     >>> runs(np.array([[1, 1, 0, 1], [0, 0, 0, 0]], bool), 10, 20)
     [[10, 20, 22], [10, 23, 24]]
     """
-    out = []
-    for i in np.flatnonzero(cells.any(axis=1)).tolist():
-        row = np.concatenate([[0], cells[i].astype(np.int8), [0]])
-        d = np.diff(row)
-        for a, b in zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist()):
-            out.append([i + i0, a + j0, b + j0])
-    return out
+    rows = np.flatnonzero(cells.any(axis=1))
+    if not len(rows):
+        return []
+    pad = np.zeros((len(rows), cells.shape[1] + 2), np.int8)
+    pad[:, 1:-1] = cells[rows]
+    d = np.diff(pad, axis=1)  # +1 where a run starts, -1 one past its end; row-major: they pair up
+    ri, a = np.nonzero(d == 1)
+    _, b = np.nonzero(d == -1)
+    return np.column_stack([rows[ri] + i0, a + j0, b + j0]).tolist()
 
 
 def _json(regions, start, goal, r, s, h, o, i0, j0, slabs, R, targets, backward) -> dict:

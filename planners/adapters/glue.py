@@ -153,9 +153,10 @@ def make_setup(space, planner: str, seed: int, query: int = 0):
         # never below RANGE_FLOOR of it: OMPL's connect step walks to its target in range-long
         # steps without looking at the clock (a car of turning radius 1e-8 in a 10 m scene, its
         # range 2e-7, walked for minutes past a 2 s limit)
+        # (an adapter may lower the floor for a turn: ``range_floor``, a Dubins car's restarts)
         own = RANGE_SHARE * si.getMaximumExtent()
         if cap < own:
-            chosen.setRange(max(cap, RANGE_FLOOR * own))
+            chosen.setRange(max(cap, getattr(adapter, "range_floor", RANGE_FLOOR) * own))
     ss.setPlanner(chosen)
     return ss, ospace, checker, validator
 

@@ -14,11 +14,10 @@ not answered, in the order of their cost on the scene (a rotating robot or a Ree
    :func:`cspace.car.laumond.to_reeds_shepp`), else a proof where POSSIBLE separates them;
 2. **proof** -- the proof before sampling (a rotating robot: those slabs refined once,
    :func:`planners.core.exact_se2.quick_proof`; a translating one, where it comes first: start
-   and goal in different free components, :func:`planners.core.exact.separated_proof`; a Dubins
-   car where that finds none: a short turn of sampling (as in 3), then the reach of one end
-   closed under the car's steps, :func:`planners.core.dubins_proof.reach_result`);
-3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`; all of it for a
-   Dubins car, which has no complete method here and goes from the slice to the proof);
+   and goal in different free components, :func:`planners.core.exact.separated_proof`);
+3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`). A Dubins car,
+   which has no complete method here, goes from the slice to restarts of sampling with the
+   reach proof and this proof between them (:func:`planners.core.auto_dubins.dubins_stages`);
 4. **refinement** -- the exact planner with the rest: the slab graph refined where FREE and
    POSSIBLE disagree (SE(2); a Reeds–Shepp car's path converted as in 1), then sampling again
    with whatever is left; for a translating robot the exact shortest path.
@@ -114,17 +113,21 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     kind = sc.space if sc.rotates else "translation"
     turns = sc.rotates and bool(cspace.body_pieces)  # a point robot does not turn: nothing to prove
 
-    def sample(budget: float, budget_iterations: int | None = iterations, turn: int = 0) -> PlanResult:
+    def sample(budget: float, budget_iterations: int | None = iterations, turn: int = 0,
+               radii: float | None = None) -> PlanResult:
         """One turn of the sampler on this query (its stage's seconds counted as ``sampling``).
         Given ``iterations`` (the caller's), a turn is bounded by its count alone, within the
         time left: where it ends, and so which stage answers, does not depend on the machine.
-        A car's later turns (``turn`` > 0) draw samples of their own (:func:`turn_seed`)."""
+        A car's later turns (``turn`` > 0) draw samples of their own (:func:`turn_seed`); given
+        ``radii``, a turn's range is at most that many turning radii (a Dubins car's restarts)."""
+        from .auto_dubins import with_range
+
         if iterations is not None:
             budget = clock.left()
         s = turn_seed(seed, turn) if turn and kind in ("reeds-shepp", "dubins") else seed
-        return clock.run("sampling", lambda: run_planner(adapter, SAMPLER, [pair], budget, s,
-                                                          iterations=budget_iterations, simplify=simplify,
-                                                          scenario=sc.name)[0])
+        call = lambda: run_planner(adapter, SAMPLER, [pair], budget, s, iterations=budget_iterations,  # noqa: E731
+                                   simplify=simplify, scenario=sc.name)[0]
+        return clock.run("sampling", call if radii is None else lambda: with_range(adapter, radii, call))
 
     if tuple(query.start) == tuple(query.goal):
         return _answer(sample(time_limit, None), "sampling", clock, seed)
@@ -144,6 +147,11 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
                                                        refine=False))
         if r is not None and (r.solved or r.proven_unsolvable):
             return _answer(r, "slab graph", clock, seed)
+    if turns and kind == "dubins":  # restarts of sampling, the reach proof, the SE(2) proof
+        from .auto_dubins import dubins_stages
+
+        r, stage = dubins_stages(sc, cspace, query, sample, clock, time_limit, iterations)
+        return _answer(r if r is not None else _timed_out(sc, adapter, query, time_limit, seed), stage, clock, seed)
     if turns or not sc.rotates:  # the proof before sampling (the first slabs refined once)
         from .exact import separated_proof
         from .exact_se2 import quick_proof
@@ -152,21 +160,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         r = clock.run("proof", lambda: prove(sc, cspace, query, time_limit))
         if r is not None:
             return _answer(r, "proof", clock, seed)
-    if turns and kind == "dubins" and clock.left() > 0:
-        # No SE(2) proof: a short turn of sampling (as stage 3's), then the reach of either end,
-        # closed under the car's steps (its regions cost a solvable query more than the turn)
-        from .dubins_proof import reach_budget, reach_result
-        from .exact_se2 import slab_regions_of
-
-        # (samples of its own: turn 3, after the slice's 0 and before stage 3's 1 and 2)
-        r = sample(min(SAMPLE_SHARE * clock.left(), max(SAMPLE_MIN, clock.elapsed())), turn=3)
-        if r.solved:
-            return _answer(r, "sampling", clock, seed)
-        r = clock.run("proof", lambda: reach_result(sc, cspace, slab_regions_of(cspace), query,
-                                                    reach_budget(time_limit)))
-        if r is not None:
-            return _answer(r, "proof", clock, seed)
-    share = 1.0 if kind == "dubins" or not turns and sc.rotates else \
+    share = 1.0 if not turns and sc.rotates else \
         TRANSLATION_SAMPLE_SHARE if kind == "translation" else SAMPLE_SHARE
     sampled = None
     if clock.left() > 0:
@@ -186,11 +180,15 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
             again = sample(clock.left(), turn=2)
             if again.solved:
                 return _answer(again, "sampling", clock, seed)
-    if failed is None:  # the earlier stages used the whole limit
-        failed = PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, adapter.dim)),
-                            length=math.inf, planner="auto", seed=seed, start=tuple(query.start),
-                            goal=tuple(query.goal), message=f"not solved within the time limit ({time_limit:g} s)")
-    return _answer(failed, None, clock, seed)
+    return _answer(failed if failed is not None else _timed_out(sc, adapter, query, time_limit, seed), None,
+                   clock, seed)
+
+
+def _timed_out(sc, adapter, query, time_limit: float, seed: int) -> PlanResult:
+    """Nothing to report but the time: the earlier stages used the whole limit."""
+    return PlanResult(scenario=sc.name, solved=False, exact=False, path=np.zeros((0, adapter.dim)), length=math.inf,
+                      planner="auto", seed=seed, start=tuple(query.start), goal=tuple(query.goal),
+                      message=f"not solved within the time limit ({time_limit:g} s)")
 
 
 def small_scene(sc, cspace) -> bool:

@@ -1,8 +1,9 @@
 """A Dubins car's proof that no path exists, as a PlanResult: the reach of one end closed under
 the forward car's steps (:func:`cspace.car.dubins_reach.reach_proof`), grown from the start and
-then from the goal (driving backward) within a share of the time limit. ``auto`` runs it where a
-Dubins query has neither a path nor an SE(2) proof, and ``exact`` before it gives up on a car;
-``cspace check-proof`` re-checks the proof (:mod:`planners.core.dubins_check`)."""
+from the goal (driving backward), each at the coarse step before either at the fine one, within
+a share of the time limit. ``auto`` runs it after a Dubins query's third restart of sampling
+(:mod:`planners.core.auto_dubins`), and ``exact`` before it gives up on a car; ``cspace
+check-proof`` re-checks the proof (:mod:`planners.core.dubins_check`)."""
 from __future__ import annotations
 
 import math
@@ -36,7 +37,7 @@ def reach_result(sc, cspace, regions, query, budget: float) -> PlanResult | None
     None otherwise (not a Dubins car, a point robot, the reach not confined within the cap, or
     ``budget`` seconds spent). ``regions``: the C-space's slab regions
     (:func:`planners.core.exact_se2.slab_regions_of`), whose POSSIBLE the reach reads."""
-    from cspace.car.dubins_reach import reach_proof
+    from cspace.car.dubins_reach import MAX_CELLS, STEPS, reach_proof
 
     if sc.space != "dubins" or not cspace.body_pieces or tuple(query.start) == tuple(query.goal):
         return None
@@ -46,9 +47,9 @@ def reach_result(sc, cspace, regions, query, budget: float) -> PlanResult | None
         return None
     t0 = time.perf_counter()
     deadline = t0 + budget
-    for backward in (False, True):
+    for frac, backward in ((f, b) for f in STEPS for b in (False, True)):  # coarse first, either end
         proof = reach_proof(regions, query.start, query.goal, float(sc.turning_radius), backward=backward,
-                            deadline=deadline)
+                            deadline=deadline, steps=(frac,), max_cells=int(MAX_CELLS * (STEPS[0] / frac) ** 4))
         if proof is not None:
             cells = sum(b - a for s in proof["slabs"] for _, a, b in s["cells"])
             held = sum(1 for s in proof["slabs"] if s["cells"])
