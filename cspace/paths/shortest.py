@@ -55,8 +55,11 @@ class ShortestPath:
     stats: dict = field(default_factory=dict)
 
 
-def free_space(pieces: list, bounds) -> "object":
+def free_space(pieces: list, bounds, checked: bool = True) -> "object":
     """The free C-space F = bounds minus the union of the pieces, a shapely geometry.
+    ``checked=False``: GEOS's union as it comes, without its check (:mod:`cspace.kernel.minkowski.union`),
+    for a caller that certifies every point and path it takes from F exactly against the pieces
+    and states nothing from F's shape alone.
 
     >>> F = free_space([np.array([[1., 1], [2, 1], [2, 2], [1, 2]])], (0, 3, 0, 3))
     >>> F.area
@@ -78,7 +81,8 @@ def free_space(pieces: list, bounds) -> "object":
     rings = shapely.linearrings(np.concatenate(closed), indices=np.repeat(np.arange(len(closed)),
                                                                             [len(c) for c in closed]))
     polys = shapely.polygons(rings)
-    taken = union(polys)  # checked (cspace.kernel.minkowski.union): GEOS's float overlay can drop a piece
+    # checked (cspace.kernel.minkowski.union): GEOS's float overlay can drop a piece
+    taken = union(polys) if checked else shapely.union_all(polys)
     return shapely.orient_polygons(box.difference(taken)) if hasattr(shapely, "orient_polygons") \
         else _orient(box.difference(taken))
 
@@ -273,6 +277,9 @@ class _Scene:
         nodes, nbrs = self._reflex[k]
         return list(nodes), list(nbrs)  # callers append the tips of zero-area pieces
 
+    def meshed(self) -> bool:
+        return any(not isinstance(m, Exception) for m in self._mesh.values())
+
     def mesh(self, k: int):
         from .freemesh import FreeMesh, MeshError
 
@@ -297,13 +304,7 @@ def _scene(pieces: list, bounds: tuple, free: list | None = None) -> _Scene:
     """The :class:`_Scene` of these pieces and bounds, reused when a recent call had the same
     ones (compared by content: a digest of every coordinate and piece size); the
     :data:`SCENES_KEPT` most recently used are kept."""
-    import hashlib
-
-    h = hashlib.blake2b(np.asarray(bounds, dtype=np.float64).tobytes(), digest_size=20)
-    h.update(np.array([len(p) for p in pieces], dtype=np.int64).tobytes())
-    for p in pieces:
-        h.update(np.ascontiguousarray(p, dtype=np.float64).tobytes())
-    key = h.digest()
+    key = _digest(pieces, bounds)
     scene = _SCENES.get(key)
     if scene is None:
         scene = _SCENES[key] = _Scene(pieces, bounds, free)
@@ -312,6 +313,28 @@ def _scene(pieces: list, bounds: tuple, free: list | None = None) -> _Scene:
     else:
         _SCENES.move_to_end(key)
     return scene
+
+
+def _digest(pieces: list, bounds) -> bytes:
+    import hashlib
+
+    h = hashlib.blake2b(np.asarray(bounds, dtype=np.float64).tobytes(), digest_size=20)
+    h.update(np.array([len(p) for p in pieces], dtype=np.int64).tobytes())
+    for p in pieces:
+        h.update(np.ascontiguousarray(p, dtype=np.float64).tobytes())
+    return h.digest()
+
+
+def meshed(pieces: list, bounds) -> bool:
+    """Is a mesh of F for these pieces and bounds kept from a recent search (the next search in
+    it pays for no triangulation)? Nothing is built.
+
+    >>> sq = [np.array([[1., 1], [2, 1], [2, 2], [1, 2]])]
+    >>> meshed(sq, (0, 4, 0, 4)), warm(sq, (0, 4, 0, 4)), meshed(sq, (0, 4, 0, 4))
+    (False, 1, True)
+    """
+    scene = _SCENES.get(_digest(pieces, tuple(map(float, bounds))))
+    return scene is not None and scene.meshed()
 
 
 def warm(pieces: list, bounds, free: list | None = None) -> int:

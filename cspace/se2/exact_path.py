@@ -30,7 +30,7 @@ import numpy as np
 
 from ..kernel.polygons.rotation import wrap_angle
 from ..paths.pathcheck import path_violations
-from ..paths.shortest import shortest_path
+from ..paths.shortest import meshed, shortest_path
 from .slab_graph import point_free
 
 
@@ -74,11 +74,13 @@ def holding(part: list, theta: float, slack: float = 0.0) -> list[int]:
     return out
 
 
-def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.ndarray:
+def assemble(walk: list, part: list, freg: list, regions, start, goal, near: bool = False) -> np.ndarray:
     """The poses of a FREE walk ``[(node, link point to the next node), ..., (G, None)]``.
 
     ``part``: the slabs (a, b); ``freg``: their FREE regions; ``regions``: the
     :class:`cspace.se2.slab_graph.SlabRegions` (for the FREE of the start's and goal's angles).
+    ``near``: the link points moved where the path is first (:func:`near_links`), the walk's own
+    where that path fails its checks.
 
     >>> from cspace.se2.slab_graph import SlabRegions
     >>> sr = SlabRegions([], [np.array([[0., 0], [1, 0], [0, 1]])], (0, 10, 0, 10))
@@ -86,6 +88,11 @@ def assemble(walk: list, part: list, freg: list, regions, start, goal) -> np.nda
     >>> assemble(walk, [], [], sr, (1, 1, 0.0), (5, 1, 0.0)).tolist()
     [[1.0, 1.0, 0.0], [5.0, 1.0, 0.0]]
     """
+    if near:
+        try:
+            return assemble(near_links(walk, part, freg, regions, start, goal), part, freg, regions, start, goal)
+        except AssemblyError:
+            pass
     at = [0]
     try:
         return _assemble(walk, part, freg, regions, start, goal, at)
@@ -136,6 +143,51 @@ def _assemble(walk, part, freg, regions, start, goal, at: list) -> np.ndarray:
     if tuple(pts[-1]) != (xg, yg):
         _translate(poses, regions.free_at(tg), bounds, pts[-1], (xg, yg), tg)
     return np.array(poses, dtype=np.float64)
+
+
+def near_links(walk: list, part: list, freg: list, regions, start, goal) -> list:
+    """The walk with its link points moved where the path is (per query): the translation that
+    crosses the scene is made at one slab of the walk, the first whose FREE has a kept mesh
+    (:func:`cspace.paths.shortest.meshed`), else the first of the widest (its mesh, kept, then
+    serves the next queries), the links before it each into the overlap of its two
+    components near the point before it (the start for the first), those after it near the
+    point after it (the goal for the last): :meth:`cspace.se2.slab_graph.SlabRegions.link_near`.
+    A point joining an end to its slab directly, or with no overlap near, stays. The same
+    nodes: a walk of the same FREE graph, assembled and checked as any other.
+
+    >>> from cspace.se2.slab_graph import SlabRegions
+    >>> sr = SlabRegions([], [np.array([[0., 0], [.2, 0], [0, .2]])], (0, 10, 0, 10))
+    >>> part = [(0.0, 0.5), (0.5, 1.0)]
+    >>> walk = [((-1, 0), (1.0, 1.0)), ((0, 0), (9.0, 9.0)), ((1, 0), (8.0, 8.0)), ((-2, 0), None)]
+    >>> [p for _, p in near_links(walk, part, [sr.free(a, b) for a, b in part], sr, (1, 1, 0.2), (2, 1, 0.7))]
+    [(1.0, 1.0), (2.0, 1.0), (2.0, 1.0), None]
+    """
+    nodes, pts = [n for n, _ in walk], [p for _, p in walk[:-1]]
+    m = len(nodes) - 1
+    if m < 2:
+        return walk
+    ends = [(float(start[0]), float(start[1]), float(start[2])), (float(goal[0]), float(goal[1]), float(goal[2]))]
+    # (a kept mesh first: a search in it costs milliseconds, a new one ~0.1 s on a large map)
+    rank = [(meshed(freg[n[0]].pieces, regions.bounds), part[n[0]][1] - part[n[0]][0]) for n in nodes[1:m]]
+    carrier = 1 + rank.index(max(rank))
+
+    def region_of(i: int):  # node i's region and component (an end's: FREE at its own angle)
+        if nodes[i][0] >= 0:
+            return freg[nodes[i][0]], nodes[i][1]
+        x, y, th = ends[0] if i == 0 else ends[1]
+        zero = regions.free_at(th)
+        return zero, regions.containing(zero, x, y)
+
+    out = list(pts)
+    for order, ref in ((range(carrier), ends[0][:2]), (range(m - 1, carrier - 1, -1), ends[1][:2])):
+        for i in order:
+            p = (float(pts[i][0]), float(pts[i][1]))
+            if p not in (ends[0][:2], ends[1][:2]):
+                (r1, c1), (r2, c2) = region_of(i), region_of(i + 1)
+                q = None if c1 is None or c2 is None else regions.link_near(r1, c1, r2, c2, *ref)
+                out[i] = p if q is None else q
+            ref = out[i]
+    return [(n, out[i] if i < m else None) for i, n in enumerate(nodes)]
 
 
 def _turn(poses: list, p, theta: float) -> None:
