@@ -76,6 +76,21 @@ def test_a_search_with_room_reads_the_body_s_possible_regions():
     assert not other.share_possible(body)  # another body: POSSIBLE differs, nothing shared
 
 
+@pytest.mark.slow  # (several seconds: the sweep along the curves)
+def test_a_car_s_slab_graph_path_with_room_passes_the_sweep():
+    """FREE with room is built without the union's check and the walk's links are moved: the
+    path is still certified curve by curve, and the independent sweep along the curves agrees."""
+    from cspace.car.curves import reeds_shepp_segments
+
+    sc = load_scenario(os.path.join(SCENARIOS, "car", "parallel_tight.toml"))
+    r = planners.plan(sc, seed=0, time=20.0)
+    assert r.solved and r.answered_by == "slab graph", r.message
+    assert tuple(r.path[0]) == tuple(r.start) and tuple(r.path[-1]) == tuple(r.goal)
+    j = oracle.car_sweep_check(sc, r.path, lambda a, b: reeds_shepp_segments(a, b, sc.turning_radius),
+                               sc.turning_radius)
+    assert not j["collides"] and not j["out_of_bounds"]
+
+
 @pytest.mark.slow  # (about 1 s: the scene planned twice)
 def test_preparing_a_c_space_changes_no_answer():
     from planners.core.auto import prepare
