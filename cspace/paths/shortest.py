@@ -277,9 +277,6 @@ class _Scene:
         nodes, nbrs = self._reflex[k]
         return list(nodes), list(nbrs)  # callers append the tips of zero-area pieces
 
-    def meshed(self) -> bool:
-        return any(not isinstance(m, Exception) for m in self._mesh.values())
-
     def mesh(self, k: int):
         from .freemesh import FreeMesh, MeshError
 
@@ -304,7 +301,13 @@ def _scene(pieces: list, bounds: tuple, free: list | None = None) -> _Scene:
     """The :class:`_Scene` of these pieces and bounds, reused when a recent call had the same
     ones (compared by content: a digest of every coordinate and piece size); the
     :data:`SCENES_KEPT` most recently used are kept."""
-    key = _digest(pieces, bounds)
+    import hashlib
+
+    h = hashlib.blake2b(np.asarray(bounds, dtype=np.float64).tobytes(), digest_size=20)
+    h.update(np.array([len(p) for p in pieces], dtype=np.int64).tobytes())
+    for p in pieces:
+        h.update(np.ascontiguousarray(p, dtype=np.float64).tobytes())
+    key = h.digest()
     scene = _SCENES.get(key)
     if scene is None:
         scene = _SCENES[key] = _Scene(pieces, bounds, free)
@@ -313,28 +316,6 @@ def _scene(pieces: list, bounds: tuple, free: list | None = None) -> _Scene:
     else:
         _SCENES.move_to_end(key)
     return scene
-
-
-def _digest(pieces: list, bounds) -> bytes:
-    import hashlib
-
-    h = hashlib.blake2b(np.asarray(bounds, dtype=np.float64).tobytes(), digest_size=20)
-    h.update(np.array([len(p) for p in pieces], dtype=np.int64).tobytes())
-    for p in pieces:
-        h.update(np.ascontiguousarray(p, dtype=np.float64).tobytes())
-    return h.digest()
-
-
-def meshed(pieces: list, bounds) -> bool:
-    """Is a mesh of F for these pieces and bounds kept from a recent search (the next search in
-    it pays for no triangulation)? Nothing is built.
-
-    >>> sq = [np.array([[1., 1], [2, 1], [2, 2], [1, 2]])]
-    >>> meshed(sq, (0, 4, 0, 4)), warm(sq, (0, 4, 0, 4)), meshed(sq, (0, 4, 0, 4))
-    (False, 1, True)
-    """
-    scene = _SCENES.get(_digest(pieces, tuple(map(float, bounds))))
-    return scene is not None and scene.meshed()
 
 
 def warm(pieces: list, bounds, free: list | None = None) -> int:

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..kernel.polygons.rotation import wrap_angle
 from ..paths.pathcheck import path_violations
-from ..paths.shortest import meshed, shortest_path
+from ..paths.shortest import shortest_path
 from .slab_graph import point_free
 
 
@@ -147,9 +147,9 @@ def _assemble(walk, part, freg, regions, start, goal, at: list) -> np.ndarray:
 
 def near_links(walk: list, part: list, freg: list, regions, start, goal) -> list:
     """The walk with its link points moved where the path is (per query): the translation that
-    crosses the scene is made at one slab of the walk, the first whose FREE has a kept mesh
-    (:func:`cspace.paths.shortest.meshed`), else the first of the widest (its mesh, kept, then
-    serves the next queries), the links before it each into the overlap of its two
+    crosses the scene is made at one slab of the walk, the first that carried such a translation
+    for an earlier query on these regions (``regions.carriers``: its mesh is kept), else the first
+    of the widest, the links before it each into the overlap of its two
     components near the point before it (the start for the first), those after it near the
     point after it (the goal for the last): :meth:`cspace.se2.slab_graph.SlabRegions.link_near`.
     A point joining an end to its slab directly, or with no overlap near, stays. The same
@@ -167,9 +167,11 @@ def near_links(walk: list, part: list, freg: list, regions, start, goal) -> list
     if m < 2:
         return walk
     ends = [(float(start[0]), float(start[1]), float(start[2])), (float(goal[0]), float(goal[1]), float(goal[2]))]
-    # (a kept mesh first: a search in it costs milliseconds, a new one ~0.1 s on a large map)
-    rank = [(meshed(freg[n[0]].pieces, regions.bounds), part[n[0]][1] - part[n[0]][0]) for n in nodes[1:m]]
+    # (a slab that carried one before first: its mesh is kept, a search in it costs milliseconds,
+    # a new one ~0.1 s on a large map)
+    rank = [(part[n[0]] in regions.carriers, part[n[0]][1] - part[n[0]][0]) for n in nodes[1:m]]
     carrier = 1 + rank.index(max(rank))
+    regions.carriers.add(part[nodes[carrier][0]])
 
     def region_of(i: int):  # node i's region and component (an end's: FREE at its own angle)
         if nodes[i][0] >= 0:

@@ -134,6 +134,10 @@ class SlabRegions:
         # that only looks for a path (every point and motion of it certified again exactly) and
         # states nothing from FREE's shape (no "undecided" resolution is read from it)
         self.free_checked = True
+        # the slabs (a, b) whose FREE carried a walk's crossing translation (exact_path.near_links:
+        # the next walks cross there first, where the mesh is kept); so a path may depend on the
+        # queries these regions answered before, each certified the same way
+        self.carriers: set = set()
         self._free: dict = {}
         self._possible: dict = {}
         self._links: dict = {}
