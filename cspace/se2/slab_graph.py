@@ -279,7 +279,10 @@ class SlabRegions:
         for w in (2.0, 8.0, 32.0, 128.0):
             w *= self.radius
             box = shapely.box(x - w, y - w, x + w, y + w)
-            local = shapely.intersection(shapely.intersection(c1, box), c2)
+            try:
+                local = shapely.intersection(shapely.intersection(c1, box), c2)
+            except shapely.errors.GEOSException:  # (an overlay GEOS refuses: the kept point serves)
+                return None
             parts = [p for p in shapely.get_parts(local) if p.geom_type == "Polygon" and p.area > 0.0]
             if w == 2.0 * self.radius and any(shapely.intersects_xy(p, x, y) and p.boundary.distance(pt) > self.tol
                                               for p in parts):
