@@ -194,14 +194,11 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
 
 
 def prepare(sc, cspace) -> float:
-    """For a C-space that will serve many queries (a large map): build what its queries read first
-    and what depends on the map alone, kept with the C-space; returns the seconds it took. A
-    rotating robot or a car: the POSSIBLE regions of the proof before sampling, their components
+    """For a C-space serving many queries (a large map), build what they read first on the map
+    alone, kept with it; returns its seconds. A rotating robot or a car: the proof's POSSIBLE regions,
     labelled (:func:`planners.core.exact_se2.prepare`); a Reeds–Shepp car also FREE at the first 8
-    slabs with the first room of :data:`ROOMS` and the links between them (stage 1's search,
-    and the refinement's start). Nothing else changes: a query answers the same, sooner."""
+    slabs with the first room of :data:`ROOMS`, and their links. A query answers the same, sooner."""
     from cspace.se2.exact import initial_partition
-
     from .exact_se2 import prepare as prepare_se2, search_regions
 
     t = _now()
@@ -209,15 +206,13 @@ def prepare(sc, cspace) -> float:
         return 0.0
     prepare_se2(cspace)
     if sc.space == "reeds-shepp":
-        regions = search_regions(cspace, ROOMS[0] * _reach(cspace))
-        part = initial_partition()
+        regions, part = search_regions(cspace, ROOMS[0] * _reach(cspace)), initial_partition()
         for (a, b), (c, d) in zip(part, part[1:] + part[:1]):
             regions.free_links(regions.free(a, b), regions.free(c, d))
     return _now() - t
 
 
-def _reach(cspace) -> float:
-    """The robot's reach from its reference point (the unit of :data:`ROOMS`)."""
+def _reach(cspace) -> float:  # the robot's reach from its reference point (the unit of ROOMS)
     return max(float(np.max(np.hypot(p[:, 0], p[:, 1]))) for p in cspace.body_pieces)
 
 
