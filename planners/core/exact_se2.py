@@ -29,6 +29,10 @@ from .result import PlanResult
 
 QUICK_SHARE = 0.1   # of the time limit, at most, for the proof before sampling
 QUICK_MAX = 1.0     # seconds, at most, whatever the limit
+# A search's room (a car's path kept off the obstacles, a heuristic, no promise) is a disk's polygon
+# this much (relative) outside it: an octagon, not the 71 sides of a clearance the user asks for (its
+# corners at every obstacle corner made FREE's boundary, its links and its mesh several times larger)
+ROOM_DISK_TOLERANCE = 0.1
 SHORTCUT_TRIES = 100  # the vertex reduction of a bounded shortening tries at least this many shortcuts
 CAR_SLABS = 128     # the finest partition a car's proof-only search tries
 # The proof before sampling refines the first 8 slabs once, where the POSSIBLE graph still joins
@@ -53,7 +57,8 @@ def search(cspace, query, time_limit: float | None, *, possible_only: bool = Fal
     regions are kept with the C-space, so the queries of one scene share them.
 
     ``room`` > 0 asks for a path that keeps that much more clearance: the robot is inflated by
-    a polygon holding the disk of radius ``room`` as well (its own regions, kept too); a start
+    a polygon holding the disk of radius ``room`` as well (an octagon: :data:`ROOM_DISK_TOLERANCE`;
+    its own regions, kept too); a start
     or goal closer than that to an obstacle raises ValueError. ``near``: the path turns where it
     is, not at the links' kept points (:func:`cspace.se2.exact_path.near_links`)."""
     from cspace.se2.exact import exact_se2_search
@@ -62,7 +67,7 @@ def search(cspace, query, time_limit: float | None, *, possible_only: bool = Fal
     if room > 0:
         from cspace.kernel.minkowski.margin import margin_shapes
 
-        margin += margin_shapes(float(room))
+        margin += margin_shapes(float(room), disk_tolerance=ROOM_DISK_TOLERANCE)
     regions = _regions_of(cspace, float(room))
     return exact_se2_search(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, tuple(query.start),
                             tuple(query.goal), time_limit=time_limit, margin=margin or None,
@@ -142,7 +147,7 @@ def _regions_of(cspace, room: float = 0.0):
         if room > 0:
             from cspace.kernel.minkowski.margin import margin_shapes
 
-            margin += margin_shapes(room)
+            margin += margin_shapes(room, disk_tolerance=ROOM_DISK_TOLERANCE)
         kept[room] = slab_regions(
             cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, margin or None,
             inner_obstacles=getattr(cspace, "inner_obstacle_pieces", None),
