@@ -224,12 +224,14 @@ def prepare_space(yaml_path: str, space: str, first, footprint=FOOTPRINT, radius
                     "pieces": len(cs.obstacle_pieces), "K": cs.slabs, "vertices": sum(len(o.polygon) for o in sc.obstacles)}
 
 
-def lazy_builds(cs) -> dict:
-    """What the queries built on first use: the slabs (count, seconds) and the proof's regions."""
+def lazy_builds(cs, before: dict | None = None) -> dict:
+    """What the queries built on first use: the slabs (count, seconds) and the proof's regions
+    (less ``before``: what a preparation built, as this returned it then)."""
     from planners.core.exact_se2 import built_regions
 
     n, seconds = cs.slabs_built()
-    return {"slabs": n, "slab_s": seconds, **built_regions(cs)}
+    out = {"slabs": n, "slab_s": seconds, **built_regions(cs)}
+    return {k: v - (before or {}).get(k, 0) for k, v in out.items()}
 
 
 def run_space(space: str, sc, cs, prep: dict, pairs: list, judge: GridJudge, peer: bool, limit: float) -> dict:
@@ -277,7 +279,7 @@ def run_space(space: str, sc, cs, prep: dict, pairs: list, judge: GridJudge, pee
     checks = {"preparation <= 2 s": prep["cpu"] <= 2, "mean <= 45 ms": mean <= 0.045, "p95 <= 100 ms": p95 <= 0.1,
               "all answered": p["answered"] == n, "0 colliding": p["colliding"] == 0}
     met = "; ".join(f"{k} {'met' if v else 'MISSED'}" for k, v in checks.items())
-    lazy = lazy_builds(cs)
+    lazy = lazy_builds(cs, prep.get("prepared"))
     print(f"  ours, plan() (default planner): {p['answered']}/{n} answered ({p['solved']} paths); CPU mean "
           f"{mean * 1e3:.1f} ms, p95 {p95 * 1e3:.1f} ms, median {pct(p['cpu'], 50) * 1e3:.1f} ms (wall mean "
           f"{statistics.mean(p['wall']) * 1e3:.1f} ms, p95 {pct(p['wall'], 95) * 1e3:.1f} ms); colliding {p['colliding']}"

@@ -55,8 +55,11 @@ class ShortestPath:
     stats: dict = field(default_factory=dict)
 
 
-def free_space(pieces: list, bounds) -> "object":
+def free_space(pieces: list, bounds, checked: bool = True) -> "object":
     """The free C-space F = bounds minus the union of the pieces, a shapely geometry.
+    ``checked=False``: GEOS's union as it comes, without its check (:mod:`cspace.kernel.minkowski.union`),
+    for a caller that certifies every point and path it takes from F exactly against the pieces
+    and states nothing from F's shape alone.
 
     >>> F = free_space([np.array([[1., 1], [2, 1], [2, 2], [1, 2]])], (0, 3, 0, 3))
     >>> F.area
@@ -78,7 +81,8 @@ def free_space(pieces: list, bounds) -> "object":
     rings = shapely.linearrings(np.concatenate(closed), indices=np.repeat(np.arange(len(closed)),
                                                                             [len(c) for c in closed]))
     polys = shapely.polygons(rings)
-    taken = union(polys)  # checked (cspace.kernel.minkowski.union): GEOS's float overlay can drop a piece
+    # checked (cspace.kernel.minkowski.union): GEOS's float overlay can drop a piece
+    taken = union(polys) if checked else shapely.union_all(polys)
     return shapely.orient_polygons(box.difference(taken)) if hasattr(shapely, "orient_polygons") \
         else _orient(box.difference(taken))
 

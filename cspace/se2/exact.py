@@ -79,7 +79,7 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
                      time_limit: float | None = None, min_width: float = TWO_PI / 2048, initial_slabs: int = 8,
                      margin: list | None = None, possible_only: bool = False, refine: bool = True,
                      regions: SlabRegions | None = None, inner_obstacles: list | None = None,
-                     inner_robot: list | None = None, excess: float = 0.0) -> SE2ExactResult:
+                     inner_robot: list | None = None, excess: float = 0.0, near: bool = False) -> SE2ExactResult:
     """Plan for a robot of convex ``robot_pieces`` (body frame) among convex ``obstacle_pieces``:
     a certified path, a proof that none exists, or "undecided" at the resolution reached.
 
@@ -94,7 +94,8 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
     (a disk's inscribed polygon where ``obstacle_pieces`` / ``robot_pieces`` hold its
     circumscribed one): POSSIBLE and the proof are built of them, so that a proof holds for the
     disks themselves (None: the same pieces, polygons only); ``excess``: their polygons' error,
-    for the resolution statement.
+    for the resolution statement. ``near``: a walk's link points moved where the path is first
+    (:func:`cspace.se2.exact_path.near_links`; its own points where that assembly fails).
 
     >>> wall = [np.array([[4., 0], [5, 0], [5, 4], [4, 4]]), np.array([[4., 6], [5, 6], [5, 10], [4, 10]])]
     >>> bar = [np.array([[-1.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-1.5, 0.2]])]
@@ -115,7 +116,7 @@ def exact_se2_search(obstacle_pieces: list, robot_pieces: list, bounds, start, g
         regions = slab_regions(obstacle_pieces, robot, bounds, margin, inner_obstacles=inner_obstacles,
                                inner_robot=inner_robot, excess=excess)
     search = _Search(regions, start, goal, time_limit, float(min_width), initial_slabs)
-    search.possible_only, search.refine = bool(possible_only), bool(refine)
+    search.possible_only, search.refine, search.near = bool(possible_only), bool(refine), bool(near)
     return search.run()
 
 
@@ -180,7 +181,7 @@ class _Search:
         self.min_width = min_width
         self.part = initial_partition(initial_slabs)
         self.times = {"regions": 0.0, "graphs": 0.0, "path": 0.0}
-        self.possible_only, self.refine = False, True
+        self.possible_only, self.refine, self.near = False, True, False
         self.refinements = 0
         self.graph_sizes: dict = {}
         self.banned: set = set()  # FREE links a failed assembly ruled out (by _key)
@@ -210,7 +211,7 @@ class _Search:
                     if walk is not None:
                         t = time.perf_counter()
                         try:
-                            path = assemble(walk, self.part, freg, self.R, self.start, self.goal)
+                            path = assemble(walk, self.part, freg, self.R, self.start, self.goal, near=self.near)
                         except AssemblyError as exc:  # a certified walk whose exact re-check failed
                             self.times["path"] += time.perf_counter() - t
                             self._repair(walk, exc)

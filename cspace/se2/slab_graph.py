@@ -130,6 +130,14 @@ class SlabRegions:
         self.pad = slab_pad(ps)  # slab_inner's pad (u / 16)
         self.eps = EPS_UNITS * self.unit
         self.proof_tol = TOL_UNITS * self.unit
+        # FREE's union checked as POSSIBLE's is (cspace.kernel.minkowski.union); off for a search
+        # that only looks for a path (every point and motion of it certified again exactly) and
+        # states nothing from FREE's shape (no "undecided" resolution is read from it)
+        self.free_checked = True
+        # the slabs (a, b) whose FREE carried a walk's crossing translation (exact_path.near_links:
+        # the next walks cross there first, where the mesh is kept); so a path may depend on the
+        # queries these regions answered before, each certified the same way
+        self.carriers: set = set()
         self._free: dict = {}
         self._possible: dict = {}
         self._links: dict = {}
@@ -205,7 +213,7 @@ class SlabRegions:
 
         obstacles = self.obstacles if obstacles is None else obstacles
         pieces = pair_sums(obstacles, [reflect(h) for h in robot_side]) if robot_side and obstacles else []
-        F = free_space(pieces, self.bounds)
+        F = free_space(pieces, self.bounds, checked=kind == "possible" or self.free_checked)
         comps = [p for p in shapely.get_parts(F) if p.geom_type == "Polygon" and not p.is_empty]
         boxes = np.array([p.bounds for p in comps], dtype=np.float64).reshape(-1, 4)
         order = sorted(range(len(comps)), key=lambda i: (tuple(boxes[i]), -comps[i].area))
@@ -214,6 +222,18 @@ class SlabRegions:
             shapely.prepare(c)
         return Region(a, b, kind, pieces, comps, boxes[order].reshape(-1, 4), cores, time.perf_counter() - t,
                       piece_boxes(pieces))
+
+    def share_possible(self, other: "SlabRegions") -> bool:
+        """Read and build POSSIBLE in ``other``'s cache from now on, where both have the same body,
+        obstacles and proof numbers (POSSIBLE does not depend on the margin FREE keeps: a search
+        asking for more room reuses the body's regions); False (nothing shared) otherwise."""
+        same = (self.unit, self.pad, self.eps, len(self.core_robot), len(self.core_obstacles)) == \
+            (other.unit, other.pad, other.eps, len(other.core_robot), len(other.core_obstacles)) and \
+            all(np.array_equal(a, b) for a, b in zip(self.core_robot + self.core_obstacles,
+                                                     other.core_robot + other.core_obstacles))
+        if same:
+            self._possible = other._possible
+        return same
 
     # -- links ---------------------------------------------------------------------------
 
@@ -237,6 +257,41 @@ class SlabRegions:
             self._links[key] = out
             self.counts["links_built"] += 1
         return self._links[key]
+
+    def link_near(self, r1: Region, i: int, r2: Region, j: int, x: float, y: float) -> tuple[float, float] | None:
+        """A point deep inside FREE component i of r1 and j of r2 (as deep as :meth:`free_links`'
+        points) near (x, y): (x, y) itself where it is one, else one of their overlap inside a
+        square round it (2, 8, 32, 128 robot radii wide, the first that holds one; within it, of
+        the overlap's part nearest to (x, y)); None where none is that near. Per query: a walk
+        then turns where it is, not at the one point :meth:`free_links` keeps for the pair,
+        which on a large map may be a hundred metres away.
+
+        >>> sr = SlabRegions([np.array([[4., 0], [5, 0], [5, 10], [4, 10]])], [np.array([[0., 0], [.2, 0], [0, .2]])],
+        ...                  (0, 10, 0, 10))
+        >>> f1, f2 = sr.free(0.0, 0.5), sr.free(0.5, 1.0)
+        >>> x, y = sr.link_near(f1, 0, f2, 0, 4.5, 5.0)  # in the wall: a point of the left side near it
+        >>> sr.link_near(f1, 0, f2, 0, 1.0, 1.0), bool(x < 4 and abs(y - 5) < 3)
+        ((1.0, 1.0), True)
+        """
+        import shapely
+
+        c1, c2, pt = r1.components[i], r2.components[j], shapely.Point(float(x), float(y))
+        for w in (2.0, 8.0, 32.0, 128.0):
+            w *= self.radius
+            box = shapely.box(x - w, y - w, x + w, y + w)
+            try:
+                local = shapely.intersection(shapely.intersection(c1, box), c2)
+            except shapely.errors.GEOSException:  # (an overlay GEOS refuses: the kept point serves)
+                return None
+            parts = [p for p in shapely.get_parts(local) if p.geom_type == "Polygon" and p.area > 0.0]
+            if w == 2.0 * self.radius and any(shapely.intersects_xy(p, x, y) and p.boundary.distance(pt) > self.tol
+                                              for p in parts):
+                return float(x), float(y)
+            for p in sorted(parts, key=lambda q: (q.distance(pt), q.bounds)):
+                found = deep_point(p, self.tol)
+                if found is not None:
+                    return found
+        return None
 
     def possible_links(self, r1: Region, r2: Region) -> list[tuple[int, int]]:
         """(i, j): POSSIBLE components of r1 and r2 whose closures meet or come within ``proof_tol``."""

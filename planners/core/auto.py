@@ -191,6 +191,29 @@ def _timed_out(sc, adapter, query, time_limit: float, seed: int) -> PlanResult:
                       message=f"not solved within the time limit ({time_limit:g} s)")
 
 
+def prepare(sc, cspace) -> float:
+    """For a C-space serving many queries (a large map), build what they read first on the map
+    alone, kept with it; returns its seconds. A rotating robot or a car: the proof's POSSIBLE regions,
+    labelled (:func:`planners.core.exact_se2.prepare`); a Reeds–Shepp car also FREE at the first 8
+    slabs with the first room of :data:`ROOMS`, and their links. A query answers the same, sooner."""
+    from cspace.se2.exact import initial_partition
+    from .exact_se2 import prepare as prepare_se2, search_regions
+
+    t = _now()
+    if not (sc.rotates and cspace.body_pieces):
+        return 0.0
+    prepare_se2(cspace)
+    if sc.space == "reeds-shepp":
+        regions, part = search_regions(cspace, ROOMS[0] * _reach(cspace)), initial_partition()
+        for (a, b), (c, d) in zip(part, part[1:] + part[:1]):
+            regions.free_links(regions.free(a, b), regions.free(c, d))
+    return _now() - t
+
+
+def _reach(cspace) -> float:  # the robot's reach from its reference point (the unit of ROOMS)
+    return max(float(np.max(np.hypot(p[:, 0], p[:, 1]))) for p in cspace.body_pieces)
+
+
 def small_scene(sc, cspace) -> bool:
     """A rotating robot (not a car) in a scene of at most :data:`SMALL_PAIRS` convex pairs
     (obstacle pieces x robot pieces): its stages run in the order of :func:`_small_se2`."""
@@ -313,7 +336,7 @@ def _slab_graph(sc, cspace, adapter, query, source, budget: float, simplify: boo
     if sc.space == "se2":
         return exact_se2(sc, cspace, adapter, query, source, time_limit=budget, simplify=simplify, refine=refine)
     end = _now() + budget
-    reach = max(float(np.max(np.hypot(p[:, 0], p[:, 1]))) for p in cspace.body_pieces)
+    reach = _reach(cspace)
     rooms = [f * reach for f in ROOMS] + ([0.0] if refine else [])
     for i, room in enumerate(rooms):
         t = _now()
@@ -321,7 +344,7 @@ def _slab_graph(sc, cspace, adapter, query, source, budget: float, simplify: boo
         if share <= 0:
             return None
         try:
-            res = search(cspace, query, share, refine=refine, room=room)
+            res = search(cspace, query, share, refine=refine, room=room, near=True)
         except ValueError:  # the start or the goal is closer than ``room`` to an obstacle
             continue
         if res.status == "unsolvable":  # POSSIBLE is the body's whatever the room: a proof

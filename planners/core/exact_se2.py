@@ -29,6 +29,10 @@ from .result import PlanResult
 
 QUICK_SHARE = 0.1   # of the time limit, at most, for the proof before sampling
 QUICK_MAX = 1.0     # seconds, at most, whatever the limit
+# A search's room (a car's path kept off the obstacles, a heuristic, no promise) is a disk's polygon
+# this much (relative) outside it: an octagon, not the 71 sides of a clearance the user asks for (its
+# corners at every obstacle corner made FREE's boundary, its links and its mesh several times larger)
+ROOM_DISK_TOLERANCE = 0.1
 SHORTCUT_TRIES = 100  # the vertex reduction of a bounded shortening tries at least this many shortcuts
 CAR_SLABS = 128     # the finest partition a car's proof-only search tries
 # The proof before sampling refines the first 8 slabs once, where the POSSIBLE graph still joins
@@ -47,25 +51,27 @@ _JOINS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def search(cspace, query, time_limit: float | None, *, possible_only: bool = False, refine: bool = True,
-           min_width: float | None = None, room: float = 0.0):
+           min_width: float | None = None, room: float = 0.0, near: bool = False):
     """The slab-graph search on an SE(2) C-space's pieces (body frame; its margin, if any,
     inflates the robot for the path, while a proof is made for the body itself). The slab
     regions are kept with the C-space, so the queries of one scene share them.
 
     ``room`` > 0 asks for a path that keeps that much more clearance: the robot is inflated by
-    a polygon holding the disk of radius ``room`` as well (its own regions, kept too); a start
-    or goal closer than that to an obstacle raises ValueError."""
+    a polygon holding the disk of radius ``room`` as well (an octagon: :data:`ROOM_DISK_TOLERANCE`;
+    its own regions, kept too); a start
+    or goal closer than that to an obstacle raises ValueError. ``near``: the path turns where it
+    is, not at the links' kept points (:func:`cspace.se2.exact_path.near_links`)."""
     from cspace.se2.exact import exact_se2_search
 
     margin = list(cspace.margin or [])
     if room > 0:
         from cspace.kernel.minkowski.margin import margin_shapes
 
-        margin += margin_shapes(float(room))
+        margin += margin_shapes(float(room), disk_tolerance=ROOM_DISK_TOLERANCE)
     regions = _regions_of(cspace, float(room))
     return exact_se2_search(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, tuple(query.start),
                             tuple(query.goal), time_limit=time_limit, margin=margin or None,
-                            possible_only=possible_only, refine=refine, regions=regions,
+                            possible_only=possible_only, refine=refine, regions=regions, near=near,
                             **({} if min_width is None else {"min_width": min_width}))
 
 
@@ -114,7 +120,8 @@ def proof_joins(cspace, build: bool = True) -> list:
 def built_regions(cspace) -> dict:
     """What the slab graph has built for this C-space so far, every room together: its FREE and
     POSSIBLE regions (``regions``, how many) and their seconds (``region_s``); nothing built: 0."""
-    made = [r for sr in _REGIONS.get(cspace, {}).values() for r in (*sr._free.values(), *sr._possible.values())]
+    made = {id(r): r for sr in _REGIONS.get(cspace, {}).values() for r in (*sr._free.values(), *sr._possible.values())}
+    made = list(made.values())  # (POSSIBLE shared between rooms: counted once)
     return {"regions": len(made), "region_s": sum(r.seconds for r in made)}
 
 
@@ -122,6 +129,11 @@ def slab_regions_of(cspace):
     """The C-space's POSSIBLE and FREE regions (a :class:`cspace.se2.slab_graph.SlabRegions`), the
     ones the slab graph's search reads and keeps (a Dubins car's reach proof reads them too)."""
     return _regions_of(cspace)
+
+
+def search_regions(cspace, room: float = 0.0):
+    """The regions :func:`search` reads for this ``room`` (made on first use and kept)."""
+    return _regions_of(cspace, float(room))
 
 
 def _regions_of(cspace, room: float = 0.0):
@@ -135,12 +147,15 @@ def _regions_of(cspace, room: float = 0.0):
         if room > 0:
             from cspace.kernel.minkowski.margin import margin_shapes
 
-            margin += margin_shapes(room)
+            margin += margin_shapes(room, disk_tolerance=ROOM_DISK_TOLERANCE)
         kept[room] = slab_regions(
             cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, margin or None,
             inner_obstacles=getattr(cspace, "inner_obstacle_pieces", None),
             inner_robot=getattr(cspace, "inner_body_pieces", None),
             excess=disk_excess(cspace.scenario) if getattr(cspace, "scenario", None) is not None else 0.0)
+        if room > 0:  # a car's search for a path with room: FREE's union unchecked (its path is
+            kept[room].free_checked = False  # certified again; it states nothing), POSSIBLE the body's
+            kept[room].share_possible(_regions_of(cspace))
     return kept[room]
 
 

@@ -20,14 +20,14 @@ def run(monkeypatch, fails):
     real = exact.assemble
     seen = []
 
-    def flaky(walk, part, freg, regions, start, goal):
+    def flaky(walk, part, freg, regions, start, goal, near=False):
         i = fails(walk, part)
         seen.append([part[n[0]] if n[0] >= 0 else n for n, _ in walk])
         if i is not None:
             e = AssemblyError(f"simulated failure at node {i}")
             e.index = i
             raise e
-        return real(walk, part, freg, regions, start, goal)
+        return real(walk, part, freg, regions, start, goal, near=near)
 
     monkeypatch.setattr(exact, "assemble", flaky)
     r = exact.exact_se2_search(WALL, BAR, (0, 10, 0, 10), (2, 5, 0.0), (8, 5, 0.0), time_limit=60.0)

@@ -1,0 +1,109 @@
+"""A car on a large map (issue 47, the warehouse's Reeds–Shepp queries): the slab graph's path
+turns where it is, not at the one link point kept per pair of components (on a large map a
+hundred metres away); a search asking for room shares the body's POSSIBLE regions; the
+preparation of a C-space for many queries changes no answer. Every path is judged by the
+independent sweep (scripts/sweep_oracle.py, shapely), not by the C-space that certified it.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+
+import numpy as np
+import pytest
+
+import planners
+from conftest import SCENARIOS, load_script
+from cspace.io.load import load_scenario, scenario_from_dict
+from cspace.se2.exact import exact_se2_search
+from cspace.se2.slab_graph import SlabRegions
+
+oracle = load_script("sweep_oracle")
+BAR = [[-0.6, -0.15], [0.6, -0.15], [0.6, 0.15], [-0.6, 0.15]]
+POSTS = [[[20.0, 20.0], [22.0, 20.0], [22.0, 22.0], [20.0, 22.0]], [[70.0, 60.0], [73.0, 60.0], [73.0, 64.0], [70.0, 64.0]],
+         [[6.2, 3.5], [6.8, 3.5], [6.8, 6.5], [6.2, 6.5]]]  # (the last between the test's start and goal)
+
+
+def _open_map(start, goal) -> object:
+    """A 100 m square with two posts, a bar robot: the overlap of two neighbouring slabs' FREE is
+    most of the map, so the link point kept for the pair is near its middle."""
+    return scenario_from_dict({"name": "open", "space": "se2", "bounds": {"xmin": 0, "xmax": 100, "ymin": 0, "ymax": 100},
+                               "robot": {"polygon": BAR}, "obstacles": [{"polygon": p} for p in POSTS],
+                               "start": dict(zip(("x", "y", "theta"), start)),
+                               "goal": dict(zip(("x", "y", "theta"), goal))})
+
+
+def _length(path) -> float:
+    return float(np.hypot(*np.diff(np.asarray(path)[:, :2], axis=0).T).sum())
+
+
+def test_a_walk_turns_where_it_is_not_at_the_far_link_point():
+    """... and its short translation round the post between start and goal is searched in a
+    window round them: the path still passes the independent sweep."""
+    start, goal = (5.0, 5.0, 0.0), (8.0, 5.0, 2.5)  # 3 m apart, a turn through three slabs, a post between
+    sc = _open_map(start, goal)
+    pieces = [np.array(p, dtype=float) for p in POSTS]
+    far = exact_se2_search(pieces, [np.array(BAR)], (0, 100, 0, 100), start, goal)
+    near = exact_se2_search(pieces, [np.array(BAR)], (0, 100, 0, 100), start, goal, near=True)
+    assert far.status == near.status == "solved"
+    for r in (far, near):
+        j = oracle.sweep_check(sc, r.path)
+        assert not j["collides"] and not j["out_of_bounds"]
+        assert tuple(r.path[0]) == start and tuple(r.path[-1][:2]) == goal[:2]
+    assert _length(far.path) > 50.0  # (the test is not blind: the kept points are mid-map)
+    assert _length(near.path) < 4 * math.dist(start[:2], goal[:2])
+    assert not (near.path[:, 1] == 5.0).all()  # (it went round the post)
+
+
+def test_the_kept_point_stays_where_no_overlap_is_near():
+    wall = np.array([[4.0, 0.0], [5.0, 0.0], [5.0, 10.0], [4.0, 10.0]])
+    sr = SlabRegions([wall], [np.array([[0.0, 0.0], [0.2, 0.0], [0.0, 0.2]])], (0, 10, 0, 10))
+    f1, f2 = sr.free(0.0, 0.5), sr.free(0.5, 1.0)
+    right = [i for i, c in enumerate(f1.components) if c.bounds[0] > 4.5]
+    left = [j for j, c in enumerate(f2.components) if c.bounds[2] < 4.5]
+    assert right and left and sr.link_near(f1, right[0], f2, left[0], 4.5, 5.0) is None  # they do not overlap
+    x, y = sr.link_near(f1, right[0], f2, [j for j in range(len(f2.components)) if j not in left][0], 9.0, 9.0)
+    assert (x, y) == (9.0, 9.0) and sr.pose_free(x, y, 0.0) and sr.pose_free(x, y, 1.0)
+
+
+def test_a_search_with_room_reads_the_body_s_possible_regions():
+    from planners.core.exact_se2 import search_regions
+    from planners.core.plan import build_cspace
+
+    sc = load_scenario(os.path.join(SCENARIOS, "car", "parallel_tight.toml"))
+    cs = build_cspace(sc)
+    body, roomy = search_regions(cs), search_regions(cs, 0.01)
+    assert roomy.possible(0.0, 0.5) is body.possible(0.0, 0.5)
+    assert roomy.free(0.0, 0.5) is not body.free(0.0, 0.5)
+    other = SlabRegions(body.obstacles, [p * 0.5 for p in body.robot], body.bounds)
+    assert not other.share_possible(body)  # another body: POSSIBLE differs, nothing shared
+
+
+@pytest.mark.slow  # (several seconds: the sweep along the curves)
+def test_a_car_s_slab_graph_path_with_room_passes_the_sweep():
+    """FREE with room is built without the union's check and the walk's links are moved: the
+    path is still certified curve by curve, and the independent sweep along the curves agrees."""
+    from cspace.car.curves import reeds_shepp_segments
+
+    sc = load_scenario(os.path.join(SCENARIOS, "car", "parallel_tight.toml"))
+    r = planners.plan(sc, seed=0, time=20.0)
+    assert r.solved and r.answered_by == "slab graph", r.message
+    assert tuple(r.path[0]) == tuple(r.start) and tuple(r.path[-1]) == tuple(r.goal)
+    j = oracle.car_sweep_check(sc, r.path, lambda a, b: reeds_shepp_segments(a, b, sc.turning_radius),
+                               sc.turning_radius)
+    assert not j["collides"] and not j["out_of_bounds"]
+
+
+@pytest.mark.slow  # (about 1 s: the scene planned twice)
+def test_preparing_a_c_space_changes_no_answer():
+    from planners.core.auto import prepare
+    from planners.core.plan import build_cspace
+
+    sc = load_scenario(os.path.join(SCENARIOS, "car", "parallel_tight.toml"))
+    plain, ready = build_cspace(sc), build_cspace(sc)
+    assert prepare(sc, ready) > 0.0
+    a = planners.plan(sc, seed=3, time=20.0, cspace=plain)
+    b = planners.plan(dataclasses.replace(sc), seed=3, time=20.0, cspace=ready)
+    assert a.solved and b.solved and a.answered_by == b.answered_by == "slab graph"
+    assert np.array_equal(a.path, b.path)
