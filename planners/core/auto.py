@@ -134,7 +134,17 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         r = clock.run("sampling", lambda: _direct(sc, adapter, query, pair, seed))
         if r is not None:
             return _answer(r, "sampling", clock, seed)
-    if turns:  # a slice of sampling: an open scene is answered here, a large map too
+    sliced = False
+    if turns and kind == "reeds-shepp":  # the compiled slice (None on the pure path: OMPL's below)
+        from .car_sampling import connect_slice
+
+        slice_s = clock.left() if iterations is not None else min(SLICE_SHARE * time_limit, clock.left())
+        r = clock.run("sampling", lambda: connect_slice(sc, adapter, query, pair, seed, slice_s, simplify,
+                                                         clock.t0 + clock.limit))
+        if r is not None and r.solved:
+            return _answer(r, "sampling", clock, seed)
+        sliced = r is not None
+    if turns and not sliced:  # a slice of sampling: an open scene is answered here, a large map too
         r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
             return _answer(r, "sampling", clock, seed)
