@@ -5,10 +5,11 @@ search (the Reeds–Shepp length to the tree's nodes, at every step of either tr
 compiled search (:func:`cspace.car.connect.connect`) grows its trees the same way with a
 search that passes over nodes by lower bounds of that length, and asks the adapter's certified
 motion test for every motion. :func:`connect_slice` runs it for :data:`SLICE_ITERATIONS`
-samples at most, stepping :data:`STEP_SHARE` of the space's extent (at most the adapter's range
-bound), and returns a :class:`PlanResult` as the sampling planners' (the path re-checked by the
-adapter; shortened under the same validator when asked), or None on the pure path (no compiled
-search: the caller samples with OMPL).
+samples at most, stepping :data:`STEP_SHARE` of the space's extent, and returns a
+:class:`PlanResult` as the sampling planners' (the path re-checked by the adapter; shortened
+under the same validator when asked), or None on the pure path (no compiled search) and on a scene larger than OMPL's range bound for a car (:func:`small_car_scene`: a
+map of hundreds of turning radii, whose first queries build slabs inside the slice): the caller
+samples with OMPL there, as before.
 """
 from __future__ import annotations
 
@@ -26,27 +27,46 @@ SLICE_ITERATIONS = 1000  # samples of the compiled slice (each grows one tree, t
 STEP_SHARE = 0.1
 
 
-def step_length(adapter) -> float:
-    """The slice's step: :data:`STEP_SHARE` of the space's extent, at most the adapter's range bound.
+def _extent(adapter) -> float:
+    xmin, xmax, ymin, ymax = adapter.cspace.bounds
+    return math.hypot(xmax - xmin, ymax - ymin) + 0.5 * math.pi
 
-    >>> class A: cspace = type("C", (), {"bounds": (0.0, 30.0, 0.0, 40.0)})(); k = 0; max_range = 1e9
+
+def step_length(adapter) -> float:
+    """The slice's step: :data:`STEP_SHARE` of the space's extent.
+
+    >>> class A: cspace = type("C", (), {"bounds": (0.0, 30.0, 0.0, 40.0)})()
     >>> round(step_length(A()), 6)
     5.15708
     """
-    xmin, xmax, ymin, ymax = adapter.cspace.bounds
-    own = STEP_SHARE * (math.hypot(xmax - xmin, ymax - ymin) + 0.5 * math.pi)
+    return STEP_SHARE * _extent(adapter)
+
+
+def small_car_scene(adapter) -> bool:
+    """Whether OMPL's own range (:data:`planners.adapters.glue.RANGE_SHARE` of the extent) is within
+    the adapter's range bound (:data:`planners.adapters.car.RANGE_RADII` turning radii): a scene
+    of about 100 radii or less, as the bundled car scenes (10-20), not a building's map (hundreds).
+
+    >>> class A: cspace = type("C", (), {"bounds": (0.0, 30.0, 0.0, 40.0)})(); k = 0; max_range = 20.0
+    >>> small_car_scene(A())
+    True
+    """
+    from ..adapters.glue import RANGE_SHARE
+
     cap = getattr(adapter, "max_range", None)
-    return own if cap is None else min(own, math.ldexp(cap, -adapter.k))
+    return cap is not None and RANGE_SHARE * _extent(adapter) <= math.ldexp(cap, -adapter.k)
 
 
 def connect_slice(sc, adapter, query, pair, seed: int, budget: float, simplify: bool,
                   end: float) -> PlanResult | None:
     """The compiled slice on one query within ``budget`` seconds (its samples counted, so where
     it ends is the same on every machine that finishes them in time): a solved or unsolved
-    PlanResult, or None on the pure path. ``end``: the ``time.perf_counter()`` value the
+    PlanResult, or None on the pure path and on a large scene (OMPL's slice there). ``end``: the ``time.perf_counter()`` value the
     shortening stops at."""
     from cspace.car.connect import connect
 
+    if not small_car_scene(adapter):
+        return None
     t0 = time.perf_counter()
     adapter.forget()  # a new run: nothing remembered from the last query's
     got = connect(adapter.motion_free, pair[0], pair[1], adapter.radius, adapter.cspace.bounds,

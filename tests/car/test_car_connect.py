@@ -116,3 +116,15 @@ def test_without_the_extension_auto_samples_with_ompl(monkeypatch):
     res = planners.plan(sc, seed=1, time=10.0, simplify=False)
     assert res.solved and res.answered_by == "sampling" and "compiled" not in res.message, res.message
     assert swept_free(sc, np.asarray(res.path))
+
+
+def test_a_map_of_hundreds_of_radii_keeps_ompl_s_slice():
+    # (a building's map: its first queries build slabs inside the slice; OMPL's slice re-runs there)
+    from planners.adapters.car import CarSpace
+    from planners.core.car_sampling import connect_slice, small_car_scene
+
+    sc, ad, q, pair = setup_of("parking.toml")
+    assert small_car_scene(ad)
+    tiny = CarSpace(ad.cspace, "reeds-shepp", ad.radius / 20)  # the same scene, 20x as many radii across
+    assert not small_car_scene(tiny)
+    assert connect_slice(sc, tiny, q, pair, 0, 1.0, False, time.perf_counter() + 1.0) is None
