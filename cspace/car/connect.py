@@ -49,14 +49,14 @@ def connect(motion_free, start, goal, radius: float, bounds, step: float, seed: 
     >>> got is None or all(test(tuple(a), tuple(b)) for a, b in zip(got[0][:-1].tolist(), got[0][1:].tolist()))
     True
     """
-    free = motion_free
-    if deadline is not None:
-        clock = time.perf_counter
+    clock = time.perf_counter
 
-        def free(q0, q1) -> bool:
-            if clock() > deadline:
-                raise _Late
-            return motion_free(q0, q1)
+    def in_time(q0, q1) -> bool:
+        if clock() > deadline:
+            raise _Late
+        return motion_free(q0, q1)
+
+    free = motion_free if deadline is None else in_time
 
     try:
         got = motions.car_connect(start, goal, radius, bounds, step, seed, iterations, free)
