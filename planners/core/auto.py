@@ -4,7 +4,9 @@ It runs the project's planners as stages of one budget, each only when the ones 
 not answered, in the order of their cost on the scene (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- a car first tries its one shortest curve from start to goal (the
-   path when it is free: :func:`_direct`); then RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
+   path when it is free: :func:`_direct`; a Reeds–Shepp car on a small scene then samples with the
+   compiled RRT-Connect, :func:`planners.core.car_sampling.connect_slice`, in place of OMPL's
+   slice); then RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
    :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
    scene, or a query on a large map, is answered here in milliseconds, before any region of the
    slab graph is built (every rotating robot and car: a Dubins car too);
