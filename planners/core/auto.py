@@ -4,9 +4,8 @@ It runs the project's planners as stages of one budget, each only when the ones 
 not answered, in the order of their cost on the scene (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- a car first tries its one shortest curve from start to goal (the
-   path when it is free: :func:`_direct`; a Reeds–Shepp car on a small scene then samples with the
-   compiled RRT-Connect, :func:`planners.core.car_sampling.connect_slice`, in place of OMPL's
-   slice); then RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
+   path when it is free: :func:`_direct`); then RRTConnect (a small Reeds–Shepp scene: the compiled
+   one, :func:`.car_sampling.connect_slice`) for at most :data:`SLICE_ITERATIONS` iterations (and
    :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
    scene, or a query on a large map, is answered here in milliseconds, before any region of the
    slab graph is built (every rotating robot and car: a Dubins car too);
@@ -58,6 +57,7 @@ import weakref
 
 import numpy as np
 
+from .car_sampling import connect_slice
 from .result import PlanResult
 
 SAMPLER = "RRTConnect"
@@ -136,17 +136,11 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         r = clock.run("sampling", lambda: _direct(sc, adapter, query, pair, seed))
         if r is not None:
             return _answer(r, "sampling", clock, seed)
-    sliced = False
-    if turns and kind == "reeds-shepp":  # the compiled slice (None on the pure path: OMPL's below)
-        from .car_sampling import connect_slice
-
-        slice_s = clock.left() if iterations is not None else min(SLICE_SHARE * time_limit, clock.left())
-        r = clock.run("sampling", lambda: connect_slice(sc, adapter, query, pair, seed, slice_s, simplify,
-                                                         clock.t0 + clock.limit))
-        if r is not None and r.solved:
-            return _answer(r, "sampling", clock, seed)
-        sliced = r is not None
-    if turns and not sliced:  # a slice of sampling: an open scene is answered here, a large map too
+    r = clock.run("sampling", lambda: connect_slice(sc, adapter, query, pair, seed, clock, SLICE_SHARE * time_limit,
+                                                     iterations, simplify)) if turns and kind == "reeds-shepp" else None
+    if r is not None and r.solved:  # a small Reeds–Shepp scene: the compiled slice (None: OMPL's below)
+        return _answer(r, "sampling", clock, seed)
+    if turns and r is None:  # a slice of sampling: an open scene is answered here, a large map too
         r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
             return _answer(r, "sampling", clock, seed)

@@ -57,17 +57,19 @@ def small_car_scene(adapter) -> bool:
     return cap is not None and RANGE_SHARE * _extent(adapter) <= math.ldexp(cap, -adapter.k)
 
 
-def connect_slice(sc, adapter, query, pair, seed: int, budget: float, simplify: bool,
-                  end: float) -> PlanResult | None:
-    """The compiled slice on one query within ``budget`` seconds (its samples counted, so where
-    it ends is the same on every machine that finishes them in time): a solved or unsolved
-    PlanResult, or None on the pure path and on a large scene (OMPL's slice there). ``end``: the ``time.perf_counter()`` value the
-    shortening stops at."""
+def connect_slice(sc, adapter, query, pair, seed: int, clock, share_s: float, iterations: int | None,
+                  simplify: bool) -> PlanResult | None:
+    """The compiled slice on one query within ``share_s`` seconds, or all the time ``clock`` has
+    left (``clock.left()``) where the caller counts ``iterations`` (its samples are counted either
+    way, so where it ends is the same on every machine that finishes them in time): a solved or
+    unsolved PlanResult, or None on the pure path and on a large scene (OMPL's slice there). The
+    shortening stops at the clock's end (``clock.t0 + clock.limit``, ``time.perf_counter()``)."""
     from cspace.car.connect import connect
 
     if not small_car_scene(adapter):
         return None
-    t0 = time.perf_counter()
+    t0, end = time.perf_counter(), clock.t0 + clock.limit
+    budget = clock.left() if iterations is not None else min(share_s, clock.left())
     adapter.forget()  # a new run: nothing remembered from the last query's
     got = connect(adapter.motion_free, pair[0], pair[1], adapter.radius, adapter.cspace.bounds,
                   step_length(adapter), seed, SLICE_ITERATIONS, deadline=t0 + max(budget, 0.0))

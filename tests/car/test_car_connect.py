@@ -127,4 +127,6 @@ def test_a_map_of_hundreds_of_radii_keeps_ompl_s_slice():
     assert small_car_scene(ad)
     tiny = CarSpace(ad.cspace, "reeds-shepp", ad.radius / 20)  # the same scene, 20x as many radii across
     assert not small_car_scene(tiny)
-    assert connect_slice(sc, tiny, q, pair, 0, 1.0, False, time.perf_counter() + 1.0) is None
+    clock = type("Clock", (), {"t0": time.perf_counter(), "limit": 1.0, "left": lambda self: 1.0})()
+    assert connect_slice(sc, tiny, q, pair, 0, clock, 1.0, None, False) is None
+    assert connect_slice(sc, ad, q, pair, 0, clock, 1.0, None, False).solved  # the scene's own radius: small
