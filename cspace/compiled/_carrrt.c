@@ -201,8 +201,10 @@ PyObject *fast_car_connect(PyObject *self, PyObject *const *args, Py_ssize_t nar
     }
     int from_start = 1; /* the tree sampled towards this iteration: start, goal, start, ... */
     for (; it < iterations && !path; it++, from_start = !from_start) {
-        double q[3] = {v[7] + unit(&seed) * (v[8] - v[7]), v[9] + unit(&seed) * (v[10] - v[9]),
-                       -PI + unit(&seed) * TWO_PI};
+        double q[3]; /* x, y, then theta: drawn in this order (an initializer's order is unspecified) */
+        q[0] = v[7] + unit(&seed) * (v[8] - v[7]);
+        q[1] = v[9] + unit(&seed) * (v[10] - v[9]);
+        q[2] = -PI + unit(&seed) * TWO_PI;
         Tree *A = &trees[!from_start], *B = &trees[from_start];
         int g = grow(A, from_start, q, r, range, free_cb, &motions);
         if (g == FAILED) goto done;

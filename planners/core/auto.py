@@ -141,7 +141,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
             return _answer(r, "sampling", clock, seed)
     r = clock.run("sampling", lambda: connect_slice(sc, adapter, query, pair, seed, clock, SLICE_SHARE * time_limit,
                                                      iterations, simplify)) if turns and kind == "reeds-shepp" else None
-    if r is not None and r.solved:  # a small Reeds–Shepp scene: the compiled slice (None: OMPL's below)
+    if r is not None and r.solved:  # a small Reeds–Shepp scene: its own slice (None: OMPL's below)
         return _answer(r, "sampling", clock, seed)
     if turns and r is None:  # a slice of sampling: an open scene is answered here, a large map too
         r = sampling_slice(sample, cspace, clock, time_limit)

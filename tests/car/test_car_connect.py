@@ -2,7 +2,8 @@
 ``auto``'s slice that runs it (planners/core/car_sampling.py): its paths pass the independent
 sweep (scripts/sweep_oracle.py, along the curves), every motion is at most one step long (the
 interpolation along a curve), the same seed gives the same path, its budgets (samples, deadline)
-stop it, and without the extension ``auto`` samples with OMPL as before."""
+stop it; without the extension the same search runs in Python (``search_python``: the compiled
+search's oracle, the same path for the same arguments)."""
 from __future__ import annotations
 
 import math
@@ -11,6 +12,7 @@ import time
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
 
 import planners
 from conftest import SCENARIOS, load_script
@@ -102,20 +104,62 @@ def test_auto_answers_a_small_car_scene_by_the_compiled_slice(name):
     sc = load_scenario(os.path.join(SCENARIOS, "car", name))
     for simplify in (False, True):
         res = planners.plan(sc, seed=1, time=10.0, simplify=simplify)
-        assert res.solved and res.answered_by == "sampling" and "compiled RRT-Connect" in res.message, res.message
+        assert res.solved and res.answered_by == "sampling" and "own RRT-Connect" in res.message, res.message
         assert swept_free(sc, np.asarray(res.path))
         again = planners.plan(sc, seed=1, time=10.0, simplify=simplify)
         assert np.array_equal(res.path, again.path)
 
 
-def test_without_the_extension_auto_samples_with_ompl(monkeypatch):
+@compiled
+@pytest.mark.parametrize("name", RS_SCENES + ["u_turn_cusps.toml", "parallel_tight.toml"])
+def test_the_python_search_is_the_compiled_one(name):
+    # The oracle: the same samples, trees, motions asked and path, double for double, on every
+    # bundled Reeds-Shepp scene (parallel_tight: no path in 300 samples, the same count of motions).
+    from cspace.car.connect import search_python
+    from cspace.compiled import motions
+
+    sc, ad, q, pair = setup_of(name)
+    for seed in (0, 3):
+        ad.forget()
+        c = motions.car_connect(*pair, ad.radius, sc.bounds, step_length(ad), seed, 300, ad.motion_free)
+        ad.forget()
+        p = search_python(*pair, ad.radius, sc.bounds, step_length(ad), seed, 300, ad.motion_free)
+        assert c[1:] == p[1:] and (c[0] is None) == (p[0] is None), (name, seed, c[1:], p[1:])
+        assert c[0] is None or c[0] == p[0], (name, seed)
+
+
+@compiled
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**64 - 1), st.floats(0.3, 3.0), st.floats(0.5, 6.0),
+       st.lists(st.tuples(st.floats(1, 9), st.floats(1, 9)), min_size=0, max_size=4))
+def test_the_python_search_is_the_compiled_one_on_random_scenes(seed, radius, step, centres):
+    # Random boxes, radii and steps; the motion test is the certified one of that scene.
+    from cspace.car.connect import search_python
+    from cspace.car.motion import CarCSpace
+    from cspace.compiled import motions
+
+    box = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
+    obstacles = [np.array([[x - 0.5, y - 0.5], [x + 0.5, y - 0.5], [x + 0.5, y + 0.5], [x - 0.5, y + 0.5]])
+                 for x, y in centres if not (abs(x - 0.5) < 1.2 and abs(y - 0.5) < 1.2) and
+                 not (abs(x - 9.5) < 1.2 and abs(y - 9.5) < 1.2)]
+    cs = CarCSpace((0, 10, 0, 10), obstacles, [box], slabs=16)
+    test = cs.car_motion_test("reeds-shepp", radius)
+    a, b = (0.5, 0.5, 0.3), (9.5, 9.5, -2.0)
+    c = motions.car_connect(a, b, radius, (0, 10, 0, 10), step, seed, 60, test)
+    p = search_python(a, b, radius, (0, 10, 0, 10), step, seed, 60, test)
+    assert c == p
+
+
+def test_without_the_extension_auto_runs_the_same_search_in_python(monkeypatch):
     import cspace.car.connect as connect_module
 
-    monkeypatch.setattr(connect_module.motions, "car_connect", lambda *a, **k: None)
     sc = load_scenario(os.path.join(SCENARIOS, "car", "u_turn.toml"))
+    first = planners.plan(sc, seed=1, time=10.0, simplify=False)
+    monkeypatch.setattr(connect_module.motions, "car_connect", lambda *a, **k: None)
     res = planners.plan(sc, seed=1, time=10.0, simplify=False)
-    assert res.solved and res.answered_by == "sampling" and "compiled" not in res.message, res.message
+    assert res.solved and res.answered_by == "sampling" and "own RRT-Connect" in res.message, res.message
     assert swept_free(sc, np.asarray(res.path))
+    assert np.array_equal(res.path, first.path)  # the same path as the compiled search's
 
 
 def test_a_map_of_hundreds_of_radii_keeps_ompl_s_slice():
