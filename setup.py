@@ -1,5 +1,5 @@
 """Build hook for the optional compiled fast path (cspace/compiled/_fast.c, _build.c, _cells.c,
-_chords.c, _gjk.c, _nearest.c, _se2motion.c, _carmotion.c, _carwords.c, _disccost.c and their header
+_chords.c, _gjk.c, _nearest.c, _se2motion.c, _carmotion.c, _carwords.c, _carrrt.c, _disccost.c and their header
 _fast.h); everything else is in pyproject.toml.
 
 ``optional=True``: on a machine without a C compiler (or where the build fails) the
@@ -15,7 +15,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 # Each product rounded once, as the float filter's error bound assumes: no FMA contraction.
 args = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off"]
-sources = [f"cspace/compiled/{name}.c" for name in ("_fast", "_build", "_cells", "_chords", "_gjk", "_nearest", "_se2motion", "_carmotion", "_carwords", "_disccost")]
+sources = [f"cspace/compiled/{name}.c" for name in ("_fast", "_build", "_cells", "_chords", "_gjk", "_nearest", "_se2motion", "_carmotion", "_carwords", "_carrrt", "_disccost")]
 
 # The sources' fingerprint, compiled in (cspace/compiled/fingerprint.py: loaded by its path, numpy
 # may not be installed yet), so that sources edited or pulled since the build run the pure path.

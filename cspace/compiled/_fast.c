@@ -690,6 +690,9 @@ static PyMethodDef methods[] = {
     {"car_motion", (PyCFunction)(void (*)(void))fast_car_motion, METH_FASTCALL,
      "car_motion(handle, grids, x0, y0, th0, x1, y1, th1, radius, dubins, longest, turns): car_curve of the "
      "shortest curve's segments, computed here with car_curves' doubles (_carmotion.c)."},
+    {"car_connect", (PyCFunction)(void (*)(void))fast_car_connect, METH_FASTCALL,
+     "car_connect(x0, y0, th0, x1, y1, th1, radius, xmin, xmax, ymin, ymax, range, seed, iterations, motion_free): "
+     "(path or None, iterations, motions): a Reeds-Shepp car's RRT-Connect (_carrrt.c)."},
     {"reeds_shepp_word", (PyCFunction)(void (*)(void))fast_reeds_shepp_word, METH_FASTCALL,
      "reeds_shepp_word(x, y, phi): reeds_shepp.py's word and lengths, the same doubles, or None (_carwords.c)."},
     {"dubins_word", (PyCFunction)(void (*)(void))fast_dubins_word, METH_FASTCALL,

@@ -4,7 +4,7 @@
    (chord polygons), _gjk.c (the GJK loop of min_clearance), _nearest.c (min_clearance's
    search over its pairs), _se2motion.c and _carmotion.c (the compiled SE(2) motion and car
    curve checks: they share the angle wrap, the slab lookup and the handles' helpers below),
-   _carwords.c (Dubins and Reeds-Shepp words), _disccost.c (the clearance objective's motion
+   _carwords.c (Dubins and Reeds-Shepp words), _carrrt.c (a Reeds-Shepp car's RRT-Connect), _disccost.c (the clearance objective's motion
    cost in translation).
 
    The one certified predicate they share: the sign of a cross product of two edge
@@ -211,6 +211,7 @@ PyObject *fast_se2_motion(PyObject *self, PyObject *const *args, Py_ssize_t narg
 PyObject *fast_car_handle(PyObject *self, PyObject *args);                     /* _carmotion.c */
 PyObject *fast_car_curve(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carmotion.c */
 PyObject *fast_car_motion(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carmotion.c */
+PyObject *fast_car_connect(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carrrt.c */
 int fast_car_segments(int dubins, const double *q0, const double *q1, double r, char *kinds, double *lengths); /* _carwords.c */
 PyObject *fast_reeds_shepp_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */
 PyObject *fast_dubins_word(PyObject *self, PyObject *const *args, Py_ssize_t nargs); /* _carwords.c */

@@ -129,3 +129,14 @@ def _handles_apply(ext, cs) -> bool:
     """Can a compiled motion handle be made over ``cs``: the extension in use, the SE(2)
     pose handle built (the C-space was made on the compiled path) and a robot to turn?"""
     return ext is not None and getattr(cs, "_fast", None) is not None and bool(cs.robot_pieces)
+
+
+def car_connect(start, goal, radius: float, bounds, step: float, seed: int, iterations: int, motion_free):
+    """A Reeds–Shepp car's RRT-Connect compiled (cspace/compiled/_carrrt.c): ``(path or None,
+    iterations, motions asked)``, or None on the pure path (:func:`cspace.car.connect.connect`
+    says what it does)."""
+    _fast = extension()
+    if _fast is None:
+        return None
+    return _fast.car_connect(*map(float, start), *map(float, goal), float(radius), *map(float, bounds), float(step),
+                             int(seed), int(iterations), motion_free)

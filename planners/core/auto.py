@@ -4,7 +4,8 @@ It runs the project's planners as stages of one budget, each only when the ones 
 not answered, in the order of their cost on the scene (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- a car first tries its one shortest curve from start to goal (the
-   path when it is free: :func:`_direct`); then RRTConnect for at most :data:`SLICE_ITERATIONS` iterations (and
+   path when it is free: :func:`_direct`); then RRTConnect (a small Reeds–Shepp scene: the compiled
+   one, :func:`.car_sampling.connect_slice`) for at most :data:`SLICE_ITERATIONS` iterations (and
    :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
    scene, or a query on a large map, is answered here in milliseconds, before any region of the
    slab graph is built (every rotating robot and car: a Dubins car too);
@@ -55,6 +56,7 @@ import weakref
 
 import numpy as np
 
+from .car_sampling import connect_slice
 from .result import PlanResult
 
 SAMPLER = "RRTConnect"
@@ -137,7 +139,11 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
         r = clock.run("sampling", lambda: _direct(sc, adapter, query, pair, seed))
         if r is not None:
             return _answer(r, "sampling", clock, seed)
-    if turns:  # a slice of sampling: an open scene is answered here, a large map too
+    r = clock.run("sampling", lambda: connect_slice(sc, adapter, query, pair, seed, clock, SLICE_SHARE * time_limit,
+                                                     iterations, simplify)) if turns and kind == "reeds-shepp" else None
+    if r is not None and r.solved:  # a small Reeds–Shepp scene: its own slice (None: OMPL's below)
+        return _answer(r, "sampling", clock, seed)
+    if turns and r is None:  # a slice of sampling: an open scene is answered here, a large map too
         r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
             return _answer(r, "sampling", clock, seed)
