@@ -217,7 +217,8 @@ def test_a_join_by_rounding_at_one_heading_near_an_obstacle_is_decided_in_c():
     heading) where the slab's hull is too coarse (near an obstacle: its segment test fails): the
     compiled call certifies it (2) wherever the robot there has clearance, as the pure path's
     exact translational test does (was: 1, the join left to that test, ~0.4 ms a motion: 3 to 31
-    times in 6 of the loading dock's first 10 seeds of `plan`, shortening included). Motions into the bay and past the truck."""
+    times in 6 of the loading dock's first 10 seeds of `plan`, shortening included). Motions into
+    the bay and past the truck."""
     sc, cs, pure = scene("loading_dock.toml")
     r = sc.turning_radius
     g = tuple(map(float, sc.all_queries()[0].goal))
