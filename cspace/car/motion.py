@@ -29,7 +29,11 @@ On the compiled path (:func:`cspace.compiled.motions.car_curve`, cspace/compiled
 the probe, the straight segments and the arcs' halving run in one C call per curve with the
 same doubles; it answers "free" only where this path would (a separating axis needs this
 path's gap plus ~2048 roundoffs), "not free" only on a pose in collision, and hands
-anything else ("undecided") to this path, the oracle.
+anything else ("undecided") to this path, the oracle. The planners' motion test joins the
+curve's end to q1 in that call too, where one slab's segment test certifies the join or, at one
+heading, the robot swept along it is separated with that margin, as a straight segment is
+(near an obstacle the slab's hull is too coarse; the exact translational test here would
+say free too); else the join is this path's.
 """
 from __future__ import annotations
 

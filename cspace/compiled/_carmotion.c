@@ -390,16 +390,11 @@ typedef struct {
     char kind;
 } Link;
 
-/* A straight segment at the angle th from (x0, y0) to (x1, y1): 1, 0 or an R_ code. */
-static int64_t straight(Car *h, PyObject *grids, double x0, double y0, double x1, double y1, double th)
+/* The robot at the one angle th (th wrapped, its slab's grid in `grids`) translated from (x0, y0)
+   to (x1, y1), past the slab's segment test: its pieces swept along halved sub-segments
+   separated by fixed_hits (1), a middle pose in collision (0), or an R_ code. */
+static int64_t fixed_sweep(Car *h, PyObject *grids, double x0, double y0, double x1, double y1, double th)
 {
-    int64_t k = slab_index(h->slab_lo, h->slab_hi, h->K, th);
-    if (k < 0) return R_UNDECIDED;
-    PyObject *g = PyList_GET_ITEM(grids, k);
-    if (g == Py_None) return R_SLAB(k);
-    int r = fast_grid_segment(g, x0, y0, x1, y1);
-    if (r == -2) return R_ERROR;
-    if (r == 1 || r == 3) return 1;
     if (place_pieces(h, cos(th), sin(th), 0.0, 0.0) < 0) return R_UNDECIDED;
     int64_t top = 1, budget = STRAIGHT_BUDGET;
     h->stack[0] = 0.0, h->stack[1] = 1.0;
@@ -420,6 +415,19 @@ static int64_t straight(Car *h, PyObject *grids, double x0, double y0, double x1
         top += 2;
     }
     return 1;
+}
+
+/* A straight segment at the angle th from (x0, y0) to (x1, y1): 1, 0 or an R_ code. */
+static int64_t straight(Car *h, PyObject *grids, double x0, double y0, double x1, double y1, double th)
+{
+    int64_t k = slab_index(h->slab_lo, h->slab_hi, h->K, th);
+    if (k < 0) return R_UNDECIDED;
+    PyObject *g = PyList_GET_ITEM(grids, k);
+    if (g == Py_None) return R_SLAB(k);
+    int r = fast_grid_segment(g, x0, y0, x1, y1);
+    if (r == -2) return R_ERROR;
+    if (r == 1 || r == 3) return 1;
+    return fixed_sweep(h, grids, x0, y0, x1, y1, th);
 }
 
 /* One arc (_arc_free): 1, 0 or an R_ code; *budget is the curve's budget of hulls. */
@@ -497,8 +505,12 @@ static int64_t link_segment(Link *chain, int *nl, double *p, char kind, double l
    (SE2CSpace.motion_free): 1 when p is q1, or when the motion, its angles between p's and
    q1's, stays within one slab's hull interval and the slab C-space's segment test (the grid
    walk) certifies its reference segment free -- free at every angle of the interval, so at
-   every pose of the motion; 0 otherwise (the caller joins them), R_ERROR. The caller's
-   counts of that motion are made here. */
+   every pose of the motion -- or, the join at one angle (p's heading is q1's, the usual join:
+   the curve's end differs from q1 by rounding of x and y only), when the robot at that angle
+   swept along it is separated from every obstacle piece with the margin (fixed_sweep, as a
+   straight segment of the curve: where the slab's hull is too coarse, near an obstacle, the
+   Python path's exact translational test would say free too); 0 otherwise (the caller joins
+   them, its "not free" included), R_ERROR. The caller's counts of that motion are made here. */
 static int64_t join_end(Car *h, PyObject *grids, const double *p, const double *q1)
 {
     if (p[0] == q1[0] && p[1] == q1[1] && p[2] == q1[2]) return 1;
@@ -513,10 +525,17 @@ static int64_t join_end(Car *h, PyObject *grids, const double *p, const double *
     if (g == Py_None) return 0;
     int r = fast_grid_segment(g, p[0], p[1], q1[0], q1[1]);
     if (r == -2) return R_ERROR;
-    if (!(r == 1 || r == 3)) return 0;
+    const char *how = "slab_certified";
+    if (!(r == 1 || r == 3)) {
+        if (a0 != a1) return 0; /* a turn past the slab's test: the caller's */
+        int64_t f = fixed_sweep(h, grids, p[0], p[1], q1[0], q1[1], a0);
+        if (f == R_ERROR) return R_ERROR;
+        if (f != 1) return 0; /* a collision, the floor, undecided: the caller decides */
+        how = "refined";
+    }
     PyObject *d = h->checks;
     if (fast_add_count(d, "motions", 1) < 0 || fast_add_count(d, "submotions", 1) < 0
-        || fast_add_count(d, "slab_certified", 1) < 0)
+        || fast_add_count(d, how, 1) < 0)
         return R_ERROR;
     return 1;
 }

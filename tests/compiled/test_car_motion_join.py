@@ -200,3 +200,69 @@ def test_a_new_planning_run_starts_with_nothing_remembered():
     assert car.motion_free(a, b) and car._free
     car.forget()  # auto's direct curve, before any validator: a new run too
     assert not car._free
+
+
+def robot_clearance(sc, q) -> float:
+    """The distance from the robot at pose q to the obstacles (shapely: an independent oracle)."""
+    from shapely import affinity
+
+    placed = [affinity.translate(affinity.rotate(p, q[2], origin=(0, 0), use_radians=True), q[0], q[1])
+              for p in oracle.robot_pieces(sc)]
+    return min(p.distance(o.to_shapely()) for p in placed for o in sc.obstacles)
+
+
+@compiled
+def test_a_join_by_rounding_at_one_heading_near_an_obstacle_is_decided_in_c():
+    """The usual join (the curve's end differs from the goal pose by rounding of x and y, the same
+    heading) where the slab's hull is too coarse (near an obstacle: its segment test fails): the
+    compiled call certifies it (2) wherever the robot there has clearance, as the pure path's
+    exact translational test does (was: 1, the join left to that test, ~0.4 ms a motion: 3 to 31
+    times in 6 of the loading dock's first 10 seeds of `plan`, shortening included). Motions into
+    the bay and past the truck."""
+    sc, cs, pure = scene("loading_dock.toml")
+    r = sc.turning_radius
+    g = tuple(map(float, sc.all_queries()[0].goal))
+    motion = motions.car_motion(motions.car_curve(cs, MAX_HULLS, FLOOR_REL, ARC_CHUNK))
+    grids = [cs.slab(k)._fast for k in range(cs.slabs)]
+    rng = random.Random(5)
+    coarse = 0
+    for i in range(400):
+        if i % 2:  # up the bay towards the goal, the sides 0.15 away
+            b = (g[0] + rng.uniform(-0.14, 0.14), g[1] + rng.uniform(-1.5, 0.0), g[2] + rng.uniform(-0.1, 0.1))
+        else:  # along the truck's south side, a few cm from it
+            b = (rng.uniform(1.0, 3.0), rng.uniform(2.05, 2.14), rng.uniform(-0.05, 0.05))
+        a = (b[0] - rng.uniform(0.3, 1.5) * math.cos(b[2]), b[1] - rng.uniform(0.3, 1.5) * math.sin(b[2]),
+             wrap_angle(b[2] + rng.uniform(-0.2, 0.2)))
+        if not (cs.is_free(a) and cs.is_free(b)):
+            continue
+        code, *p = motion(grids, *a, *b, r, False, 1e6 * cs.extent, 128 * math.pi * r, True)
+        if code not in (1, 2) or tuple(p) == b or p[2] != b[2]:
+            continue  # not free, or no join, or a join that turns (not this test's)
+        if cs.slab(cs._slab_index(b[2])).segment_free(tuple(p[:2]), b[:2]):
+            continue  # the slab's test certifies it: not the coarse case
+        coarse += 1
+        want = pure.motion_free(tuple(p), b)  # the exact join
+        if code == 2:
+            assert want, (a, b)
+        else:  # left to the exact path: only where the robot (nearly) touches an obstacle
+            assert not (want and robot_clearance(sc, b) > 1e-9), ("a join with clearance left to the exact path", a, b)
+    assert coarse >= 20, coarse
+
+
+@compiled
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.floats(1.2, 3.0), st.sampled_from([0.0, 1e-15, 1e-13, 1e-12, 1e-11, 1e-9, 1e-6, -1e-13, -1e-9]),
+       st.floats(0.2, 1.2), st.floats(-0.06, 0.0), st.floats(-1e-3, 1e-3))
+def test_hypothesis_joins_at_poses_touching_an_obstacle(x, gap, back, dy, dth):
+    """Goal poses at or within a hair of the loading dock's truck (its south side y = 2.5, the van
+    0.35 from its axle to its side: heading 0 touches at y = 2.15), reached from behind: where the
+    compiled call certifies chain and join (2) the pure path says free, and the motion test's
+    answer is always the pure path's (never a false "free" at a touching pose)."""
+    sc, cs, pure = scene("loading_dock.toml")
+    r = sc.turning_radius
+    b = (x, 2.5 - 0.35 - gap, 0.0 if dth < 0 else dth)
+    a = (x - back, b[1] + dy, 0.0)
+    want = pure.curve_free(a, reeds_shepp_segments(a, b, r), r, q1=b) if pure.is_free(a) and pure.is_free(b) else False
+    if joined(cs, a, b, "reeds-shepp", r) == 2:
+        assert want, (a, b)
+    assert cs.car_motion_test("reeds-shepp", r)(a, b) == want, (a, b)
