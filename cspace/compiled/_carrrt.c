@@ -131,35 +131,31 @@ static int grow(Tree *T, int start, const double *q, double r, double range, PyO
     return reach ? REACHED : ADVANCED;
 }
 
+/* Appends to `out` the poses of T from node i up to its root, as (x, y, th) tuples: 0, or -1
+   with an error set. */
+static int append_branch(PyObject *out, const Tree *T, int64_t i)
+{
+    for (; i >= 0; i = T->up[i]) {
+        const double *q = T->q + 3 * i;
+        PyObject *t = Py_BuildValue("(ddd)", q[0], q[1], q[2]);
+        if (!t || PyList_Append(out, t) < 0) {
+            Py_XDECREF(t);
+            return -1;
+        }
+        Py_DECREF(t);
+    }
+    return 0;
+}
+
 /* The path: the start tree's root to node a, then the goal tree's node b (the same pose) to
    its root, as a list of (x, y, th) tuples. */
 static PyObject *join(const Tree *S, int64_t a, const Tree *G, int64_t b)
 {
     PyObject *out = PyList_New(0);
     if (!out) return NULL;
-    for (int64_t i = a; i >= 0; i = S->up[i]) {
-        const double *q = S->q + 3 * i;
-        PyObject *t = Py_BuildValue("(ddd)", q[0], q[1], q[2]);
-        if (!t || PyList_Append(out, t) < 0) {
-            Py_XDECREF(t);
-            Py_DECREF(out);
-            return NULL;
-        }
-        Py_DECREF(t);
-    }
-    if (PyList_Reverse(out) < 0) {
+    if (append_branch(out, S, a) < 0 || PyList_Reverse(out) < 0 || append_branch(out, G, G->up[b]) < 0) {
         Py_DECREF(out);
         return NULL;
-    }
-    for (int64_t i = G->up[b]; i >= 0; i = G->up[i]) {
-        const double *q = G->q + 3 * i;
-        PyObject *t = Py_BuildValue("(ddd)", q[0], q[1], q[2]);
-        if (!t || PyList_Append(out, t) < 0) {
-            Py_XDECREF(t);
-            Py_DECREF(out);
-            return NULL;
-        }
-        Py_DECREF(t);
     }
     return out;
 }
