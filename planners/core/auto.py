@@ -4,8 +4,8 @@ It runs the project's planners as stages of one budget, each only when the ones 
 not answered, in the order of their cost on the scene (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- a car first tries its one shortest curve from start to goal (the
-   path when it is free: :func:`_direct`); then RRTConnect (a small Reeds–Shepp scene: the compiled
-   one, :func:`.car_sampling.connect_slice`) for at most :data:`SLICE_ITERATIONS` iterations (and
+   path when it is free: :func:`_direct`); then RRTConnect (a small Reeds–Shepp scene: the car's own,
+   compiled or in Python, :func:`.car_sampling.connect_slice`) for at most :data:`SLICE_ITERATIONS` iterations (and
    :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
    scene, or a query on a large map, is answered here in milliseconds, before any region of the
    slab graph is built (every rotating robot and car: a Dubins car too);
