@@ -27,7 +27,7 @@ import numpy as np
 
 from ..compiled import motions
 from ..kernel.polygons.rotation import wrap_angle
-from .curves import reeds_shepp_segments
+from .curves import curve_length, reeds_shepp_segments
 
 
 class _Late(Exception):
@@ -96,13 +96,6 @@ class _Samples:
         return float((s ^ (s >> 31)) >> 11) * (1.0 / 9007199254740992.0)
 
 
-def _length(segments) -> float:
-    total = 0.0
-    for _, v in segments:
-        total += abs(v)
-    return total
-
-
 def _nearest(nodes: list, q, r: float) -> tuple[int, float]:
     # A node's straight-line distance to q, and r times the turn between their headings, are each
     # at most the length of any curve joining them: a node whose bound is not below the best
@@ -113,7 +106,7 @@ def _nearest(nodes: list, q, r: float) -> tuple[int, float]:
         bound = max(math.sqrt(dx * dx + dy * dy), r * abs(wrap_angle(q[2] - p[2])))
         if bound >= best:
             continue
-        d = _length(reeds_shepp_segments(p, q, r))
+        d = curve_length(reeds_shepp_segments(p, q, r))
         if d < best:
             best, at = d, i
     return at, best
