@@ -203,14 +203,14 @@ def prepare(sc, cspace) -> float:
     labelled (:func:`planners.core.exact_se2.prepare`); a Reeds–Shepp car also FREE at the first 8
     slabs with the first room of :data:`ROOMS`, and their links. A query answers the same, sooner."""
     from cspace.se2.exact import initial_partition
-    from .exact_se2 import prepare as prepare_se2, search_regions
+    from .exact_se2 import prepare as prepare_se2, slab_regions_of
 
     t = _now()
     if not (sc.rotates and cspace.body_pieces):
         return 0.0
     prepare_se2(cspace)
     if sc.space == "reeds-shepp":
-        regions, part = search_regions(cspace, ROOMS[0] * _reach(cspace)), initial_partition()
+        regions, part = slab_regions_of(cspace, ROOMS[0] * _reach(cspace)), initial_partition()
         for (a, b), (c, d) in zip(part, part[1:] + part[:1]):
             regions.free_links(regions.free(a, b), regions.free(c, d))
     return _now() - t

@@ -63,11 +63,7 @@ def search(cspace, query, time_limit: float | None, *, possible_only: bool = Fal
     is, not at the links' kept points (:func:`cspace.se2.exact_path.near_links`)."""
     from cspace.se2.exact import exact_se2_search
 
-    margin = list(cspace.margin or [])
-    if room > 0:
-        from cspace.kernel.minkowski.margin import margin_shapes
-
-        margin += margin_shapes(float(room), disk_tolerance=ROOM_DISK_TOLERANCE)
+    margin = _room_margin(cspace, float(room))
     regions = _regions_of(cspace, float(room))
     return exact_se2_search(cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, tuple(query.start),
                             tuple(query.goal), time_limit=time_limit, margin=margin or None,
@@ -125,15 +121,22 @@ def built_regions(cspace) -> dict:
     return {"regions": len(made), "region_s": sum(r.seconds for r in made)}
 
 
-def slab_regions_of(cspace):
+def slab_regions_of(cspace, room: float = 0.0):
     """The C-space's POSSIBLE and FREE regions (a :class:`cspace.se2.slab_graph.SlabRegions`), the
-    ones the slab graph's search reads and keeps (a Dubins car's reach proof reads them too)."""
-    return _regions_of(cspace)
-
-
-def search_regions(cspace, room: float = 0.0):
-    """The regions :func:`search` reads for this ``room`` (made on first use and kept)."""
+    ones the slab graph's search reads for this ``room`` and keeps (a Dubins car's reach proof
+    reads the body's, ``room`` 0)."""
     return _regions_of(cspace, float(room))
+
+
+def _room_margin(cspace, room: float) -> list:
+    """The C-space's margin shapes, and the polygon holding the disk of radius ``room`` (an octagon:
+    :data:`ROOM_DISK_TOLERANCE`) where ``room`` > 0: what the robot is inflated by."""
+    margin = list(cspace.margin or [])
+    if room > 0:
+        from cspace.kernel.minkowski.margin import margin_shapes
+
+        margin += margin_shapes(room, disk_tolerance=ROOM_DISK_TOLERANCE)
+    return margin
 
 
 def _regions_of(cspace, room: float = 0.0):
@@ -143,11 +146,7 @@ def _regions_of(cspace, room: float = 0.0):
 
     kept = _REGIONS.setdefault(cspace, {})
     if room not in kept:
-        margin = list(cspace.margin or [])
-        if room > 0:
-            from cspace.kernel.minkowski.margin import margin_shapes
-
-            margin += margin_shapes(room, disk_tolerance=ROOM_DISK_TOLERANCE)
+        margin = _room_margin(cspace, room)
         kept[room] = slab_regions(
             cspace.obstacle_pieces, cspace.body_pieces, cspace.bounds, margin or None,
             inner_obstacles=getattr(cspace, "inner_obstacle_pieces", None),

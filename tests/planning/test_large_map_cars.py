@@ -68,12 +68,12 @@ def test_the_kept_point_stays_where_no_overlap_is_near():
 
 
 def test_a_search_with_room_reads_the_body_s_possible_regions():
-    from planners.core.exact_se2 import search_regions
+    from planners.core.exact_se2 import slab_regions_of
     from planners.core.plan import build_cspace
 
     sc = load_scenario(os.path.join(SCENARIOS, "car", "parallel_tight.toml"))
     cs = build_cspace(sc)
-    body, roomy = search_regions(cs), search_regions(cs, 0.01)
+    body, roomy = slab_regions_of(cs), slab_regions_of(cs, 0.01)
     assert roomy.possible(0.0, 0.5) is body.possible(0.0, 0.5)
     assert roomy.free(0.0, 0.5) is not body.free(0.0, 0.5)
     other = SlabRegions(body.obstacles, [p * 0.5 for p in body.robot], body.bounds)
