@@ -90,3 +90,17 @@ def initial_partition(n: int = 8) -> list[tuple[float, float]]:
     part = [slab_range(k, n) for k in range(n)]
     part[-1] = (part[-1][0], math.nextafter(math.pi, math.inf))
     return part
+
+
+def bisected(part: list, split=None) -> list[tuple[float, float]]:
+    """The slabs ``part`` with those of ``split`` (indices; every one where None) cut in two at
+    their middle: the search's refinement, and what a caller preparing its regions reads.
+
+    >>> bisected([(0.0, 1.0), (1.0, 3.0)], {1})
+    [(0.0, 1.0), (1.0, 2.0), (2.0, 3.0)]
+    """
+    out = []
+    for k, (a, b) in enumerate(part):
+        cut = (split is None or k in split) and a < b
+        out += [(a, 0.5 * (a + b)), (0.5 * (a + b), b)] if cut else [(a, b)]
+    return out

@@ -44,7 +44,7 @@ import numpy as np
 from ..kernel.polygons.rotation import TWO_PI, wrap_angle
 from .slab_graph import SlabRegions, point_free
 from .exact_path import AssemblyError, assemble, holding
-from .critical import critical_angles, initial_partition, with_zero_slabs  # noqa: F401 (initial_partition: the API)
+from .critical import bisected, critical_angles, initial_partition, with_zero_slabs  # noqa: F401 (initial_partition: the API)
 from .exact_report import PROOF_FORMAT, disk_excess, margin_reach, proof_json, resolution  # noqa: F401
 from ..kernel.slabs.slab import ANGLE_SLACK
 from .walks import G_NODE, S_NODE, cheapest_walk, labels, reach, shortest_walk
@@ -275,10 +275,7 @@ class _Search:
         if not split or not self.refine:
             return False
         self.refinements += 1
-        new = []
-        for k, (a, b) in enumerate(self.part):
-            new += [(a, 0.5 * (a + b)), (0.5 * (a + b), b)] if k in split and a < b else [(a, b)]
-        self.part = new
+        self.part = bisected(self.part, split)
         return True
 
     def _regions(self, kind: str) -> list:

@@ -4,7 +4,7 @@ It runs the project's planners as stages of one budget, each only when the ones 
 not answered, in the order of their cost on the scene (a rotating robot or a Reeds–Shepp car):
 
 0. **sampling**, a slice -- a car first tries its one shortest curve from start to goal (the
-   path when it is free: :func:`_direct`); then RRTConnect (a small Reeds–Shepp scene: the car's own,
+   path when it is free: :func:`.car_sampling.direct_curve`); then RRTConnect (a small Reeds–Shepp scene: the car's own,
    compiled or in Python, :func:`.car_sampling.connect_slice`) for at most :data:`SLICE_ITERATIONS` iterations (and
    :data:`SLICE_SHARE` of the limit, not counting the slabs it builds: :func:`sampling_slice`): an open
    scene, or a query on a large map, is answered here in milliseconds, before any region of the
@@ -16,9 +16,11 @@ not answered, in the order of their cost on the scene (a rotating robot or a Ree
 2. **proof** -- the proof before sampling (a rotating robot: those slabs refined once,
    :func:`planners.core.exact_se2.quick_proof`; a translating one, where it comes first: start
    and goal in different free components, :func:`planners.core.exact.separated_proof`);
-3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`). A Dubins car,
-   which has no complete method here, goes from the slice to restarts of sampling with the
-   reach proof and this proof between them (:func:`planners.core.auto_dubins.dubins_stages`);
+3. **sampling** -- RRTConnect with a share of what is left (:data:`SAMPLE_SHARE`); not for a Reeds–Shepp
+   car on a large map (no car RRT of its own), where the slice failed: on a warehouse map that turn
+   answered few queries and cost the others 50 ms before their refinement. A Dubins car, which has no
+   complete method here, goes from the slice to restarts of sampling with the reach proof and this
+   proof between them (:func:`planners.core.auto_dubins.dubins_stages`);
 4. **refinement** -- the exact planner with the rest: the slab graph refined where FREE and
    POSSIBLE disagree (SE(2); a Reeds–Shepp car's path converted as in 1), then sampling again
    with whatever is left; for a translating robot the exact shortest path.
@@ -56,7 +58,7 @@ import weakref
 
 import numpy as np
 
-from .car_sampling import connect_slice
+from .car_sampling import connect_slice, direct_curve
 from .result import PlanResult
 
 SAMPLER = "RRTConnect"
@@ -69,7 +71,7 @@ TRANSLATION_SAMPLE_SHARE = 0.5
 # A Reeds–Shepp car's SE(2) path is asked to keep this much room (x the robot's reach from its
 # reference point), the largest its start and goal allow first.
 ROOMS = (0.05, 0.01, 0.002)
-BOUNDED_PAST = 32  # poses: a car's path longer than this gets the bounded shortening only  # a translating robot: sampling, then the exact shortest path
+BOUNDED_PAST = 32  # poses: a car's path longer than this gets the bounded shortening only
 # A small SE(2) scene (obstacle pieces x robot pieces, the convex pairs each slab region sums, at
 # most this): its first 8 slab regions cost a few milliseconds, about a failed slice, and run first.
 SMALL_PAIRS = 16
@@ -136,13 +138,14 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     if turns and small_scene(sc, cspace):
         return _small_se2(sc, cspace, adapter, query, pair, clock, seed, source, iterations, simplify)
     if turns and kind in ("dubins", "reeds-shepp"):  # a car: its one curve from start to goal, if free
-        r = clock.run("sampling", lambda: _direct(sc, adapter, query, pair, seed))
+        r = clock.run("sampling", lambda: direct_curve(sc, adapter, query, pair, seed))
         if r is not None:
             return _answer(r, "sampling", clock, seed)
-    r = clock.run("sampling", lambda: connect_slice(sc, adapter, query, pair, seed, clock, SLICE_SHARE * time_limit,
-                                                     iterations, simplify)) if turns and kind == "reeds-shepp" else None
-    if r is not None and r.solved:  # a small Reeds–Shepp scene: its own slice (None: OMPL's below)
-        return _answer(r, "sampling", clock, seed)
+    own = clock.run("sampling", lambda: connect_slice(sc, adapter, query, pair, seed, clock, SLICE_SHARE * time_limit,
+                                                       iterations, simplify)) if turns and kind == "reeds-shepp" else None
+    if own is not None and own.solved:  # a small Reeds–Shepp scene: its own slice (None: OMPL's below)
+        return _answer(own, "sampling", clock, seed)
+    r, no_turn = own, turns and kind == "reeds-shepp" and own is None  # (3.: a large map's car has no turn)
     if turns and r is None:  # a slice of sampling: an open scene is answered here, a large map too
         r = sampling_slice(sample, cspace, clock, time_limit)
         if r.solved:
@@ -169,7 +172,7 @@ def auto_plan(sc, cspace, adapter, query, pair, time_limit: float, seed: int, *,
     share = 1.0 if not turns and sc.rotates else \
         TRANSLATION_SAMPLE_SHARE if kind == "translation" else SAMPLE_SHARE
     sampled = None
-    if clock.left() > 0:
+    if clock.left() > 0 and not no_turn:
         # Where a refinement follows, sampling gets a short turn: long enough for an open scene
         # (as long as the first slabs and the proof took), short of the refinement's time.
         budget = clock.left() if share == 1.0 else min(share * clock.left(), max(SAMPLE_MIN, clock.elapsed()))
@@ -200,9 +203,10 @@ def _timed_out(sc, adapter, query, time_limit: float, seed: int) -> PlanResult:
 def prepare(sc, cspace) -> float:
     """For a C-space serving many queries (a large map), build what they read first on the map
     alone, kept with it; returns its seconds. A rotating robot or a car: the proof's POSSIBLE regions,
-    labelled (:func:`planners.core.exact_se2.prepare`); a Reeds–Shepp car also FREE at the first 8
-    slabs with the first room of :data:`ROOMS`, and their links. A query answers the same, sooner."""
-    from cspace.se2.exact import initial_partition
+    labelled (:func:`planners.core.exact_se2.prepare`); a Reeds–Shepp car also FREE with the first room
+    of :data:`ROOMS` at the first 8 slabs, and their links, and at their halves (the refinement's first
+    bisection: what a query through a door reads). A query answers the same, sooner."""
+    from cspace.se2.critical import bisected, initial_partition
     from .exact_se2 import prepare as prepare_se2, slab_regions_of
 
     t = _now()
@@ -213,6 +217,8 @@ def prepare(sc, cspace) -> float:
         regions, part = slab_regions_of(cspace, ROOMS[0] * _reach(cspace)), initial_partition()
         for (a, b), (c, d) in zip(part, part[1:] + part[:1]):
             regions.free_links(regions.free(a, b), regions.free(c, d))
+        for a, b in bisected(part):  # (their links, 0.2 s more on a warehouse map, on first use)
+            regions.free(a, b)
     return _now() - t
 
 
@@ -280,26 +286,6 @@ def _small_se2(sc, cspace, adapter, query, pair, clock: _Clock, seed: int, sourc
         if r.solved:
             return _answer(r, "sampling", clock, seed)
     return _answer(failed, None, clock, seed)
-
-
-def _direct(sc, adapter, query, pair, seed: int) -> PlanResult | None:
-    """Stage 0's first try for a car: the shortest curve from start to goal, the whole path when
-    the car's motion validator certifies it free (one curve check; None otherwise)."""
-    t = _now()
-    adapter.forget()  # a new run: nothing remembered from the last query's
-    if not adapter.motion_free(*pair):
-        return None
-    found_cpu = time.process_time()
-    path = np.array(pair, dtype=np.float64)
-    ok, _ = adapter.verify(path, query.start, query.goal)
-    if not ok:  # certified a moment ago: a fault, left to the stages after
-        return None
-    length = adapter.length(path)
-    return PlanResult(scenario=sc.name, solved=True, exact=True, path=path, length=length, planner="auto",
-                      seed=seed, timings={"solve": _now() - t}, checks={"states": 0, "motions": 1},
-                      stages=["direct curve"], start=tuple(query.start), goal=tuple(query.goal),
-                      message="certified solution: the direct curve from start to goal is free",
-                      length_unsimplified=length, first_path_cpu=found_cpu)
 
 
 def turn_seed(seed: int, turn: int) -> int:

@@ -1,4 +1,4 @@
-"""``auto``'s first sampling slice for a Reeds–Shepp car: its own RRT-Connect (compiled, or the same in Python).
+"""``auto``'s first sampling for a car: its direct curve, and a Reeds–Shepp car's own RRT-Connect (compiled, or the same in Python).
 
 OMPL's RRTConnect on a car spends most of a small scene's time in its own nearest-neighbour
 search (the Reeds–Shepp length to the tree's nodes, at every step of either tree); the
@@ -102,3 +102,23 @@ def connect_slice(sc, adapter, query, pair, seed: int, clock, share_s: float, it
                       message=f"certified solution (the car's own RRT-Connect: {stats['iterations']} samples, "
                               f"{len(path) - 1} curves{note})",
                       length_unsimplified=raw_len, first_path_cpu=found_cpu, first_solution=solve_s, **base)
+
+
+def direct_curve(sc, adapter, query, pair, seed: int) -> PlanResult | None:
+    """``auto``'s first try for a car: the shortest curve from start to goal, the whole path when
+    the car's motion validator certifies it free (one curve check; None otherwise)."""
+    t = time.perf_counter()
+    adapter.forget()  # a new run: nothing remembered from the last query's
+    if not adapter.motion_free(*pair):
+        return None
+    found_cpu = time.process_time()
+    path = np.array(pair, dtype=np.float64)
+    ok, _ = adapter.verify(path, query.start, query.goal)
+    if not ok:  # certified a moment ago: a fault, left to the stages after
+        return None
+    length = adapter.length(path)
+    return PlanResult(scenario=sc.name, solved=True, exact=True, path=path, length=length, planner="auto",
+                      seed=seed, timings={"solve": time.perf_counter() - t}, checks={"states": 0, "motions": 1},
+                      stages=["direct curve"], start=tuple(query.start), goal=tuple(query.goal),
+                      message="certified solution: the direct curve from start to goal is free",
+                      length_unsimplified=length, first_path_cpu=found_cpu)

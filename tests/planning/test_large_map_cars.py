@@ -107,3 +107,67 @@ def test_preparing_a_c_space_changes_no_answer():
     b = planners.plan(dataclasses.replace(sc), seed=3, time=20.0, cspace=ready)
     assert a.solved and b.solved and a.answered_by == b.answered_by == "slab graph"
     assert np.array_equal(a.path, b.path)
+
+
+def test_preparing_builds_the_halves_a_first_refinement_reads(monkeypatch):
+    """A Reeds–Shepp car's preparation builds FREE (with the first room) at the first 8 slabs and
+    at their halves: a door that no 45° slab passes makes the search bisect every slab once, and
+    each half it then reads was built by the preparation (the same floats: one bisection,
+    :func:`cspace.se2.critical.bisected`), none anew but the start's and goal's own angle."""
+    from cspace.se2 import exact
+    from planners.core.auto import ROOMS, prepare
+    from planners.core.exact_se2 import search, slab_regions_of
+    from planners.core.plan import build_cspace
+
+    wall = [[[-0.1, 0.3], [0.1, 0.3], [0.1, 3], [-0.1, 3]], [[-0.1, -3], [0.1, -3], [0.1, -0.3], [-0.1, -0.3]]]
+    sc = scenario_from_dict({"space": "reeds-shepp", "turning_radius": 0.5,
+                             "bounds": {"xmin": -4, "xmax": 4, "ymin": -3, "ymax": 3},
+                             "robot": {"polygon": [[-0.5, -0.25], [0.5, -0.25], [0.5, 0.25], [-0.5, 0.25]]},
+                             "start": {"x": -2.5, "y": 0.0, "theta": 0.3}, "goal": {"x": 2.5, "y": 0.0, "theta": 0.3},
+                             "obstacles": [{"polygon": p} for p in wall]}, "door.toml")
+    cs = build_cspace(sc)
+    prepare(sc, cs)
+    room = ROOMS[0] * max(float(np.hypot(*p.T).max()) for p in cs.body_pieces)
+    regions = slab_regions_of(cs, room)
+    prepared, built = set(regions._free), regions.counts["free_built"]
+    split, halves = exact._Search._split, []
+
+    def split_once(self, which):  # every slab halved once, then no more
+        if self.refinements:
+            return False
+        done = split(self, set(range(len(self.part))))
+        halves.extend(self.part)
+        return done
+
+    monkeypatch.setattr(exact._Search, "_split", split_once)
+    search(cs, sc.all_queries()[0], 30.0, refine=True, room=room, near=True)
+    assert len(halves) == 16 and set(halves) <= prepared
+    assert regions.counts["free_built"] - built == 1  # FREE at θ = 0.3, the start's and goal's
+
+
+def test_a_reeds_shepp_car_on_a_large_map_goes_from_its_slice_to_the_refinement(monkeypatch):
+    """Where the car's own RRT-Connect does not run (a large map) and OMPL's slice failed, no second
+    turn of sampling comes before the refinement (on the warehouse map it cost the queries through
+    a door 50 ms and answered few): the refinement answers, its path passes the sweep."""
+    import planners.core.auto as auto
+    import planners.core.routine as routine
+    from cspace.car.curves import reeds_shepp_segments
+
+    wall = [[[-0.1, 0.3], [0.1, 0.3], [0.1, 3], [-0.1, 3]], [[-0.1, -3], [0.1, -3], [0.1, -0.3], [-0.1, -0.3]]]
+    sc = scenario_from_dict({"space": "reeds-shepp", "turning_radius": 0.5,
+                             "bounds": {"xmin": -4, "xmax": 4, "ymin": -3, "ymax": 3},
+                             "robot": {"polygon": [[-0.5, -0.25], [0.5, -0.25], [0.5, 0.25], [-0.5, 0.25]]},
+                             "start": {"x": -2.5, "y": 0.0, "theta": 0.3}, "goal": {"x": 2.5, "y": 0.0, "theta": 0.3},
+                             "obstacles": [{"polygon": p} for p in wall]}, "door.toml")
+    seeds = []
+    real = routine.run_planner
+    monkeypatch.setattr(routine, "run_planner", lambda *a, **k: seeds.append(a[4]) or real(*a, **k))
+    monkeypatch.setattr(auto, "direct_curve", lambda *a, **k: None)  # (here the one curve is free)
+    monkeypatch.setattr(auto, "connect_slice", lambda *a, **k: None)  # as on a large map
+    monkeypatch.setattr(auto, "SLICE_ITERATIONS", 2)  # a slice that cannot answer
+    res = planners.plan(sc, seed=3, time=60.0)
+    assert res.solved and res.answered_by == "refinement", res.message
+    assert seeds == [3], seeds  # the slice alone: no turn (its seed would be auto.turn_seed(3, 1))
+    j = oracle.car_sweep_check(sc, res.path, lambda a, b: reeds_shepp_segments(a, b, sc.turning_radius),
+                               sc.turning_radius)
+    assert not j["collides"] and not j["out_of_bounds"]
