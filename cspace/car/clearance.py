@@ -16,7 +16,8 @@ piece translates at one heading, so over [s0, s1] it sweeps exactly the hull of 
 placements, whose GJK distance is the interval's least (slack 0). On an arc every robot point
 turns about the turning centre by the same angle, so the robot stays in the slab hulls of its
 pieces turned about that centre (:func:`arc_bound`); their distance is a second lower bound,
-taken where its slack (quadratic in the turn) is below the Lipschitz one. The path's bound is the least over intervals covering every
+taken where its slack (quadratic in the turn) is below the Lipschitz one, and asked only of an
+interval that comes to the top of the best-first heap below (most never do). The path's bound is the least over intervals covering every
 segment of every motion (and over the joins from a curve's end to its target pose, which a
 Dubins curve may miss by a few 1e-6 radii: the distance at the curve's end less the most a
 robot point moves over the join). Intervals are split best-first (the one of smallest bound first,
@@ -132,19 +133,24 @@ def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces:
             best = min(best, local[j].nearest(np.vstack([q + (x0, y0), q + (x1, y1)]), best)[0])
         return min(best, cap[0])
 
-    def push(j: int, s0: float, s1: float, e0: tuple, e1: tuple) -> None:
+    def push(j: int, s0: float, s1: float, e0: tuple, e1: tuple, turned: bool = False) -> None:
+        """An interval into the heap with its bound. An arc's enters with the Lipschitz bound; its
+        turned hulls' (:func:`arc_bound`, dearer) is asked when it comes to the top (``turned``),
+        so an interval that never does (most, where the least is elsewhere) never pays for it."""
         nonlocal count
         count += 1
         if parts[j][2] == "S":  # the swept hull's distance: the interval's exact least, no slack
-            heapq.heappush(heap, (max(0.0, straight(j, s0, s1)), count, j, s0, s1, 0.0, e0, e1))
+            heapq.heappush(heap, (max(0.0, straight(j, s0, s1)), count, j, s0, s1, 0.0, e0, e1, True))
             return
         lip = 1.0 + rho / r
         lb = max(0.0, min(e0[0], e1[0], 0.5 * (e0[0] + e1[0] - lip * (s1 - s0))))
         slack = 0.5 * lip * (s1 - s0)
-        hull, hull_slack = arc_bound(pose(j, s0), parts[j][2], math.copysign(s1 - s0, parts[j][3]), r, rob, local[j])
-        if hull_slack < slack:  # the turned hull's bound, where it is the tighter claim
-            lb, slack = max(0.0, min(hull, cap[0])), hull_slack
-        heapq.heappush(heap, (lb, count, j, s0, s1, slack, e0, e1))
+        if turned:
+            hull, hull_slack = arc_bound(pose(j, s0), parts[j][2], math.copysign(s1 - s0, parts[j][3]), r, rob,
+                                         local[j])
+            if hull_slack < slack:  # the turned hull's bound, where it is the tighter claim
+                lb, slack = max(0.0, min(hull, cap[0])), hull_slack
+        heapq.heappush(heap, (lb, count, j, s0, s1, slack, e0, e1, turned))
 
     for j, (_, k0, kind, length) in enumerate(parts):
         lip = 1.0 if kind == "S" else 1.0 + rho / r
@@ -158,13 +164,17 @@ def car_path_clearance(path, segments_of: Callable, radius: float, robot_pieces:
             push(j, cuts[m], cuts[m + 1], ends[m], ends[m + 1])
         if joins.get(j):  # over the join, within that of the curve's end (measured: the last cut)
             heapq.heappush(heap, (max(0.0, ends[-1][0] - joins[j]), -j - 1, j, cuts[-1], cuts[-1], 0.0,
-                                  ends[-1], ends[-1]))
+                                  ends[-1], ends[-1], True))
     samples = count + len(parts)
     while True:
-        lb, _, j, s0, s1, slack, e0, e1 = heap[0]
+        lb, _, j, s0, s1, slack, e0, e1, turned = heap[0]
         if slack <= tol or lb >= upper - tol or samples >= max_samples or not math.isfinite(lb):
             break
         heapq.heappop(heap)
+        if not turned:  # an arc's interval at the top: its turned hulls' bound before any split
+            push(j, s0, s1, e0, e1, turned=True)
+            samples += 1
+            continue
         sm = 0.5 * (s0 + s1)
         em = at(pose(j, sm), j)
         samples += 1
@@ -200,7 +210,7 @@ def arc_bound(pose, kind: str, length: float, r: float, rob: list, obs: Nearest)
     >>> bool(0.0 < d <= 3.0 - 0.25 - 0.5 * 0.1), slack < 0.08  # R = 1.35, Δ = 0.1: mostly 2 R sin(Δ/4)
     (True, True)
     """
-    from ..kernel.slabs.slab import slab_hull, slab_pad
+    from ..kernel.slabs.slab import slab_pad, slab_points
 
     x, y, th = pose
     side = 1.0 if kind == "L" else -1.0
@@ -214,8 +224,9 @@ def arc_bound(pose, kind: str, length: float, r: float, rob: list, obs: Nearest)
     for p in rob:
         q = rotate(p, th) + (x - cx, y - cy)
         far = max(far, float(np.hypot(q[:, 0], q[:, 1]).max()))
-        hull = slab_hull(q, lo, hi, scale=scale) + (cx, cy)
-        best = min(best, obs.nearest(hull, best)[0])
+        pts, d = slab_points(q, lo, hi, scale=scale)  # the slab hull: conv(pts) grown by [-d, d]^2
+        grow = d * math.sqrt(2.0)  # (GJK reads conv(pts): no hull, no sum, the pad taken off its distance)
+        best = min(best, obs.nearest(pts + (cx, cy), best + grow)[0] - grow)
     pad = slab_pad(scale + far)
     return best, 2.0 * far * (1.0 / math.cos(0.5 * (hi - lo)) - 1.0) + 2.0 * far * math.sin(0.25 * (hi - lo)) + 8.0 * pad
 

@@ -74,3 +74,50 @@ def test_an_obstacle_in_the_notch_of_the_sweep_is_within_the_slack():
     assert d <= true + 1e-9
     assert true - d > 1e-3  # the notch: well below (this case is the one the slack must cover)
     assert true - d <= slack + 1e-9, (d, true, slack)
+
+
+def test_a_path_s_clearance_is_a_lower_bound_within_its_tolerance_of_the_dense_sweep():
+    """car_path_clearance along Reeds–Shepp curves (its arcs' turned-hull bounds asked only of the
+    intervals that come to the top of its heap) against the robot placed densely along the same
+    curves and measured by shapely: never above that least, and at most its tolerance (plus the
+    dense placements' own spacing error) below it."""
+    from cspace.car.clearance import TOL, car_path_clearance
+    from cspace.car.curves import knots, reeds_shepp_segments
+
+    rng = np.random.default_rng(11)
+    piece = np.array([[-0.3, -0.35], [1.1, -0.35], [1.1, 0.35], [-0.3, 0.35]])
+    r = 1.0
+    rho = float(np.hypot(*piece.T).max())
+    checked = 0
+    for _ in range(14):
+        poses = [(float(rng.uniform(0, 6)), float(rng.uniform(0, 6)), float(rng.uniform(-math.pi, math.pi)))
+                 for _ in range(3)]
+        obstacles = []
+        for _ in range(3):
+            c = rng.uniform(-2, 8, 2)
+            pts = c + rng.uniform(-0.8, 0.8, (6, 2))
+            hull = shapely.MultiPoint([tuple(p) for p in pts]).convex_hull
+            if hull.geom_type == "Polygon" and hull.area > 1e-3:
+                obstacles.append(np.asarray(hull.exterior.coords)[:-1])
+        if not obstacles:
+            continue
+        seg = lambda a, b: reeds_shepp_segments(a, b, r)  # noqa: E731
+        got = car_path_clearance(np.array(poses), seg, r, [piece], obstacles)
+        union = shapely.union_all([shapely.Polygon(o) for o in obstacles])
+        least, spacing = math.inf, 0.0
+        for a, b in zip(poses[:-1], poses[1:]):
+            segs = [s for s in seg(a, b) if s[1] != 0.0]
+            for (kind, length), k0 in zip(segs, knots(a, segs, r)):
+                n = max(2, int(abs(length) / 0.003))
+                spacing = max(spacing, (1 + (rho / r if kind != "S" else 0.0)) * abs(length) / n)
+                for f in np.linspace(0.0, 1.0, n + 1):
+                    x, y, th = advance(k0, kind, f * length, r)
+                    c, s = math.cos(th), math.sin(th)
+                    least = min(least, shapely.Polygon(piece @ np.array([[c, s], [-s, c]]) + (x, y)).distance(union))
+        if least == 0.0:
+            assert got.distance == 0.0
+            continue
+        checked += 1
+        assert got.distance <= least + 1e-9, (poses, got.distance, least)
+        assert least - got.distance <= TOL * max(r, rho) + 0.5 * spacing + 1e-9, (poses, got.distance, least)
+    assert checked >= 5

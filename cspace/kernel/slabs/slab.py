@@ -108,20 +108,34 @@ def slab_hull(piece: np.ndarray, a: float, b: float, *, scale: float = 0.0) -> n
     >>> H[H[:, 1].argmax()].round(9).tolist()  # the tangents of (1, 1) and (-1, 1) meet at (0, 2)
     [0.0, 2.0]
     """
+    pts, d = slab_points(piece, a, b, scale=scale)
+    if d == 0.0:
+        return pts
+    square = np.array([[-d, -d], [d, -d], [d, d], [-d, d]])
+    return minkowski_sum(convex_hull(pts), square)
+
+
+def slab_points(piece: np.ndarray, a: float, b: float, *, scale: float = 0.0) -> tuple[np.ndarray, float]:
+    """(points, δ): :func:`slab_hull` (same arguments) is the convex hull of the points summed with
+    the square [−δ, δ]² (δ = 0, the points a convex polygon: ``b == a``). For a caller that needs
+    no polygon, only a distance: GJK's from the points' hull, less δ√2, bounds the hull's from below.
+
+    >>> pts, d = slab_points(np.array([[-1., -1], [1, -1], [1, 1], [-1, 1]]), 0.0, math.pi / 2)
+    >>> len(pts), 0.0 < d < 1e-12
+    (12, True)
+    """
     p = as_array(piece, copy=False)
     a, b = float(a), float(b)
     if not (b >= a and b - a <= 0.5 * math.pi + 4 * ANGLE_SLACK):
         raise ValueError(f"slab_hull: need 0 <= b - a <= pi/2, got [{a!r}, {b!r}]")
     if b == a:
-        return rotate_piece(p, a)
+        return rotate_piece(p, a), 0.0
     half = 0.5 * (b - a)
     m = a + half
     apex = rotate(p, m) / math.cos(half)  # the end tangents meet at R_m v / cos(Δ/2)
     pts = np.concatenate([rotate(p, a), rotate(p, b), apex])
     r = float(np.abs(apex).max()) * math.sqrt(2.0)
-    d = slab_pad(max(r, float(scale)))
-    square = np.array([[-d, -d], [d, -d], [d, d], [-d, d]])
-    return minkowski_sum(convex_hull(pts), square)
+    return pts, slab_pad(max(r, float(scale)))
 
 
 def slab_inner(piece: np.ndarray, a: float, b: float, pad: float) -> np.ndarray:
