@@ -58,6 +58,7 @@ from ..kernel.slabs.slab import ANGLE_SLACK, robot_radius, slab_hull, slab_inner
 from ..kernel.polygons.rotation import rotate_piece
 from ..translation.build import pair_sums
 from ..paths.shortest import free_space
+from .link_points import deep_in_both, deep_point, inner_point
 
 UNIT_REL = 2.0**-40  # the proof side's unit u, relative to S (see SlabRegions)
 EPS_UNITS = 64.0  # POSSIBLE's extra shrink of the cores (the checker's sums: 16 u)
@@ -134,6 +135,10 @@ class SlabRegions:
         # that only looks for a path (every point and motion of it certified again exactly) and
         # states nothing from FREE's shape (no "undecided" resolution is read from it)
         self.free_checked = True
+        # links found without the overlay where one component's deep point is deep in the other
+        # (:func:`cspace.se2.link_points.deep_in_both`; another link point, so another path: on for a
+        # car's search with room, whose path turns where it is, not at the link points)
+        self.quick_links, self._deep = False, {}
         # the slabs (a, b) whose FREE carried a walk's crossing translation (exact_path.near_links:
         # the next walks cross there first, where the mesh is kept); so a path may depend on the
         # queries these regions answered before, each certified the same way
@@ -248,8 +253,10 @@ class SlabRegions:
 
             out = []
             for i, j in _box_pairs(r1.boxes, r2.boxes, 0.0):
-                inter = shapely.intersection(r1.components[i], r2.components[j])
-                pt = deep_point(inter, self.tol)
+                pt = deep_in_both(r1, i, r2, j, self.tol, self._deep) if self.quick_links else None
+                if pt is None:
+                    inter = shapely.intersection(r1.components[i], r2.components[j])
+                    pt = deep_point(inter, self.tol)
                 if pt is None:
                     pt = inner_point(inter)
                 if pt is not None:
@@ -381,45 +388,6 @@ def piece_boxes(pieces: list) -> np.ndarray:
     """
     lo, hi = box_pairs(pieces)  # the kernel's (lo, hi), side by side
     return np.hstack([lo, hi]).reshape(-1, 4)
-
-
-def deep_point(geom, depth: float) -> tuple[float, float] | None:
-    """A point of ``geom`` (shapely, polygonal) farther than ``depth`` from its boundary, or None:
-    the centre of the largest inscribed circle of its largest part.
-
-    >>> import shapely
-    >>> x, y = deep_point(shapely.box(0, 0, 2, 1), 0.1)
-    >>> bool(0.4 < x < 1.6 and abs(y - 0.5) < 1e-9), deep_point(shapely.box(0, 0, 2, 1e-9), 0.1)
-    (True, None)
-    """
-    import shapely
-
-    parts = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and p.area > 0.0]
-    for p in sorted(parts, key=lambda q: -q.area):
-        x0, y0, x1, y1 = p.bounds  # a coarse circle is enough: any point deep inside will do
-        mic = shapely.maximum_inscribed_circle(p, tolerance=0.02 * max(x1 - x0, y1 - y0))
-        (cx, cy), _ = shapely.get_coordinates(mic).tolist()
-        if p.boundary.distance(shapely.Point(cx, cy)) > depth and shapely.intersects_xy(p, cx, cy):
-            return float(cx), float(cy)
-    return None
-
-
-def inner_point(geom) -> tuple[float, float] | None:
-    """A point inside ``geom`` (shapely, polygonal) of positive area, however thin: the
-    representative point of its largest part; None if it has no area.
-
-    >>> import shapely
-    >>> x, y = inner_point(shapely.box(0, 5, 3, 5 + 1e-9))
-    >>> 0 < x < 3 and 5 < y < 5 + 1e-9, inner_point(shapely.LineString([(0, 0), (1, 1)]))
-    (True, None)
-    """
-    import shapely
-
-    parts = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and p.area > 0.0]
-    if not parts:
-        return None
-    pt = max(parts, key=lambda q: q.area).representative_point()
-    return float(pt.x), float(pt.y)
 
 
 def _box_pairs(b1: np.ndarray, b2: np.ndarray, grow: float) -> list[tuple[int, int]]:

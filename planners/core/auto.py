@@ -204,8 +204,8 @@ def prepare(sc, cspace) -> float:
     """For a C-space serving many queries (a large map), build what they read first on the map
     alone, kept with it; returns its seconds. A rotating robot or a car: the proof's POSSIBLE regions,
     labelled (:func:`planners.core.exact_se2.prepare`); a Reeds–Shepp car also FREE with the first room
-    of :data:`ROOMS` at the first 8 slabs, and their links, and at their halves (the refinement's first
-    bisection: what a query through a door reads). A query answers the same, sooner."""
+    of :data:`ROOMS` at the first 8 slabs and at their halves (the refinement's first bisection: what a
+    query through a door reads), and their links. A query answers the same, sooner."""
     from cspace.se2.critical import bisected, initial_partition
     from .exact_se2 import prepare as prepare_se2, slab_regions_of
 
@@ -215,10 +215,9 @@ def prepare(sc, cspace) -> float:
     prepare_se2(cspace)
     if sc.space == "reeds-shepp":
         regions, part = slab_regions_of(cspace, ROOMS[0] * _reach(cspace)), initial_partition()
-        for (a, b), (c, d) in zip(part, part[1:] + part[:1]):
-            regions.free_links(regions.free(a, b), regions.free(c, d))
-        for a, b in bisected(part):  # (their links, 0.2 s more on a warehouse map, on first use)
-            regions.free(a, b)
+        for slabs in (part, bisected(part)):
+            for (a, b), (c, d) in zip(slabs, slabs[1:] + slabs[:1]):
+                regions.free_links(regions.free(a, b), regions.free(c, d))
     return _now() - t
 
 

@@ -153,7 +153,8 @@ def _regions_of(cspace, room: float = 0.0):
             inner_robot=getattr(cspace, "inner_body_pieces", None),
             excess=disk_excess(cspace.scenario) if getattr(cspace, "scenario", None) is not None else 0.0)
         if room > 0:  # a car's search for a path with room: FREE's union unchecked (its path is
-            kept[room].free_checked = False  # certified again; it states nothing), POSSIBLE the body's
+            kept[room].free_checked = False  # certified again; it states nothing), POSSIBLE the body's,
+            kept[room].quick_links = True  # links without the overlay where they can (its path turns where it is)
             kept[room].share_possible(_regions_of(cspace))
     return kept[room]
 

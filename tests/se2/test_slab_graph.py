@@ -12,7 +12,8 @@ import pytest
 import shapely
 from hypothesis import given, settings, strategies as st
 
-from cspace.se2.slab_graph import SlabRegions, deep_point, point_free
+from cspace.se2.link_points import deep_point
+from cspace.se2.slab_graph import SlabRegions, point_free
 
 
 def turned(poly, th, x=0.0, y=0.0):
@@ -157,3 +158,32 @@ def test_possible_links_and_near_agree_with_measured_distances():
         for x, y in ((1.0, 1.0), (3.0, 4.0), (5.0, 5.5), (9.5, 7.5)):
             assert sr.near(p1, x, y) == [i for i, c in enumerate(p1.components)
                                          if shapely.distance(c, shapely.Point(x, y)) <= sr.tol]
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 10_000))
+def test_quick_links_join_the_same_components_at_points_deep_in_both(seed):
+    """Links found without the overlay (``quick_links``: a component's own deep point, where the
+    next slab's component holds it that deep) join the same component pairs as the overlay's, at
+    points farther than the link depth from both components' boundaries (shapely's distances)."""
+    rng = np.random.default_rng(seed)
+    boxes = []
+    for _ in range(int(rng.integers(4, 14))):  # (many: pockets, components apart whose boxes overlap)
+        x, y, w, h = rng.uniform(0, 9), rng.uniform(0, 7), rng.uniform(0.2, 2.5), rng.uniform(0.2, 2.5)
+        boxes.append(np.array([[x, y], [x + w, y], [x + w, y + h], [x, y + h]]))
+    slow, quick = SlabRegions(boxes, [TRI], BOUNDS), SlabRegions(boxes, [TRI], BOUNDS)
+    quick.quick_links = True
+    for k in range(8):
+        a, b = -math.pi + k * math.pi / 4, -math.pi + (k + 1) * math.pi / 4
+        c, d = b, b + math.pi / 4
+        r1, r2 = quick.free(a, b), quick.free(c, d)
+        want = {(i, j) for i, j, _ in slow.free_links(slow.free(a, b), slow.free(c, d))}
+        got = quick.free_links(r1, r2)
+        assert {(i, j) for i, j, _ in got} == want
+        for i, j, (x, y) in got:
+            p = shapely.Point(x, y)
+            both = r1.components[i].intersection(r2.components[j])
+            assert both.covers(p)
+            if r1.components[i].boundary.distance(p) > quick.tol and r2.components[j].boundary.distance(p) > quick.tol:
+                continue  # a deep link (the quick one's, or the overlay's where it was deep)
+            assert deep_point(both, quick.tol) is None  # else only where the overlap has no deep point
