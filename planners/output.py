@@ -351,3 +351,26 @@ def queries_csv(paths, dim: int = 2) -> str:
         body = path_csv(waypoints, dim).split("\n", 1)[1]
         lines += [f"{int(i)},{row}" for row in body.splitlines()]
     return f"query,{'x,y,theta' if dim == 3 else 'x,y'}\n" + "".join(line + "\n" for line in lines)
+
+
+def say(text: str, gone: bool = False) -> bool:
+    """Print a command's report ``text`` (flushed), unless its reader went away (``cspace plan ...
+    --json out.json | head -1``); True once it has (``gone``: it had already), so that the caller
+    still writes the files it was asked for, then ends as the closed pipe asks (it raises
+    BrokenPipeError: exit 141, quietly).
+
+    >>> say("report")
+    report
+    False
+    """
+    if gone:
+        return True
+    import sys
+
+    try:
+        print(text)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        return True
+    return False
+

@@ -5,7 +5,7 @@ import sys
 import time
 
 from ..adapters.glue import OMPL_HINT, ompl_available
-from ..output import PLOT_FORMATS, check_distinct, check_output, write_json
+from ..output import PLOT_FORMATS, check_distinct, check_output, say, write_json
 from ..pictures.titles import planner_words
 
 
@@ -224,7 +224,7 @@ def run(args) -> int:
         from .imports import count_as_load
 
         count_as_load(res, import_s)
-    print(summary(res, verbose=args.verbose))
+    gone = say(summary(res, verbose=args.verbose))
     doc = res.as_dict()
     if args.json is not None and ompl_available():  # Bench-MR's metrics of every solved path, beside ours
         from ..bench.benchmr import result_metrics
@@ -235,7 +235,7 @@ def run(args) -> int:
     if rows is not None:
         from .scen import annotate
 
-        print("\n".join(annotate(doc, rows, kept, res.queries or [res])))
+        gone = say("\n".join(annotate(doc, rows, kept, res.queries or [res])), gone)
     if args.json is not None:
         write_json(args.json, doc, "--json")
     if args.bench_mr_json is not None:
@@ -263,6 +263,8 @@ def run(args) -> int:
     results = res.queries or [res]
     if args.proof is not None:
         write_proof(args.proof, results)
+    if gone:  # every file asked for is written: now end as the closed pipe asks (141)
+        raise BrokenPipeError
     return 0 if all(r.solved for r in results) and (rows is None or len(kept) == len(rows)) else 1
 
 

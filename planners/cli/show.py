@@ -1,7 +1,7 @@
 """``cspace show``: draw a scene's workspace, C-obstacles and convex pieces without planning."""
 from __future__ import annotations
 
-from ..output import PLOT_FORMATS, check_distinct, check_output
+from ..output import PLOT_FORMATS, check_distinct, check_output, say
 
 
 def register(sub) -> None:
@@ -63,12 +63,13 @@ def run(args) -> int:
     cs = CSpace.from_scenario(sc)
     rep = cs.report()
     margin = f" (with a margin: clearance {sc.clearance:g})" if sc.margins() else ""
-    print(f"{sc.name}: {len(sc.obstacles)} obstacles, robot {sc.robot_kind}{margin}, "
-          f"{rep['pieces']} C-obstacle pieces, built in {rep['build_seconds'] * 1e3:.1f} ms")
+    lines = [f"{sc.name}: {len(sc.obstacles)} obstacles, robot {sc.robot_kind}{margin}, "
+             f"{rep['pieces']} C-obstacle pieces, built in {rep['build_seconds'] * 1e3:.1f} ms"]
     for s in rep["stages"]:
         counts = {k: v for k, v in s.items() if k not in ("stage", "ran", "seconds", "note")}
         note = f" ({s['note']})" if s.get("note") else ""
-        print(f"  {s['stage']:<20} {'ran' if s['ran'] else 'skipped':<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
+        lines.append(f"  {s['stage']:<20} {'ran' if s['ran'] else 'skipped':<8} {s['seconds'] * 1e3:8.2f} ms  {counts}{note}")
+    gone = say("\n".join(lines))  # (a reader gone: the files below are still written)
     if args.json is not None:
         from ..output import write_json
 
@@ -77,6 +78,8 @@ def run(args) -> int:
         from ..pictures.plot import plot_scene
 
         plot_scene(sc, cs, args.plot, fmt=fmt)
+    if gone:
+        raise BrokenPipeError
     return 0
 
 
@@ -103,9 +106,9 @@ def _show_se2(sc, args, fmt) -> int:
     slab = se2.slab(k)
     a, b = slab_range(k, se2.slabs)
     rep = se2.report()
-    print(f"{sc.name}: {len(sc.obstacles)} obstacles, robot {sc.robot_kind}, SE(2) with {rep['slabs_reason']}")
-    print(f"  slab {k} of {se2.slabs}: theta in [{math.degrees(a):.4g}, {math.degrees(b):.4g}] deg, "
-          f"{len(slab.pieces)} C-obstacle pieces, built in {rep['build_seconds'] * 1e3:.1f} ms")
+    gone = say(f"{sc.name}: {len(sc.obstacles)} obstacles, robot {sc.robot_kind}, SE(2) with {rep['slabs_reason']}\n"
+               f"  slab {k} of {se2.slabs}: theta in [{math.degrees(a):.4g}, {math.degrees(b):.4g}] deg, "
+               f"{len(slab.pieces)} C-obstacle pieces, built in {rep['build_seconds'] * 1e3:.1f} ms")
     if args.json is not None:
         from ..output import write_json
 
@@ -117,4 +120,6 @@ def _show_se2(sc, args, fmt) -> int:
         plot_scene(sc, slab, args.plot, fmt=fmt, theta=th,
                    title=f"{sc.name}: slab {k}/{se2.slabs} (theta {math.degrees(a):.3g} to {math.degrees(b):.3g} deg), "
                          f"{len(slab.pieces)} pieces")
+    if gone:
+        raise BrokenPipeError
     return 0

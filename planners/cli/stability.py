@@ -2,7 +2,6 @@
 JSON and a chart."""
 from __future__ import annotations
 
-import sys
 
 from ..stability.catalogue import GUARANTEES, WIDTH, catalogue, format_table, run_all, runnable
 
@@ -16,7 +15,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..output import check_output, write_json
+    from ..output import check_output, say, write_json
 
     if args.json is not None:  # "" is refused by check_output, not skipped
         check_output(args.json, "--json")
@@ -26,17 +25,17 @@ def run(args) -> int:
 
     cases, skipped = runnable(catalogue())
     rows = run_all(cases, progress=None)
-    print(format_table(rows))
     failed = [r["case"] for r in rows if not r["passed"]]
-    print("\n" + textwrap.fill(f"{len(rows) - len(failed)}/{len(rows)} cases pass"
-                               + (f"; FAILED: {', '.join(failed)}" if failed else ""), WIDTH,
-                               subsequent_indent="  ", break_on_hyphens=False))
+    text = [format_table(rows), "\n" + textwrap.fill(f"{len(rows) - len(failed)}/{len(rows)} cases pass"
+                                                     + (f"; FAILED: {', '.join(failed)}" if failed else ""), WIDTH,
+                                                     subsequent_indent="  ", break_on_hyphens=False)]
     if skipped:
         from ..adapters.glue import OMPL_HINT
 
-        print(textwrap.fill(f"note: skipped {len(skipped)} case(s) that need OMPL, which is not installed "
-                            f"({', '.join(c.name for c in skipped)}; {OMPL_HINT})", WIDTH,
-                            subsequent_indent="  ", break_on_hyphens=False))
+        text.append(textwrap.fill(f"note: skipped {len(skipped)} case(s) that need OMPL, which is not installed "
+                                  f"({', '.join(c.name for c in skipped)}; {OMPL_HINT})", WIDTH,
+                                  subsequent_indent="  ", break_on_hyphens=False))
+    gone = say("\n".join(text))  # (a reader gone: the files below are still written)
     if args.json is not None:
         write_json(args.json, {"cases": rows, "guarantees": GUARANTEES, "passed": not failed,
                                "skipped": [c.name for c in skipped]})
@@ -44,5 +43,6 @@ def run(args) -> int:
         from ..pictures.stability_chart import plot_stability
 
         plot_stability(rows, args.plot)
-    sys.stdout.flush()
+    if gone:
+        raise BrokenPipeError
     return 0 if not failed else 1

@@ -45,7 +45,7 @@ def run(args) -> int:
 
     from ..adapters.glue import MAX_TIME, OMPL_HINT, SEED_LIMIT, ompl_available, planner_name
     from ..errors import InputError
-    from ..output import check_output
+    from ..output import check_output, say
 
     src = args.scenario
     if args.time is not None and not 0 < args.time <= MAX_TIME:
@@ -95,9 +95,11 @@ def run(args) -> int:
         from .imports import count_as_load
 
         count_as_load(res, import_s)
-    print(summary(res, verbose=args.verbose))
+    gone = say(summary(res, verbose=args.verbose))  # (a reader gone: the page is still written)
     t0 = time.perf_counter()
     write_view(res, args.out, poses=args.poses, angles=args.angles, compress=not args.no_compress, option="--out")
     if args.verbose:
-        print(f"page: {args.out} written in {time.perf_counter() - t0:.2f} s")
+        gone = say(f"page: {args.out} written in {time.perf_counter() - t0:.2f} s", gone)
+    if gone:
+        raise BrokenPipeError
     return 0 if res.solved else 1
