@@ -5,7 +5,6 @@ Per planner: the paths, how many the file calls collision-free, how many collide
 colliding pose. Exit 0 when no path called collision-free collides, 1 otherwise, 2 bad input."""
 from __future__ import annotations
 
-import sys
 
 HELP = "re-check the paths of a Bench-MR results file exactly (any planner's)"
 
@@ -26,7 +25,7 @@ def run(args) -> int:
     import time
 
     from ..bench.benchmr_results import per_planner, read_results, recheck
-    from ..output import check_output, write_json
+    from ..output import check_output, say, write_json
 
     if args.json is not None:
         check_output(args.json, "--json", inputs=[args.results])
@@ -35,13 +34,15 @@ def run(args) -> int:
     rows = recheck(doc, args.results, args.steering)
     seconds = time.perf_counter() - t0
     summary = per_planner(rows)
+    lines = []
     for name, d in sorted(summary.items()):
         first = (f"; first colliding pose ({', '.join(f'{v:.6g}' for v in d['first']['pose'])}) in run "
                  f"{d['first']['run']}" if d["first"] else "")
-        print(f"{name}: {d['paths']} paths, {d['called_free']} called collision-free, {d['colliding']} collide "
-              f"({d['called_free_colliding']} of those called free){first}")
-    print(f"rechecked {len(rows)} paths in {seconds:.2f} s")
+        lines.append(f"{name}: {d['paths']} paths, {d['called_free']} called collision-free, {d['colliding']} collide "
+                     f"({d['called_free_colliding']} of those called free){first}")
+    gone = say("\n".join(lines + [f"rechecked {len(rows)} paths in {seconds:.2f} s"]))  # (then --json all the same)
     if args.json is not None:
         write_json(args.json, {"planners": summary, "paths": rows, "seconds": seconds}, "--json")
-    sys.stdout.flush()
+    if gone:
+        raise BrokenPipeError
     return 1 if any(d["called_free_colliding"] for d in summary.values()) else 0

@@ -61,6 +61,24 @@ def test_a_path_around_the_wall_is_free(tmp_path, capsys):
     assert main(["recheck", f]) == 0 and "0 collide" in capsys.readouterr().out
 
 
+def test_a_closed_pipe_still_gets_the_json(tmp_path):
+    # `cspace recheck results.json --json o.json | head -1`, the reader gone before the first line:
+    # the JSON is written all the same, then 141, quietly
+    import subprocess
+    import sys
+
+    f = write(tmp_path, results([[0.0, 0.0, 0.0], [40.0, 0.0, 0.0], [40.0, 10.0, 0.0], [60.0, 10.0, 0.0]]))
+    r, w = os.pipe()
+    os.close(r)
+    try:
+        p = subprocess.run([sys.executable, "-m", "planners.cli", "recheck", f, "--json", str(tmp_path / "o.json")],
+                           cwd=ROOT, stdout=w, stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(w)
+    assert p.returncode == 141 and p.stderr == "", p.stderr
+    assert len(json.loads((tmp_path / "o.json").read_text())["paths"]) == 1
+
+
 def test_reeds_shepp_curves_between_waypoints_are_checked(tmp_path, capsys):
     # the two poses face away from each other across the wall's end: the shortest curve swings through it
     doc = results([[49.0, 6.5, np.pi], [51.0, 6.5, 0.0]], "reeds_shepp", 2.0)
