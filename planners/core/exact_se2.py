@@ -185,16 +185,14 @@ def exact_se2(sc, cspace, adapter, query, source: str, time_limit: float | None 
         if reach is not None:
             reach.planner, reach.timings = "exact", {**timings, **reach.timings}
             return reach
-    if car:
+    if car:  # a Dubins car (a Reeds-Shepp car's exact is planners.core.auto.exact_reeds_shepp)
         from ..adapters.glue import ompl_available
 
-        # (a Reeds-Shepp car's exact is planners.core.auto.exact_reeds_shepp: the slab graph's path as curves)
-        who, reach = (('a Dubins car (space = "dubins") cannot turn in place', "; reach of either end")
-                      if sc.space == "dubins" else (f'a car (space = "{sc.space}") cannot turn in place', ""))
         then = ("use a sampling planner such as RRTConnect" if ompl_available() else
                 "a car's path needs OMPL's sampling planners (not installed)")
-        raise ScenarioError(source, "planner", f"{who}: exact only proves there is no path, and found no "
-                                               f"proof (slab graph: {graph}{reach}): {then}")
+        raise ScenarioError(source, "planner", 'a Dubins car (space = "dubins") cannot turn in place: exact only '
+                                               f"proves there is no path, and found no proof (slab graph: {graph}; "
+                                               f"reach of either end): {then}")
     if res.status == "undecided":
         why = st.get("error") or st.get("reason", "")
         return PlanResult(solved=False, exact=False, path=np.zeros((0, 3)), length=math.inf, timings=timings,

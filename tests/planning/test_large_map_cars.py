@@ -109,6 +109,17 @@ def test_preparing_a_c_space_changes_no_answer():
     assert np.array_equal(a.path, b.path)
 
 
+def _door_car():
+    """A Reeds–Shepp car (a 1 x 0.5 box) at heading 0.3 either side of a wall's 0.6 door: no 45°
+    slab passes it, the heading 0, a slab boundary, does."""
+    wall = [[[-0.1, 0.3], [0.1, 0.3], [0.1, 3], [-0.1, 3]], [[-0.1, -3], [0.1, -3], [0.1, -0.3], [-0.1, -0.3]]]
+    return scenario_from_dict({"space": "reeds-shepp", "turning_radius": 0.5,
+                               "bounds": {"xmin": -4, "xmax": 4, "ymin": -3, "ymax": 3},
+                               "robot": {"polygon": [[-0.5, -0.25], [0.5, -0.25], [0.5, 0.25], [-0.5, 0.25]]},
+                               "start": {"x": -2.5, "y": 0.0, "theta": 0.3}, "goal": {"x": 2.5, "y": 0.0, "theta": 0.3},
+                               "obstacles": [{"polygon": p} for p in wall]}, "door.toml")
+
+
 def test_preparing_builds_the_halves_a_first_refinement_reads(monkeypatch):
     """A Reeds–Shepp car's preparation builds FREE (with the first room) at the first 8 slabs and
     at their halves: a door that no 45° slab passes makes the search bisect every slab once, and
@@ -119,12 +130,7 @@ def test_preparing_builds_the_halves_a_first_refinement_reads(monkeypatch):
     from planners.core.exact_se2 import search, slab_regions_of
     from planners.core.plan import build_cspace
 
-    wall = [[[-0.1, 0.3], [0.1, 0.3], [0.1, 3], [-0.1, 3]], [[-0.1, -3], [0.1, -3], [0.1, -0.3], [-0.1, -0.3]]]
-    sc = scenario_from_dict({"space": "reeds-shepp", "turning_radius": 0.5,
-                             "bounds": {"xmin": -4, "xmax": 4, "ymin": -3, "ymax": 3},
-                             "robot": {"polygon": [[-0.5, -0.25], [0.5, -0.25], [0.5, 0.25], [-0.5, 0.25]]},
-                             "start": {"x": -2.5, "y": 0.0, "theta": 0.3}, "goal": {"x": 2.5, "y": 0.0, "theta": 0.3},
-                             "obstacles": [{"polygon": p} for p in wall]}, "door.toml")
+    sc = _door_car()
     cs = build_cspace(sc)
     prepare(sc, cs)
     room = ROOMS[0] * max(float(np.hypot(*p.T).max()) for p in cs.body_pieces)
@@ -153,12 +159,7 @@ def test_a_reeds_shepp_car_on_a_large_map_goes_from_its_slice_to_the_refinement(
     import planners.core.routine as routine
     from cspace.car.curves import reeds_shepp_segments
 
-    wall = [[[-0.1, 0.3], [0.1, 0.3], [0.1, 3], [-0.1, 3]], [[-0.1, -3], [0.1, -3], [0.1, -0.3], [-0.1, -0.3]]]
-    sc = scenario_from_dict({"space": "reeds-shepp", "turning_radius": 0.5,
-                             "bounds": {"xmin": -4, "xmax": 4, "ymin": -3, "ymax": 3},
-                             "robot": {"polygon": [[-0.5, -0.25], [0.5, -0.25], [0.5, 0.25], [-0.5, 0.25]]},
-                             "start": {"x": -2.5, "y": 0.0, "theta": 0.3}, "goal": {"x": 2.5, "y": 0.0, "theta": 0.3},
-                             "obstacles": [{"polygon": p} for p in wall]}, "door.toml")
+    sc = _door_car()
     seeds = []
     real = routine.run_planner
     monkeypatch.setattr(routine, "run_planner", lambda *a, **k: seeds.append(a[4]) or real(*a, **k))
