@@ -6,8 +6,10 @@ Not used by the product (a test oracle, and the bench's judge of colliding motio
 the hull of a part's triangles) the hull of the piece at both ends is taken and
 buffered by the bound of the note (a point at radius r strays at most
 r * (1 - cos(dtheta / 2)) <= r * dtheta^2 / 8 from its chord), so the union of the steps
-holds the swept region. A path "collides" when that union meets an obstacle, and
-"certainly collides" when a sampled pose itself meets one.
+holds the swept region. Where it meets an obstacle the step is halved, a bounded number of
+times: a path "collides" when a sampled pose meets an obstacle (``certain``) or a translating
+piece's exact sweep does; a step still too close to decide when the halving stops is
+"undecided" (not free); the rest is free. See :func:`sweep_check`.
 """
 from __future__ import annotations
 
