@@ -16,7 +16,9 @@ the repository: it runs only when ``--bench-mr DIR`` (or ``$BENCH_MR``) names on
 ``BENCH_MR_ARGS`` and ``--figures docs/figures/benchmr`` (a picture of each polygon world and
 car model with cspace's paths, committed with the page); its section then shows the table, the
 per-world ratios, the peer's recheck counts and those pictures. Without a checkout the section
-says how to run it, and nothing outside the repository is read.
+says how to run it, and nothing outside the repository is read. OMPL.app's planar problems
+(``scripts/bench_omplapp.py``) are read the same way from an OMPL.app checkout, ``--omplapp DIR``
+(or ``$OMPLAPP``), with ``OMPLAPP_ARGS``.
 """
 from __future__ import annotations
 
@@ -53,8 +55,12 @@ TIMEOUT = 600  # seconds per script
 # run (its --quick mode is 3 s and 3 rows); longer than the others, hence its own timeout.
 BENCH_MR_ARGS = ["--seeds", "1", "--time", "10"]
 BENCH_MR_FIGURES = os.path.join("docs", "figures", "benchmr")
+# OMPL.app's planar problems: its defaults (10 seeds, 10 s a run), the figures issue 47's target is over.
+OMPLAPP_ARGS: list[str] = []
 # The longer scripts' own timeouts (seconds): 100 pairs x 3 spaces on a 2000 x 2000 map; Bench-MR's suite.
-TIMEOUTS = {"bench_nav2": 1800, "bench_warehouse": 1800, "bench_benchmr": 1800}
+TIMEOUTS = {"bench_nav2": 1800, "bench_warehouse": 1800, "bench_benchmr": 1800, "bench_omplapp": 1800}
+# Benches of another project's data: the option that names its checkout (without one: "Not run").
+CHECKOUTS = {"bench_benchmr": "--bench-mr", "bench_omplapp": "--omplapp"}
 
 
 def help_text(script: str) -> str:
@@ -63,13 +69,15 @@ def help_text(script: str) -> str:
     return proc.stdout
 
 
-def quick_command(name: str, script: str, json_path: str, bench_mr: str | None = None) -> tuple[list[str], bool]:
+def quick_command(name: str, script: str, json_path: str, checkout: str | None = None) -> tuple[list[str], bool]:
     """The command line of a quick run, and whether it writes JSON to ``json_path``
-    (``bench_benchmr``: its own arguments, with the checkout ``bench_mr``)."""
+    (``bench_benchmr``, ``bench_omplapp``: their own arguments, with the other project's ``checkout``)."""
     h = help_text(script)
     args = list(QUICK_ARGS.get(name, []))
     if name == "bench_benchmr":
-        args = ["--bench-mr", bench_mr or "", *BENCH_MR_ARGS, "--figures", BENCH_MR_FIGURES]
+        args = ["--bench-mr", checkout or "", *BENCH_MR_ARGS, "--figures", BENCH_MR_FIGURES]
+    elif name == "bench_omplapp":
+        args = ["--omplapp", checkout or "", *OMPLAPP_ARGS]
     elif "--quick" in h:
         args.append("--quick")
     wants_json = "--out-json" in h
@@ -78,10 +86,10 @@ def quick_command(name: str, script: str, json_path: str, bench_mr: str | None =
     return ["python", os.path.relpath(script, ROOT), *args], wants_json
 
 
-def run_script(name: str, script: str, work: str, bench_mr: str | None = None) -> dict:
+def run_script(name: str, script: str, work: str, checkout: str | None = None) -> dict:
     """Run one bench script, keep its stdout, JSON and timing in ``work``; returns the record."""
     json_path = os.path.join(work, f"{name}.json")
-    cmd, wants_json = quick_command(name, script, json_path, bench_mr)
+    cmd, wants_json = quick_command(name, script, json_path, checkout)
     started = {"date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                "load": list(os.getloadavg()) if hasattr(os, "getloadavg") else None}  # the machine may be shared
     limit = TIMEOUTS.get(name, TIMEOUT)
@@ -93,8 +101,8 @@ def run_script(name: str, script: str, work: str, bench_mr: str | None = None) -
         rc, out, err = "timeout", exc.stdout or "", f"timed out after {limit} s"
         out = out.decode() if isinstance(out, bytes) else out
     shown = _shown(cmd, json_path)
-    if bench_mr:  # the checkout's place on this machine is no part of the command a reader types
-        shown = shown.replace(shlex.quote(bench_mr), "DIR")
+    if checkout:  # the checkout's place on this machine is no part of the command a reader types
+        shown = shown.replace(shlex.quote(checkout), "DIR")
     rec = {"name": name, "command": shown, "seconds": time.perf_counter() - t, "rc": rc, **started,
            "stdout": out, "stderr": err[-2000:], "json": json_path if wants_json and os.path.exists(json_path) else None}
     with open(os.path.join(work, f"{name}.run.json"), "w") as fh:
@@ -265,6 +273,50 @@ def benchmr_lines(rec: dict) -> list[str]:
     return lines + [""]
 
 
+def omplapp_lines(rec: dict) -> list[str]:
+    """The OMPL.app section's body from its run's JSON: what was timed and judged, the load, the
+    table per problem with the target's check.
+
+    >>> omplapp_lines({"json": None, "stdout": ""})[0].startswith("Not run: it needs an OMPL.app checkout")
+    True
+    """
+    if not rec.get("json"):
+        return ["Not run: it needs an OMPL.app checkout (github.com/ompl/omplapp), which lives outside the",
+                "repository: `python scripts/make_benchmarks_page.py --omplapp DIR` (or `$OMPLAPP`).", ""]
+    with open(rec["json"]) as fh:
+        data = json.load(fh)
+    ms = lambda v: "-" if v is None else f"{v * 1e3:.1f} ms"  # noqa: E731
+    x = lambda v: "-" if v is None else f"{v:.2f}x"  # noqa: E731
+    load, end = data.get("load_start"), data.get("load_end")
+    n = data.get("seeds")
+    lines = [f"OMPL.app's five geometric planar problems (`resources/2D` of the checkout DIR, read as they are), {n} "
+             f"seeds, {data.get('time', 10):g} s a run. Time: CPU seconds to the first path, ours the default planner "
+             "`auto` (certified; the C-space built once before the seeds, its own column), the peer OMPL's RRTConnect "
+             "on the same state space with coal and OMPL's discrete motion check at its default step; interleaved per "
+             "seed. Every path of both is judged afterwards by the independent sweep (`scripts/sweep_oracle.py`): "
+             "rejected = colliding, undecided = closer than the sweep resolves (neither counts as sound). ours / coal "
+             "is the median of the per-seed ratios over the seeds whose coal path is sound (all seeds beside); target "
+             "<= 0.5x (issue 47).", ""]
+    if load:
+        lines += [f"Load average at the run's start: {', '.join(f'{v:.2f}' for v in load)}"
+                  + (f"; at its end: {', '.join(f'{v:.2f}' for v in end)}" if end else "")
+                  + " (a 2-core machine shared with other work: absolute times are inflated, the ratios were measured "
+                    "in the same run).", ""]
+    lines += ["| problem | obstacle vertices | C-space (once) | ours solved | ours median | ours not sound | coal solved "
+              "| coal median | coal rejected | coal undecided | ours / coal (sound) | (all) | target <= 0.5x |",
+              "|" + "---|" * 13]
+    for r in data["rows"]:
+        lines.append("| " + " | ".join([
+            r["problem"], str(r["vertices"]), ms(r["prep_s"]), f"{r['ours_solved']}/{r['seeds']}", ms(r["ours_median_s"]),
+            str(r["ours_not_sound"]), f"{r['coal_solved']}/{r['seeds']}", ms(r["coal_median_s"]),
+            str(r["coal_colliding"]), str(r["coal_undecided"]), x(r["ratio_sound"]) + f" ({r['sound_seeds']} seeds)",
+            x(r["ratio_all"]), "met" if r["target_met"] else "**MISSED**"]) + " |")
+    if data.get("skipped"):
+        lines += ["", "Skipped: " + ", ".join(f"`{f}`" for f in data["skipped"]) + " (kinodynamic control problems: "
+                  "cspace plans no control space)."]
+    return lines + [""]
+
+
 def machine_note(work: str) -> str:
     """Where the numbers were measured (saved with the run, so --from keeps it)."""
     path = os.path.join(work, "machine.json")
@@ -319,8 +371,8 @@ def render(records: list[dict], missing: list[str], work: str) -> str:
                     lines += [t, ""]
             if r["stdout"].strip():
                 lines += ["```", r["stdout"].rstrip(), "```", ""]
-        elif r["name"] == "bench_benchmr":
-            lines += benchmr_lines(r)
+        elif r["name"] in CHECKOUTS:
+            lines += benchmr_lines(r) if r["name"] == "bench_benchmr" else omplapp_lines(r)
             if r["stdout"].strip() and r.get("json"):
                 lines += ["<details><summary>The script's output</summary>", "", "```", r["stdout"].rstrip(), "```", "",
                           "</details>", ""]
@@ -432,6 +484,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--bench-mr", default=os.environ.get("BENCH_MR") or None, metavar="DIR",
                     help="a Bench-MR checkout for scripts/bench_benchmr.py (default: $BENCH_MR; without one its "
                          "section says how to run it)")
+    ap.add_argument("--omplapp", default=os.environ.get("OMPLAPP") or None, metavar="DIR",
+                    help="an OMPL.app checkout (or its resources/2D) for scripts/bench_omplapp.py (default: $OMPLAPP; "
+                         "without one its section says how to run it)")
     args = ap.parse_args(argv)
     found = {os.path.splitext(os.path.basename(p))[0]: p for p in sorted(glob.glob(os.path.join(ROOT, "scripts", "bench_*.py")))}
     order = [n for n in EXPECTED if n in found] + [n for n in found if n not in EXPECTED]
@@ -458,11 +513,12 @@ def main(argv: list[str] | None = None) -> int:
             if only and n not in only:
                 continue
             print(f"running {n} ...", flush=True)
-            if n == "bench_benchmr" and not args.bench_mr:  # its data lives outside the repository
-                records.append({"name": n, "command": "python scripts/bench_benchmr.py --bench-mr DIR", "seconds": 0.0,
+            checkout = {"bench_benchmr": args.bench_mr, "bench_omplapp": args.omplapp}.get(n)
+            if n in CHECKOUTS and not checkout:  # its data lives outside the repository
+                records.append({"name": n, "command": f"python scripts/{n}.py {CHECKOUTS[n]} DIR", "seconds": 0.0,
                                 "rc": 0, "stdout": "", "stderr": "", "json": None})
                 continue
-            records.append(run_script(n, found[n], work, args.bench_mr))
+            records.append(run_script(n, found[n], work, checkout))
             print(f"  {records[-1]['seconds']:.0f} s, exit {records[-1]['rc']}", flush=True)
         if not args.no_planners and (not only or "cspace_bench" in only):
             print("running cspace bench ...", flush=True)

@@ -6,8 +6,10 @@ Not used by the product (a test oracle, and the bench's judge of colliding motio
 the hull of a part's triangles) the hull of the piece at both ends is taken and
 buffered by the bound of the note (a point at radius r strays at most
 r * (1 - cos(dtheta / 2)) <= r * dtheta^2 / 8 from its chord), so the union of the steps
-holds the swept region. A path "collides" when that union meets an obstacle, and
-"certainly collides" when a sampled pose itself meets one.
+holds the swept region. Where it meets an obstacle the step is halved, a bounded number of
+times: a path "collides" when a sampled pose meets an obstacle (``certain``) or a translating
+piece's exact sweep does; a step still too close to decide when the halving stops is
+"undecided" (not free); the rest is free. See :func:`sweep_check`.
 """
 from __future__ import annotations
 
@@ -60,50 +62,103 @@ def at(piece, pose):
     return affinity.translate(affinity.rotate(piece, pose[2], origin=(0, 0), use_radians=True), pose[0], pose[1])
 
 
-def sweep_check(sc, path, dtheta: float = 2e-3, dxy: float | None = None, floor: float = 1e-12) -> dict:
-    """{'collides': bool, 'certain': bool, 'out_of_bounds': bool, 'steps': int, 'undecided': int} for an
-    (N, 3) path.
+def sweep_check(sc, path, dtheta: float = 2e-3, dxy: float | None = None, floor: float = 1e-12,
+                step_cap: int = 4096, total_cap: int = 400_000) -> dict:
+    """{'collides', 'certain', 'out_of_bounds', 'steps', 'undecided'} for an (N, 3) path.
 
-    A step whose padded hull meets an obstacle is halved (the pad shrinks with the square
-    of the step's rotation) until a sampled pose collides (``certain``), the padded hull
-    misses, or the pad falls below ``floor`` x the extent with the hull still within it of
-    an obstacle (``undecided``: a contact closer than the floor, counted, and reported as
-    ``collides`` only with ``strict``). The judge is shapely's, independent of cspace.
+    Each motion is cut into a grid of steps (rotation at most ``dtheta``, translation at most
+    ``dxy``). Runs of grid steps are first tested whole with the robot's convex hull (the
+    hull of the robot at a run's two ends, padded by the bound of the run's rotation, holds
+    the sweep of every piece): a run whose padded hull misses every obstacle is free, one
+    that meets an obstacle is halved down to single grid steps, which are tested piece by
+    piece. A piece's step whose padded hull meets an obstacle is halved (the pad shrinks with
+    the square of the rotation) until a sampled pose meets an obstacle (``certain``), the
+    padded hull misses, or the step is below ``floor`` x the extent. A step that does not turn
+    moves the piece by a translation, whose sweep is exactly the hull of its two ends: it is
+    decided at once (a bounded bisection looks for a pose in collision, for ``certain``).
+
+    ``collides``: a sampled pose meets an obstacle, or a translating piece's exact sweep does.
+    ``undecided``: grid steps within the resolution of an obstacle without a collision shown
+    (a contact closer than the floor, or a step that used up its ``step_cap`` sub-steps, or
+    any grazing step once the path's ``total_cap`` sub-steps are spent): neither free nor
+    colliding; a caller that needs a sound path counts them as not sound. ``steps``: the
+    hull tests made (at most about the grid's size + ``total_cap``, times the pieces): the
+    work is bounded whatever the path. The judge is shapely's, independent of cspace.
     """
     obstacles = shapely.union_all([o.to_shapely() for o in sc.obstacles]) if sc.obstacles else shapely.Polygon()
     tree_obs = prep(obstacles) if not obstacles.is_empty else None
     pieces = robot_pieces(sc) if sc.robot else [shapely.Point(0, 0)]
+    whole = shapely.union_all(pieces).convex_hull  # holds every piece: its sweep holds theirs
     r = max((float(np.hypot(*np.asarray(p.exterior.coords).T).max()) for p in pieces if p.geom_type == "Polygon"),
             default=0.0)
     xmin, xmax, ymin, ymax = sc.bounds
     ext = max(xmax - xmin, ymax - ymin)
     dxy = dxy or ext * 2e-3
     res = {"collides": False, "certain": False, "out_of_bounds": False, "steps": 0, "undecided": 0}
+    spent = [0]  # sub-steps of halving, path-wide (``total_cap``)
 
     def pad_of(a, b):
         return r * (1 - math.cos(min(abs(_shortest(a[2], b[2])), math.pi) / 2)) * 1.01 + 1e-15 * ext
 
+    def swept(shape, q0, q1, pad):
+        """The hull of ``shape`` at both poses, padded: it holds the sweep q0 -> q1."""
+        res["steps"] += 1
+        hull = shapely.union(at(shape, q0), at(shape, q1)).convex_hull
+        return hull.buffer(pad, quad_segs=2) if pad > 0 else hull
+
+    def translation_hits(piece, q0, q1) -> str:
+        """A step that does not turn: the sweep is the hull of its ends, exactly. 'free', 'collides'
+        (with a pose found by bisection: ``certain``), or 'undecided' (nearer than rounding)."""
+        if not tree_obs.intersects(swept(piece, q0, q1, 0.0)):
+            return "undecided" if tree_obs.intersects(swept(piece, q0, q1, 1e-15 * ext)) else "free"
+        for _ in range(64):  # a chain of halves whose hull meets an obstacle: one must
+            mid = _interp(q0, q1, 0.5)
+            if tree_obs.intersects(at(piece, mid)):
+                res["certain"] = True
+                break
+            q0, q1 = (q0, mid) if tree_obs.intersects(swept(piece, q0, mid, 0.0)) else (mid, q1)
+        return "collides"
+
     def step_hits(p0, p1) -> str:
-        """'free', 'collides' (a sampled pose meets an obstacle) or 'undecided'."""
-        stack = [(p0, p1)]
-        while stack:
-            q0, q1 = stack.pop()
-            res["steps"] += 1
-            pad = pad_of(q0, q1)
-            for piece in pieces:
+        """One grid step, piece by piece: 'free', 'collides' or 'undecided'."""
+        verdict = "free"
+        for piece in pieces:
+            stack, used = [(p0, p1)], 0
+            while stack:
+                q0, q1 = stack.pop()
                 g0, g1 = at(piece, q0), at(piece, q1)
                 if tree_obs.intersects(g0) or tree_obs.intersects(g1):
+                    res["certain"] = True
                     return "collides"
-                hull = shapely.union(g0, g1).convex_hull
-                if not tree_obs.intersects(hull.buffer(pad, quad_segs=2)):
+                if q0[2] == q1[2]:
+                    v = translation_hits(piece, q0, q1)
+                    if v == "collides":
+                        return v
+                    verdict = "undecided" if v == "undecided" else verdict
                     continue
-                if pad < floor * ext and math.hypot(q1[0] - q0[0], q1[1] - q0[1]) < floor * ext:
-                    res["undecided"] += 1
+                pad = pad_of(q0, q1)
+                if not tree_obs.intersects(swept(piece, q0, q1, pad)):
                     continue
+                small = pad < floor * ext and math.hypot(q1[0] - q0[0], q1[1] - q0[1]) < floor * ext
+                if small or used >= step_cap or spent[0] >= total_cap:
+                    verdict = "undecided"  # closer than the resolution, or the budget is spent
+                    continue
+                used += 2
+                spent[0] += 2
                 mid = _interp(q0, q1, 0.5)
                 stack += [(q0, mid), (mid, q1)]
-                break
-        return "free"
+        return verdict
+
+    def run_hits(poses, i, j) -> bool:
+        """Grid steps i .. j - 1 (poses i .. j, one interpolation): True when one collides."""
+        if not tree_obs.intersects(swept(whole, poses[i], poses[j], pad_of(poses[i], poses[j]))):
+            return False
+        if j - i > 1:
+            m = (i + j) // 2
+            return run_hits(poses, i, m) or run_hits(poses, m, j)
+        v = step_hits(poses[i], poses[j])
+        res["undecided"] += v == "undecided"
+        return v == "collides"
 
     for a, b in zip(path[:-1], path[1:]):
         n = max(1, math.ceil(abs(_shortest(a[2], b[2])) / dtheta), math.ceil(math.hypot(b[0] - a[0], b[1] - a[1]) / dxy))
@@ -113,10 +168,9 @@ def sweep_check(sc, path, dtheta: float = 2e-3, dxy: float | None = None, floor:
                 res["out_of_bounds"] = True
         if tree_obs is None:
             continue
-        for p0, p1 in zip(poses[:-1], poses[1:]):
-            if step_hits(p0, p1) == "collides":
-                res["collides"] = res["certain"] = True
-                return res
+        if run_hits(poses, 0, n):
+            res["collides"] = True
+            return res
     return res
 
 
