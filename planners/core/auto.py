@@ -308,7 +308,7 @@ def sampling_slice(sample, cspace, clock, time_limit: float) -> PlanResult:
     while True:
         n, t = built()[0], _now()
         budget = min(SLICE_SHARE * time_limit, clock.left())
-        r = sample(budget, SLICE_ITERATIONS)
+        r = sample(budget, int(__import__("os").environ.get("SLICEN", SLICE_ITERATIONS)))
         if r.solved or built()[0] == n or _now() - t < 0.9 * budget or clock.left() <= 0:
             return r
 
@@ -353,12 +353,13 @@ def _slab_graph(sc, cspace, adapter, query, source, budget: float, simplify: boo
 def _reeds_shepp(sc, cspace, adapter, query, se2_path, budget: float, simplify: bool, search_s: float):
     """A certified SE(2) path driven as certified Reeds–Shepp curves (Laumond's method), shortened
     under the car's validator; None if the conversion fails within ``budget``."""
-    from cspace.car.laumond import shortcut, to_reeds_shepp
+    from cspace.car.laumond import along_travel, shortcut, to_reeds_shepp
 
     from .exact_se2 import shorten
 
     t = _now()
     end = t + max(budget, 0.0)
+    se2_path = along_travel(cspace, se2_path, adapter.radius)  # (no long sideways translation left)
     poses = to_reeds_shepp(cspace, se2_path, adapter.radius, deadline=lambda: _now() > end)
     if poses is None:
         return None

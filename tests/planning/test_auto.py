@@ -189,6 +189,27 @@ def test_laumond_gives_up_within_its_budget_rather_than_return_a_colliding_curve
     assert to_reeds_shepp(cs, through, 0.5, max_depth=2) is None
 
 
+def test_a_long_sideways_translation_is_driven_along_its_way_where_the_car_can_turn():
+    """The slab graph translates at its slab's angle, often across the way it goes: 8 m sideways
+    in a corridor is a chain of parking manoeuvres; turned in place to the way it goes (where the
+    corridor lets it turn: the car's diagonal 0.72 < 1.0), then driven, it is a few curves; the
+    path passes the independent sweep. Where the car cannot turn (0.65 wide), the path is kept."""
+    from cspace.car.laumond import along_travel, to_reeds_shepp
+    from planners.core.plan import build_cspace
+
+    sideways = np.array([[5.0, 1.0, 0.0], [5.0, 9.0, 0.0]])
+    sc = scenario_from_dict(_corridor(0.4))
+    cs = build_cspace(sc)
+    turned = along_travel(cs, sideways, 0.5)
+    assert turned[:, :2].tolist() == [[5.0, 1.0], [5.0, 1.0], [5.0, 9.0], [5.0, 9.0]]
+    assert abs(abs(turned[1, 2]) - np.pi / 2) < 1e-12 and turned[1, 2] == turned[2, 2]
+    direct, aligned = to_reeds_shepp(cs, sideways, 0.5), to_reeds_shepp(cs, turned, 0.5)
+    assert direct is not None and aligned is not None and len(aligned) * 4 < len(direct), (len(aligned), len(direct))
+    assert judged_free(sc, aligned)
+    narrow = build_cspace(scenario_from_dict(_corridor(0.05)))
+    assert along_travel(narrow, sideways, 0.5).tolist() == sideways.tolist()
+
+
 def test_given_iterations_auto_s_turns_of_sampling_count_them_not_time(monkeypatch):
     # The short turn of sampling is timed (a share of what is left); with --iterations each turn is
     # bounded by its count alone, so which stage answers does not depend on the machine's speed.
