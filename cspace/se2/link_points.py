@@ -58,9 +58,9 @@ def deep_in_both(r1, i: int, r2, j: int, depth: float, kept: dict) -> tuple[floa
 
     >>> import shapely
     >>> from types import SimpleNamespace as NS
-    >>> a, b = NS(a=0.0, b=1.0, components=[shapely.box(0, 0, 4, 2)]), NS(components=[shapely.box(1, 0, 5, 2)])
+    >>> a, b = NS(a=0.0, b=1.0, components=[shapely.box(0, 0, 4, 2)]), NS(components=[shapely.box(0.5, 0, 5, 2)])
     >>> x, y = deep_in_both(a, 0, b, 0, 0.1, {})
-    >>> bool(1.1 < x < 3.9 and 0.1 < y < 1.9), deep_in_both(a, 0, NS(components=[shapely.box(3.9, 0, 9, 2)]), 0, 0.1, {})
+    >>> bool(0.6 < x < 3.9 and 0.1 < y < 1.9), deep_in_both(a, 0, NS(components=[shapely.box(3.9, 0, 9, 2)]), 0, 0.1, {})
     (True, None)
     """
     import shapely
