@@ -26,6 +26,9 @@ from ..se2.motion import interpolate
 
 MAX_DEPTH = 24        # halvings of one SE(2) motion (2^-24 of it: far below any useful piece)
 MAX_CHECKS = 100_000  # curve checks for a whole path, at most (about 6 us each on the compiled path)
+# along_travel: where a sideways translation may turn to the way it goes, as fractions of it (the
+# ends first: a turn at t in the first half ends it, one at t in the second half starts it)
+TURN_AT = (0.0, 0.05, 0.1, 0.2, 0.35, 0.65, 0.8, 0.9, 0.95, 1.0)
 
 
 def to_reeds_shepp(cspace, path, radius: float, *, max_depth: int = MAX_DEPTH, max_checks: int = MAX_CHECKS,
@@ -86,7 +89,9 @@ def along_travel(cspace, path, radius: float) -> np.ndarray:
     translation p -> q at heading θ (the slab graph translates at the angle of its slab, often across
     the way it goes), longer than 2 ``radius`` and more than 1/20 sideways, becomes a turn in place at
     p to the travel direction φ (or φ + π, the nearer to θ: forward or reverse), the translation at
-    φ, and a turn back to θ at q, where :meth:`motion_free` certifies all three (else it is kept).
+    φ, and a turn back to θ at q, where :meth:`motion_free` certifies all three (else it is kept);
+    where a turn at an end is not free, the first and last places along it (:data:`TURN_AT`) where
+    it is, the short pieces before and after still sideways.
     A car drives the new translation as one straight curve, where :func:`to_reeds_shepp` turns a
     sideways one into a chain of parking manoeuvres (on a warehouse map, 87 m sideways: 13 684 curves).
 
@@ -107,9 +112,14 @@ def along_travel(cspace, path, radius: float) -> np.ndarray:
         go = math.atan2(b[1] - a[1], b[0] - a[0])
         if a[2] == b[2] and d > 2.0 * radius and abs(math.sin(go - a[2])) > 0.05:
             phi = go if math.cos(go - a[2]) >= 0.0 else wrap_angle(go + math.pi)
-            p, q = (a[0], a[1], phi), (b[0], b[1], phi)
-            if cspace.motion_free(a, p) and cspace.motion_free(p, q) and cspace.motion_free(q, b):
-                out += [p, q]
+            # where to turn: at the ends, else a little inside (a piece of the free translation at θ
+            # is free, so only the turns and the new translation are checked)
+            at = [(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])) for t in TURN_AT]
+            first = next((m for m in at if cspace.motion_free((*m, a[2]), (*m, phi))), None)
+            last = next((m for m in at[::-1] if cspace.motion_free((*m, phi), (*m, a[2]))), None)
+            if first is not None and last is not None and at.index(first) < at.index(last) \
+                    and cspace.motion_free((*first, phi), (*last, phi)):
+                out += [p for p in [(*first, a[2]), (*first, phi), (*last, phi), (*last, a[2])] if p not in (a, b)]
         out.append(b)
     return np.array(out, dtype=np.float64)
 
