@@ -61,6 +61,24 @@ OMPLAPP_ARGS: list[str] = []
 TIMEOUTS = {"bench_nav2": 1800, "bench_warehouse": 1800, "bench_benchmr": 1800, "bench_omplapp": 1800}
 # Benches of another project's data: the option that names its checkout (without one: "Not run").
 CHECKOUTS = {"bench_benchmr": "--bench-mr", "bench_omplapp": "--omplapp"}
+# What each of them needs, for its section's "Not run" (the option, then the environment variable)
+NOT_RUN = {"bench_benchmr": ("a Bench-MR checkout (github.com/robot-motion/bench-mr)", "BENCH_MR"),
+           "bench_omplapp": ("an OMPL.app checkout (github.com/ompl/omplapp)", "OMPLAPP")}
+
+
+def checkout_data(rec: dict, name: str) -> tuple[dict | None, list[str]]:
+    """A checkout bench's JSON from its run's record, or (None, its section's "Not run" lines) where
+    nothing ran (no checkout named).
+
+    >>> checkout_data({"json": None}, "bench_omplapp")[1][0]
+    'Not run: it needs an OMPL.app checkout (github.com/ompl/omplapp), which lives outside the repository:'
+    """
+    if not rec.get("json"):
+        what, env = NOT_RUN[name]
+        return None, [f"Not run: it needs {what}, which lives outside the repository:",
+                      f"`python scripts/make_benchmarks_page.py {CHECKOUTS[name]} DIR` (or `${env}`).", ""]
+    with open(rec["json"]) as fh:
+        return json.load(fh), []
 
 
 def help_text(script: str) -> str:
@@ -213,11 +231,9 @@ def benchmr_lines(rec: dict) -> list[str]:
     >>> benchmr_lines(rec)[0].startswith("Not run: it needs a Bench-MR checkout")
     True
     """
-    if not rec.get("json"):
-        return ["Not run: it needs a Bench-MR checkout (github.com/robot-motion/bench-mr), which lives outside",
-                "the repository: `python scripts/make_benchmarks_page.py --bench-mr DIR` (or `$BENCH_MR`).", ""]
-    with open(rec["json"]) as fh:
-        data = json.load(fh)
+    data, not_run = checkout_data(rec, "bench_benchmr")
+    if data is None:
+        return not_run
     ms = lambda v: "-" if v is None else f"{v * 1e3:.0f} ms"  # noqa: E731
     x = lambda v: "-" if v is None else f"{v:.2f}x"  # noqa: E731
     load = data.get("load_start")
@@ -280,11 +296,9 @@ def omplapp_lines(rec: dict) -> list[str]:
     >>> omplapp_lines({"json": None, "stdout": ""})[0].startswith("Not run: it needs an OMPL.app checkout")
     True
     """
-    if not rec.get("json"):
-        return ["Not run: it needs an OMPL.app checkout (github.com/ompl/omplapp), which lives outside the",
-                "repository: `python scripts/make_benchmarks_page.py --omplapp DIR` (or `$OMPLAPP`).", ""]
-    with open(rec["json"]) as fh:
-        data = json.load(fh)
+    data, not_run = checkout_data(rec, "bench_omplapp")
+    if data is None:
+        return not_run
     ms = lambda v: "-" if v is None else f"{v * 1e3:.1f} ms"  # noqa: E731
     x = lambda v: "-" if v is None else f"{v:.2f}x"  # noqa: E731
     load, end = data.get("load_start"), data.get("load_end")

@@ -88,17 +88,23 @@ def test_a_tiny_checkout_is_run_and_judged(tmp_path, capsys):
     assert len(data["load_start"]) == 3
 
 
-def test_the_page_runs_it_only_with_a_checkout_and_shows_the_table(tmp_path, monkeypatch):
-    monkeypatch.delenv("OMPLAPP", raising=False)
+@pytest.mark.parametrize("name, env, needs, flags", [
+    ("bench_omplapp", "OMPLAPP", "an OMPL.app checkout", ["--out-json"]),
+    ("bench_benchmr", "BENCH_MR", "a Bench-MR checkout", ["--out-json", "--figures"])])
+def test_the_page_runs_a_checkout_bench_only_with_its_checkout(tmp_path, monkeypatch, name, env, needs, flags):
+    # (both benches whose data lives in another project's checkout: make_benchmarks_page.CHECKOUTS)
+    monkeypatch.delenv(env, raising=False)
     ran = []
     monkeypatch.setattr(PAGE, "run_script", lambda *a, **k: ran.append(a) or {})
     page = tmp_path / "page.md"
-    assert PAGE.main(["--only", "bench_omplapp", "--out", str(page), "--work", str(tmp_path / "w")]) == 0
-    assert ran == [] and "Not run: it needs an OMPL.app checkout" in page.read_text()
-    assert "python scripts/bench_omplapp.py --omplapp DIR" in page.read_text()
-    cmd, wants = PAGE.quick_command("bench_omplapp", os.path.join(PAGE.ROOT, "scripts", "bench_omplapp.py"),
-                                    "x.json", "/some/checkout")
-    assert cmd[cmd.index("--omplapp") + 1] == "/some/checkout" and wants and "--out-json" in cmd
+    assert PAGE.main(["--only", name, "--out", str(page), "--work", str(tmp_path / "w")]) == 0
+    assert ran == [] and f"Not run: it needs {needs}" in page.read_text()
+    assert f"python scripts/{name}.py {PAGE.CHECKOUTS[name]} DIR" in page.read_text()
+    cmd, wants = PAGE.quick_command(name, os.path.join(PAGE.ROOT, "scripts", f"{name}.py"), "x.json", "/some/checkout")
+    assert cmd[cmd.index(PAGE.CHECKOUTS[name]) + 1] == "/some/checkout" and wants and all(f in cmd for f in flags)
+
+
+def test_the_page_shows_the_table(tmp_path):
     row = BENCH.summary(runs((0.01, 0.04, "sound", "sound"), (0.02, 0.01, "sound", "colliding")))
     (tmp_path / "o.json").write_text(json.dumps({"rows": [row], "skipped": ["Maze_kcar.cfg"], "seeds": 2, "time": 10,
                                                  "load_start": [1.5, 1.25, 1.0], "load_end": [2.0, 1.5, 1.0]}))

@@ -76,16 +76,3 @@ def test_the_page_section_shows_the_table_ratios_and_recheck_counts(tmp_path):
     text = "\n".join(PAGE.benchmr_lines({"json": str(tmp_path / "b.json"), "stdout": ""}))
     assert "- parking1 reeds-shepp: 2 runs, 2 proofs accepted, median 180 ms CPU for the proofs" in text
     assert "- parking1 dubins:" not in text.split("Proven unsolvable")[1].split("Undecided")[0]  # none proven
-
-
-def test_without_a_checkout_the_page_runs_nothing_of_bench_mr_and_says_how(tmp_path, monkeypatch):
-    monkeypatch.delenv("BENCH_MR", raising=False)
-    ran = []
-    monkeypatch.setattr(PAGE, "run_script", lambda *a, **k: ran.append(a) or {})
-    out = tmp_path / "page.md"
-    assert PAGE.main(["--only", "bench_benchmr", "--out", str(out), "--work", str(tmp_path / "w")]) == 0
-    assert ran == []
-    assert "Not run: it needs a Bench-MR checkout" in out.read_text()
-    cmd, _ = PAGE.quick_command("bench_benchmr", PAGE.os.path.join(PAGE.ROOT, "scripts", "bench_benchmr.py"),
-                                "x.json", "/some/checkout")
-    assert cmd[cmd.index("--bench-mr") + 1] == "/some/checkout" and "--figures" in cmd and "--out-json" in cmd
