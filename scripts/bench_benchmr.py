@@ -503,6 +503,10 @@ def main(argv=None) -> int:
         return 0
     if args.quick:
         args.seeds, args.time, args.rows = 1, 3.0, 3
+    from benchutil import check_json, write_json
+
+    check_json(args.json, [os.path.join(args.bench_mr, "bin", d) for d in ("polygon_mazes", "moving_ai_scenarios")
+                           if os.path.isdir(os.path.join(args.bench_mr, "bin", d))])  # (never over the checkout's files)
     peer = not args.no_peer
     load = os.getloadavg()
     print(f"load average at start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f} ({os.cpu_count()} CPUs)")
@@ -568,9 +572,8 @@ def main(argv=None) -> int:
     if args.figures:
         figures(problems, args.figures, args.time)
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump({"rows": rows, "worlds": worlds, "load_start": list(load), "load_end": list(os.getloadavg()),
-                       "results": [{k: v for k, v in r.items() if k != "sc"} for r in results]}, fh, indent=1)
+        write_json(args.json, {"rows": rows, "worlds": worlds, "load_start": list(load), "load_end": list(os.getloadavg()),
+                               "results": [{k: v for k, v in r.items() if k != "sc"} for r in results]})
     return 0
 
 

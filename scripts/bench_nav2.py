@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import os
 import random
@@ -322,7 +321,9 @@ def main(argv=None) -> int:
     if args.pairs is None:
         args.pairs = 10 if args.quick else 100
     yaml_path = find_map(args.nav2)
-    from benchutil import coal_peer
+    from benchutil import check_json, coal_peer, write_json
+
+    check_json(args.json, [os.path.dirname(yaml_path)])  # (never over the map's files)
 
     peer = coal_peer(not args.no_peer)
     from planners.core.plan import build_cspace
@@ -346,8 +347,7 @@ def main(argv=None) -> int:
             del probe
         out[space] = run_space(space, sc, cs, prep, pairs, judge, peer, args.time)
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(out, fh, indent=1)
+        write_json(args.json, out)
     return 0
 
 

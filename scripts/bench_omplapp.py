@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import json
 import os
 import statistics
 import sys
@@ -173,15 +172,22 @@ def main(argv=None) -> int:
                                                    "comma-separated words (e.g. Maze,BugTrap)")
     ap.add_argument("--json", "--out-json", dest="json", metavar="FILE", help="write the rows and runs as JSON")
     args = ap.parse_args(argv)
+    if args.seeds < 1 or not args.time > 0 or args.repeats < 1:
+        ap.error(f"--seeds and --repeats: at least 1, --time: above 0 (got {args.seeds}, {args.repeats}, {args.time})")
     folder = resources(args.omplapp)
     if folder is None:
         print(f"no OMPL.app checkout at {args.omplapp!r} (give --omplapp DIR or set OMPLAPP): nothing run")
         return 0
+    from benchutil import check_json, write_json
+
+    check_json(args.json, [folder])  # (never over the checkout's files)
     if importlib.util.find_spec("coal") is None:
         print("coal is not installed (pip install coal, or the bench extra): nothing run")
         return 0
     words = [w for w in args.problems.split(",") if w]
     files = [f for f in PROBLEMS if os.path.isfile(os.path.join(folder, f)) and (not words or any(w in f for w in words))]
+    if words and not files:
+        ap.error(f"--problems: no problem of {', '.join(PROBLEMS)} matches {args.problems!r}")
     load = os.getloadavg()
     print(f"load average at start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f} ({os.cpu_count()} CPUs)")
     skipped = [f for f in KINODYNAMIC if os.path.isfile(os.path.join(folder, f))]
@@ -209,9 +215,8 @@ def main(argv=None) -> int:
           f"coal's paths rejected {sum(r['coal_colliding'] for r in rows)}, undecided "
           f"{sum(r['coal_undecided'] for r in rows)}; ours not sound {len(faults)}")
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump({"rows": rows, "skipped": skipped, "seeds": args.seeds, "time": args.time,
-                       "load_start": list(load), "load_end": list(os.getloadavg()), "results": results}, fh, indent=1)
+        write_json(args.json, {"rows": rows, "skipped": skipped, "seeds": args.seeds, "time": args.time,
+                               "load_start": list(load), "load_end": list(os.getloadavg()), "results": results})
     return 1 if faults else 0
 
 

@@ -2,7 +2,10 @@
 folder on ``sys.path`` before importing it)."""
 from __future__ import annotations
 
+import json
+import os
 import statistics
+import sys
 import time
 
 
@@ -34,6 +37,39 @@ def coal_peer(wanted: bool) -> bool:
         print("coal is not installed (pip install coal, or the bench extra): the peer is skipped")
         return False
     return True
+
+
+def check_json(path: str | None, inputs=()) -> None:
+    """Before any work: refuse a ``--json`` path that names one of the run's ``inputs`` (files, or
+    folders standing for every file in them: another project's checkout), a folder or an unwritable
+    place, in one line, exit 2 (:func:`planners.output.check_output`, the CLI's own check).
+
+    >>> check_json(None), check_json("out.json")
+    (None, None)
+    """
+    if path is None:
+        return
+    from planners.errors import InputError
+    from planners.output import check_output
+
+    files = []
+    for p in inputs:
+        files += [os.path.join(p, f) for f in sorted(os.listdir(p))] if os.path.isdir(p) else [p]
+    try:
+        check_output(path, "--json", inputs=files)
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+
+
+def write_json(path: str, data) -> None:
+    """Write a bench's figures as JSON, atomically (:func:`planners.output.atomic_path`): a run
+    stopped half-way leaves the old file, never half a new one."""
+    from planners.output import atomic_path
+
+    with atomic_path(path, "--json") as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            json.dump(data, fh, indent=1)
 
 
 def _clock(s: float) -> str:

@@ -50,6 +50,21 @@ def runs(*rows):
                      for k, (o, c, vo, vc) in enumerate(rows)]}
 
 
+@pytest.mark.parametrize("args, says", [
+    (["--json", "{cfg}"], "writing it would destroy it"), (["--json", "{dir}"], "is a directory"),
+    (["--seeds", "0"], "--seeds"), (["--time", "-1"], "--time"), (["--problems", "NoSuch"], "--problems")])
+def test_bad_options_and_a_json_over_the_checkout_are_refused_before_any_work(tmp_path, capsys, args, says):
+    # found by hand: --json over a problem's .cfg replaced it, and --seeds -1 ran nothing and said "met"
+    pytest.importorskip("coal")
+    d = checkout(tmp_path)
+    cfg = os.path.join(d, "BugTrap_planar.cfg")
+    before = {f: open(os.path.join(d, f), "rb").read() for f in os.listdir(d)}
+    with pytest.raises(SystemExit) as exc:
+        BENCH.main(["--omplapp", str(tmp_path)] + [a.format(cfg=cfg, dir=d) for a in args])
+    assert exc.value.code == 2 and says in capsys.readouterr().err
+    assert {f: open(os.path.join(d, f), "rb").read() for f in os.listdir(d)} == before
+
+
 def test_the_ratio_counts_coal_s_sound_seeds_and_the_target_is_checked():
     r = BENCH.summary(runs((1.0, 4.0, "sound", "sound"), (1.0, 1.0, "sound", "colliding"),
                            (3.0, 4.0, "sound", "sound"), (1.0, 8.0, "sound", "undecided"), (None, 2.0, None, "sound")))
