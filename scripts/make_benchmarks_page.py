@@ -172,6 +172,17 @@ def fmt(v) -> str:
     return str(v).replace("|", "\\|").replace("\n", " ")
 
 
+def md_cell(text) -> str:
+    r"""A name read from another project's file, safe in a Markdown table cell: its pipes,
+    backslashes, backticks, angle brackets and line breaks escaped.
+
+    >>> print(md_cell("a|b <x>`"))
+    a\|b &lt;x&gt;\`
+    """
+    out = str(text).replace("\\", "\\\\").replace("|", "\\|").replace("`", "\\`")
+    return out.replace("<", "&lt;").replace(">", "&gt;").replace("\r", " ").replace("\n", " ")
+
+
 def md_table(rows: list[dict]) -> str:
     """A Markdown table of dict rows (columns in first-seen order).
 
@@ -252,7 +263,7 @@ def benchmr_lines(rec: dict) -> list[str]:
              "ours / peer, medians | means |", "|" + "---|" * 15]
     for r in data["rows"]:
         lines.append("| " + " | ".join([
-            r["world"], r["space"], str(r["runs"]) + (f" ({r['left_out']} rows left out)" if r.get("left_out") else ""),
+            md_cell(r["world"]), r["space"], str(r["runs"]) + (f" ({r['left_out']} rows left out)" if r.get("left_out") else ""),
             ms(r.get("prep_s")), f"{r['ours_solved']} ({r['proven_unsolvable']})", str(len(r.get("undecided_queries", []))),
             str(r["ours_colliding"]), ms(r["ours_median_s"]), ms(r["ours_mean_s"]), str(r.get("peer_solved", "-")),
             str(r.get("peer_colliding", "-")), ms(r.get("peer_median_s")), ms(r.get("peer_mean_s")),
@@ -261,9 +272,9 @@ def benchmr_lines(rec: dict) -> list[str]:
     if proven:
         lines += ["", "Proven unsolvable (runs; every proof re-checked by `cspace check-proof`'s independent checker; "
                   "a Dubins car's is the reach proof of one end, closed under its forward steps):", ""]
-        lines += [f"- {r['world']} {r['space']}: {r['proven_unsolvable']} runs, {r.get('proofs_accepted', '-')} proofs "
+        lines += [f"- {md_cell(r['world'])} {r['space']}: {r['proven_unsolvable']} runs, {r.get('proofs_accepted', '-')} proofs "
                   f"accepted, median {ms(r.get('proven_proof_median_s'))} CPU for the proofs" for r in proven]
-    undecided = [(r["world"], r["space"], q, r.get("boxed_in", {}).get(str(q))) for r in data["rows"]
+    undecided = [(md_cell(r["world"]), r["space"], q, r.get("boxed_in", {}).get(str(q))) for r in data["rows"]
                  for q in r.get("undecided_queries", [])]
     if undecided:
         lines += ["", "Undecided: neither a path nor a proof within the time limit (for a Dubins car, neither the SE(2) "
@@ -273,14 +284,14 @@ def benchmr_lines(rec: dict) -> list[str]:
         lines += [f"- {w} {sp} query {q}: {why or 'no lattice evidence either'}" for w, sp, q, why in undecided]
     lines += ["", "Ours / the peer per world (both car models; the runs both solve with the peer's path sound), "
               "target <= 0.5x:", "", "| world | runs | medians | means |", "|---|---|---|---|"]
-    lines += [f"| {w['world']} | {w['sound_runs']} | {x(w['ratio_median'])} | {x(w['ratio_mean'])} |"
+    lines += [f"| {md_cell(w['world'])} | {w['sound_runs']} | {x(w['ratio_median'])} | {x(w['ratio_mean'])} |"
               for w in data.get("worlds", [])]
     checked = [r for r in data["rows"] if r.get("peer_recheck")]
     if checked:
         lines += ["", "The peer's paths (each called collision-free by its discrete check at Bench-MR's 0.005), "
                   "written in Bench-MR's results format and re-checked by `cspace recheck`'s routine:", "",
                   "| world | car | peer's paths | colliding |", "|---|---|---|---|"]
-        lines += [f"| {r['world']} | {r['space']} | {r['peer_recheck']['paths']} | {r['peer_recheck']['colliding']} |"
+        lines += [f"| {md_cell(r['world'])} | {r['space']} | {r['peer_recheck']['paths']} | {r['peer_recheck']['colliding']} |"
                   for r in checked]
     figures = sorted(glob.glob(os.path.join(ROOT, BENCH_MR_FIGURES, "*.png")))
     if figures:
@@ -321,7 +332,7 @@ def omplapp_lines(rec: dict) -> list[str]:
               "|" + "---|" * 13]
     for r in data["rows"]:
         lines.append("| " + " | ".join([
-            r["problem"], str(r["vertices"]), ms(r["prep_s"]), f"{r['ours_solved']}/{r['seeds']}", ms(r["ours_median_s"]),
+            md_cell(r["problem"]), str(r["vertices"]), ms(r["prep_s"]), f"{r['ours_solved']}/{r['seeds']}", ms(r["ours_median_s"]),
             str(r["ours_not_sound"]), f"{r['coal_solved']}/{r['seeds']}", ms(r["coal_median_s"]),
             str(r["coal_colliding"]), str(r["coal_undecided"]), x(r["ratio_sound"]) + f" ({r['sound_seeds']} seeds)",
             x(r["ratio_all"]), "met" if r["target_met"] else "**MISSED**"]) + " |")

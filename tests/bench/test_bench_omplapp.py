@@ -126,3 +126,7 @@ def test_the_page_shows_the_table(tmp_path):
     text = "\n".join(PAGE.omplapp_lines({"json": str(tmp_path / "o.json"), "stdout": ""}))
     assert "| p | 4 | 100.0 ms | 2/2 | 15.0 ms | 0 | 2/2 | 25.0 ms | 1 | 0 | 0.25x (1 seeds) | 1.12x | met |" in text
     assert "1.50, 1.25, 1.00" in text and "`Maze_kcar.cfg`" in text
+    # a name read from the checkout's file is escaped in the table (a pipe would cut the row)
+    (tmp_path / "o.json").write_text(json.dumps({"rows": [dict(row, problem="a|b<i>")], "seeds": 2}))
+    text = "\n".join(PAGE.omplapp_lines({"json": str(tmp_path / "o.json"), "stdout": ""}))
+    assert "| a\\|b&lt;i&gt; | 4 |" in text
