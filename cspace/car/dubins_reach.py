@@ -49,10 +49,15 @@ FORMAT = "cspace-dubins-proof/1"
 # Resolutions tried in turn (step s as a fraction of r; cell side h = FACTOR s^2 / r, the two
 # leaks per unit length balanced): coarse first, so a car that is not confined pays little.
 STEPS = (0.07, 0.05)
+FINE_STEP = 0.04   # a last, finer try where an end looks boxed in (planners.core.auto_dubins)
 CELL_FACTOR = 1.0
-SLAB_OVER = 1.08   # slab width = this x s / r: a step reaches its own slab and its two neighbours
+# slab width >= this x s / r: a step reaches its own slab and its two neighbours only. The reach
+# gains a slab's width of heading per step where the car turns s / r: this ratio is how much
+# tighter than r the over-approximated car turns (1.08 let a car facing a rack 0.8 m ahead, which
+# cannot turn at r = 0.5 m, turn out at r / 1.08 in the reach: no proof)
+SLAB_OVER = 1.01
 WINDOW = 2.0       # the window's half side, in turning radii (at least 3 robot radii)
-WINDOW_CELLS = 256  # ... and at most this many cells
+WINDOW_CELLS = 256  # ... and at most this many cells of the step (of the first of STEPS, at a finer one)
 MAX_CELLS = 60_000  # region cells summed over the slabs at the first step: past this, no proof
 ERODE = 1.0 / math.cos(math.pi / 32)  # a round buffer's chords (8 per quarter) lie inside its circle
 
@@ -220,13 +225,14 @@ def _stencil_of(K: int, k: int, s: float, r: float, sign: float, h: float) -> np
 
 
 def _attempt(regions, start, goal, r: float, s: float, backward: bool, deadline, max_cells: int):
-    K = int(math.ceil(2.0 * math.pi / (SLAB_OVER * s / r)))
+    K = int(math.floor(2.0 * math.pi / (SLAB_OVER * s / r)))  # the most slabs at least that wide
     h = CELL_FACTOR * s * s / r
     sign = -1.0 if backward else 1.0
     seed, other = (goal, start) if backward else (start, goal)
     xmin, xmax, ymin, ymax = regions.bounds
     o = (xmin, ymin)
-    half = min(max(WINDOW * r, 3.0 * regions.radius), WINDOW_CELLS * h)
+    # the window: at most WINDOW_CELLS cells of this step, or of the first of STEPS when finer
+    half = min(max(WINDOW * r, 3.0 * regions.radius), WINDOW_CELLS * max(h, CELL_FACTOR * STEPS[0] ** 2 * r))
     i0 = int(math.floor((seed[0] - half - o[0]) / h))
     j0 = int(math.floor((seed[1] - half - o[1]) / h))
     n = int(math.ceil(2 * half / h)) + 1
@@ -341,12 +347,14 @@ def runs(cells: np.ndarray, i0: int, j0: int) -> list:
     rows = np.flatnonzero(cells.any(axis=1))
     if not len(rows):
         return []
-    pad = np.zeros((len(rows), cells.shape[1] + 2), np.int8)
-    pad[:, 1:-1] = cells[rows]
+    cols = np.flatnonzero(cells[rows].any(axis=0))
+    c0, c1 = int(cols[0]), int(cols[-1]) + 1  # only the columns that hold cells
+    pad = np.zeros((len(rows), c1 - c0 + 2), np.int8)
+    pad[:, 1:-1] = cells[rows, c0:c1]
     d = np.diff(pad, axis=1)  # +1 where a run starts, -1 one past its end; row-major: they pair up
     ri, a = np.nonzero(d == 1)
     _, b = np.nonzero(d == -1)
-    return np.column_stack([rows[ri] + i0, a + j0, b + j0]).tolist()
+    return np.column_stack([rows[ri] + i0, a + c0 + j0, b + c0 + j0]).tolist()
 
 
 def _json(regions, start, goal, r, s, h, o, i0, j0, slabs, R, targets, backward) -> dict:

@@ -16,7 +16,7 @@ from .result import PlanResult
 
 REACH_SHARE = 0.2  # of the time limit, at most, for both ends together
 REACH_MAX = 3.0    # seconds, at most, whatever the limit (the cells' cap ends it first on the scenes we know)
-# C-space -> the (start, goal) pairs whose two attempts ran to their end without a proof (each is
+# C-space -> the (start, goal, backward) whose attempts ran to their end without a proof (each is
 # deterministic: the same regions and cap answer the same); an attempt cut by time is not kept.
 _NO_REACH: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -31,23 +31,27 @@ def reach_budget(time_limit: float) -> float:
     return min(REACH_SHARE * max(float(time_limit), 0.0), REACH_MAX)
 
 
-def reach_result(sc, cspace, regions, query, budget: float) -> PlanResult | None:
+def reach_result(sc, cspace, regions, query, budget: float, ends: tuple = ("start", "goal"),
+                 steps: tuple | None = None) -> PlanResult | None:
     """A "proven unsolvable" result with its proof (format ``cspace-dubins-proof/1``) where the
     reach of the start, or of the goal driving backward, is confined away from the other end;
     None otherwise (not a Dubins car, a point robot, the reach not confined within the cap, or
     ``budget`` seconds spent). ``regions``: the C-space's slab regions
-    (:func:`planners.core.exact_se2.slab_regions_of`), whose POSSIBLE the reach reads."""
+    (:func:`planners.core.exact_se2.slab_regions_of`), whose POSSIBLE the reach reads; ``ends``:
+    the reaches tried ("start": forward from it, "goal": backward from it), an end already tried
+    on this query to its end is not tried again; ``steps``: the resolutions tried, coarse first
+    (default :data:`cspace.car.dubins_reach.STEPS`)."""
     from cspace.car.dubins_reach import MAX_CELLS, STEPS, reach_proof
 
+    steps = STEPS if steps is None else tuple(steps)
     if sc.space != "dubins" or not cspace.body_pieces or tuple(query.start) == tuple(query.goal):
         return None
     key = (tuple(map(float, query.start)), tuple(map(float, query.goal)))
     tried = _NO_REACH.setdefault(cspace, set())
-    if key in tried:
-        return None
+    sides = [e == "goal" for e in ("start", "goal") if e in ends and key + (e == "goal",) not in tried]
     t0 = time.perf_counter()
     deadline = t0 + budget
-    for frac, backward in ((f, b) for f in STEPS for b in (False, True)):  # coarse first, either end
+    for frac, backward in ((f, b) for f in steps for b in sides):  # coarse first, either end
         proof = reach_proof(regions, query.start, query.goal, float(sc.turning_radius), backward=backward,
                             deadline=deadline, steps=(frac,), max_cells=int(MAX_CELLS * (STEPS[0] / frac) ** 4))
         if proof is not None:
@@ -63,5 +67,5 @@ def reach_result(sc, cspace, regions, query, budget: float) -> PlanResult | None
                                       f"slabs, is closed under the car's steps of {proof['step']:g} and keeps the "
                                       f"{other} out)")
     if time.perf_counter() <= deadline:
-        tried.add(key)
+        tried.update(key + (b,) for b in sides)
     return None

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import planners
+from car_scenes import wall_scene
 from conftest import SCENARIOS, load_script
 from cspace.car.curves import dubins_segments
 from cspace.io.load import load_scenario, scenario_from_dict
@@ -148,3 +149,37 @@ def test_a_tiny_turning_radius_keeps_a_restart_range_of_an_eighth_of_ompl_s(monk
     monkeypatch.setattr(auto, "SLICE_ITERATIONS", 2)  # a slice that cannot answer: the restarts do
     res = planners.plan(sc, cspace=cs, seed=0, iterations=6000, time=1000.0)
     assert res.solved and res.answered_by == "sampling", res.message
+
+
+def test_a_boxed_in_start_is_proven_before_any_restart(monkeypatch):
+    # A car facing a wall it cannot turn away from (tests/helpers/car_scenes.py): its lattice stops
+    # at a few dozen poses, so its reach proof runs right after the slice, not after 14 000
+    # iterations of restarts that cannot answer; check-proof's checker accepts it.
+    seen = _record(monkeypatch)
+    sc = wall_scene(1.5)
+    res = planners.plan(sc, seed=0, time=60.0)
+    assert res.proven_unsolvable and res.answered_by == "proof", res.message
+    assert len(seen) == 1 and seen[0][1] == auto.SLICE_ITERATIONS, seen  # the slice alone sampled
+    assert check_dubins_proof(sc, res.proof).valid
+
+
+def test_ends_in_the_open_are_never_given_a_reach_proof(monkeypatch):
+    # The hall: start and goal in the open. The slice made to fail and the reach stage moved to
+    # the first restart: their lattices run to the cap, so no reach proof is tried (one would fail
+    # after 0.1-0.2 s on a large map); the restarts answer.
+    from planners.core import dubins_proof
+
+    calls = []
+    real = dubins_proof.reach_result
+    monkeypatch.setattr(dubins_proof, "reach_result", lambda *a, **k: calls.append(k) or real(*a, **k))
+    monkeypatch.setattr(auto, "SLICE_ITERATIONS", 2)
+    monkeypatch.setattr(auto_dubins, "FIRST_RESTART", 20)
+    monkeypatch.setattr(auto_dubins, "REACH_AFTER", 1)
+    monkeypatch.setattr(auto_dubins, "QUICK_AFTER", 99)
+    monkeypatch.setattr(auto_dubins, "LATE_CAP", 200)
+    asked = []
+    boxed = auto_dubins.boxed_ends
+    monkeypatch.setattr(auto_dubins, "boxed_ends", lambda *a, **k: asked.append(a[-1] if len(a) > 3 else k) or boxed(*a, **k))
+    res = planners.plan(_hall(), seed=3, time=60.0)
+    assert res.solved and res.answered_by == "sampling", res.message
+    assert len(asked) == 2 and calls == [], (asked, calls)  # early (BOXED_CAP) and at the first restart (LATE_CAP)

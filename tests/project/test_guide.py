@@ -69,3 +69,34 @@ def test_documented_options_exist(command):
     assert documented, command
     assert documented <= offered, f"documented but not offered: {sorted(documented - offered)}"
     assert offered - {"--help"} <= documented, f"offered but not documented: {sorted(offered - documented)}"
+
+
+def quoted_runs() -> list:
+    """(shell block, quoted output, its line) for every ```sh block the guide follows with
+    "prints `...`" (or "It prints"): what that block's commands must print."""
+    out = []
+    for m in re.finditer(r"```sh\n((?:(?!```).)*)```\n\n(?:It )?prints `([^`]*)`", guide(), re.S):
+        out.append(pytest.param(m.group(1), m.group(2), id=f"line{guide()[:m.start()].count(chr(10)) + 1}"))
+    return out
+
+
+@pytest.mark.parametrize("block, quoted", quoted_runs())
+def test_shell_blocks_print_what_the_guide_quotes(block, quoted, tmp_path):
+    # Each command of the block runs as written (from the repository, its files written into
+    # tmp_path); the quote, its line breaks as spaces and "(...)" / "..." standing for any text,
+    # is found in what the block printed.
+    printed = ""
+    for line in block.splitlines():
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        args = line.split()
+        assert args[0] == "cspace", line
+        args = [os.path.join(ROOT, a) if a.startswith("scenarios/") else a for a in args[1:]]
+        proc = subprocess.run([sys.executable, "-c", "from planners.cli import main; import sys; sys.exit(main())",
+                               *args], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+        assert proc.returncode in (0, 1), (line, proc.stderr)
+        printed += proc.stdout
+    pattern = ".*?".join(re.escape(part) for part in re.split(r"\(\.\.\.\)|\.\.\.", " ".join(quoted.split())))
+    assert re.search(pattern, " ".join(printed.split())), (quoted, printed)
+    assert len(quoted_runs()) >= 3
