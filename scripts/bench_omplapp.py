@@ -181,13 +181,13 @@ def main(argv=None) -> int:
     from benchutil import check_json, write_json
 
     check_json(args.json, [folder])  # (never over the checkout's files)
-    if importlib.util.find_spec("coal") is None:
-        print("coal is not installed (pip install coal, or the bench extra): nothing run")
-        return 0
     words = [w for w in args.problems.split(",") if w]
     files = [f for f in PROBLEMS if os.path.isfile(os.path.join(folder, f)) and (not words or any(w in f for w in words))]
     if words and not files:
         ap.error(f"--problems: no problem of {', '.join(PROBLEMS)} matches {args.problems!r}")
+    if importlib.util.find_spec("coal") is None:  # (every option checked first: a bad one is refused anyway)
+        print("coal is not installed (pip install coal, or the bench extra): nothing run")
+        return 0
     load = os.getloadavg()
     print(f"load average at start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f} ({os.cpu_count()} CPUs)")
     skipped = [f for f in KINODYNAMIC if os.path.isfile(os.path.join(folder, f))]
