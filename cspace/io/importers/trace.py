@@ -48,8 +48,10 @@ def regions(blocked: np.ndarray, max_vertices: int = REGION_VERTICES) -> list[tu
     [(0, 4, 0, 4)]
     """
     c = corner_points(blocked)
+    if int(np.count_nonzero(c)) <= max_vertices:  # the whole grid is one region: no prefix sums
+        return [(0, blocked.shape[0], 0, blocked.shape[1])]
     s = np.zeros((c.shape[0] + 1, c.shape[1] + 1), dtype=np.int64)
-    s[1:, 1:] = c.cumsum(0).cumsum(1)
+    s[1:, 1:] = c.cumsum(0, dtype=np.int64).cumsum(1)
 
     def count(y0, y1, x0, x1):  # corner points of cells [y0, y1) x [x0, x1): its (y1-y0+1) x (x1-x0+1) points
         return int(s[y1 + 1, x1 + 1] - s[y0, x1 + 1] - s[y1 + 1, x0] + s[y0, x0])
@@ -108,8 +110,8 @@ def trace_rings(blocked: np.ndarray):
     )
     start, end, cell, kind = [], [], [], []
     for k, (mask, (sy, sx), (ey, ex)) in enumerate(kinds):
-        ys, xs = np.nonzero(mask)
-        ys, xs = ys + 1, xs + 1
+        flat = np.flatnonzero(mask)  # (one pass over the grid, faster than a 2-D nonzero)
+        ys, xs = flat // w + 1, flat % w + 1
         start.append((ys + sy) * W + xs + sx)
         end.append((ys + ey) * W + xs + ex)
         cell.append(ys * (w + 2) + xs)
@@ -118,11 +120,11 @@ def trace_rings(blocked: np.ndarray):
     n = len(start)
     if n == 0:
         return np.zeros((0, 2)), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0)
-    out_at = np.full((h + 3) * W, -1, dtype=np.int64)
+    out_at = np.full((h + 3) * W, -1, dtype=np.int32 if n < 2**31 else np.int64)  # (half the bytes to fill)
     out_at[start] = np.arange(n)
-    if (out_at >= 0).sum() != n:  # two edges leave one point
+    if np.count_nonzero(out_at >= 0) != n:  # two edges leave one point
         raise ValueError("blocked cells touch at a corner only: fill_corner_touches first")
-    nxt = out_at[end]
+    nxt = out_at[end].astype(np.int64)
     # Ring labels (the smallest edge of each cycle) and each edge's distance to its ring's
     # last edge, by pointer doubling: O(n log n).
     lab, jump = np.arange(n), nxt.copy()
