@@ -33,8 +33,8 @@ as scripts/bench_nav2.py runs Nav2's map (its ``prepare_space`` and ``run_space`
 first slabs with room, and their links), counted; slabs and the other regions built on first use,
 inside the queries that need them, and counted there; per pair ``plan()`` with the default planner
 (``auto``), its unshortened first path, and OMPL + coal; each car path judged along its curves.
-Targets (issue 47, Reeds-Shepp): preparation <= 2 s, mean <= 45 ms, p95 <= 100 ms, every query
-answered, 0 colliding (Dubins reported beside).
+Targets (issue 47, "the same targets for cars": Reeds-Shepp and Dubins): preparation <= 2 s,
+mean <= 45 ms, p95 <= 100 ms, every query answered (a path or a proof), 0 colliding.
 
 Usage: python scripts/bench_warehouse.py [--pairs N] [--size CELLS] [--time S] [--planners A,B]
        [--spaces se2,reeds-shepp,dubins] [--radius R] [--no-peer] [--json FILE]
