@@ -14,6 +14,7 @@ from __future__ import annotations
 import builtins
 import json
 import os
+import sys
 
 import pytest
 
@@ -55,6 +56,8 @@ CASES = [
     ("bench_shortest", "--plot", [], ["measure"], None),
     ("bench_startup", "--out-json", [], ["run"], "basic.toml"),
     ("bench_warehouse", "--json", ["--no-peer"], ["wh.write", "se2_run"], None),
+    ("bench_gjk", "--plot", [], ["make_pairs"], None),
+    ("make_example_map", "--out", [], ["office"], None),
 ]
 IDS = [f"{c[0]}{c[1]}{''.join(c[2])}" for c in CASES]
 
@@ -62,9 +65,9 @@ IDS = [f"{c[0]}{c[1]}{''.join(c[2])}" for c in CASES]
 def closed(monkeypatch, mod, work) -> None:
     """``mod``'s work raises, and so does every write it could make (its ``open`` for writing, the
     atomic writers): a script that does not check its output fails here, writing nothing."""
-    import benchutil
     import planners.output
 
+    benchutil = sys.modules.get("benchutil") or load_script("benchutil")  # the one the scripts import
     for name in work:
         owner, _, attr = name.rpartition(".")
         monkeypatch.setattr(getattr(mod, owner) if owner else mod, attr, raiser)
@@ -175,23 +178,29 @@ def test_the_figures_are_written_atomically(tmp_path, capsys, monkeypatch, name,
     assert json.loads(out.read_text()) == expected and os.listdir(tmp_path) == ["figures.json"]
 
 
-def test_fuzz_inputs_refuses_an_out_folder_that_is_a_file_before_any_work(tmp_path, capsys, monkeypatch):
-    mod = script("fuzz_inputs")
-    closed(monkeypatch, mod, ["run_files"])
+@pytest.mark.parametrize("name, option, work", [("fuzz_inputs", "--out", ["run_files"]),
+                                                 ("make_warehouse_map", "--out", ["warehouse", "write"]),
+                                                 ("noisy_map", "OUT_DIR", ["noisy_image", "write_map"])])
+def test_an_output_folder_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, monkeypatch, name, option, work):
+    mod = script(name)
+    closed(monkeypatch, mod, work)
     f = tmp_path / "summary.json"
     f.write_bytes(b"kept")
     with pytest.raises(SystemExit) as exc:
-        mod.main(["--out", str(f)])
+        mod.main([str(f)] if option == "OUT_DIR" else [option, str(f)])
     err = capsys.readouterr().err.strip().splitlines()
-    assert exc.value.code == 2 and len(err) == 1 and "--out" in err[0] and "not a folder" in err[0], err
-    assert f.read_bytes() == b"kept"
+    assert exc.value.code == 2 and len(err) == 1 and option in err[0] and "not a folder" in err[0], err
+    assert f.read_bytes() == b"kept" and os.listdir(tmp_path) == ["summary.json"]
 
 
-def test_the_view_screenshot_is_checked_before_planning(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("name, shoot, work", [
+    ("make_view_screenshots", "bar_door_screenshot", ["Browser"]),
+    ("make_arena_screenshot", "arena_screenshot", ["_browser_module", "make_database", "start_arena"])])
+def test_a_screenshot_is_checked_before_any_work(tmp_path, capsys, monkeypatch, name, shoot, work):
     import planners
 
-    mod = script("make_view_screenshots")
-    closed(monkeypatch, mod, ["Browser"])
+    mod = script(name)
+    closed(monkeypatch, mod, work)
     monkeypatch.setattr(planners, "plan", raiser)
     scene = os.path.join(SCENARIOS, "se2", "bar_door.toml")
     before = open(scene, "rb").read()
@@ -200,7 +209,7 @@ def test_the_view_screenshot_is_checked_before_planning(tmp_path, capsys, monkey
     for out, says in ((str(folder), "is a directory"), (scene, "unsupported extension"),
                       (str(tmp_path / "shot.jpg"), "unsupported extension")):
         with pytest.raises(SystemExit) as exc:
-            mod.bar_door_screenshot(out)
+            getattr(mod, shoot)(out)
         err = capsys.readouterr().err.strip().splitlines()
         assert exc.value.code == 2 and len(err) == 1 and says in err[0], err
     assert open(scene, "rb").read() == before and os.listdir(tmp_path) == ["shot.png"] and os.listdir(folder) == []
