@@ -58,6 +58,10 @@ CASES = [
     ("bench_warehouse", "--json", ["--no-peer"], ["wh.write", "se2_run"], None),
     ("bench_gjk", "--plot", [], ["make_pairs"], None),
     ("make_example_map", "--out", [], ["office"], None),
+    ("make_benchmarks_page", "--out", ["--only", "bench_gjk"], ["run_script", "run_planner_sweep", "machine_note"],
+     "basic.toml"),
+    ("make_benchmarks_page", "--out", ["--only", "bench_gjk"], ["run_script", "run_planner_sweep", "machine_note"],
+     "maps/office.yaml"),
 ]
 IDS = [f"{c[0]}{c[1]}{''.join(c[2])}" for c in CASES]
 
@@ -180,7 +184,10 @@ def test_the_figures_are_written_atomically(tmp_path, capsys, monkeypatch, name,
 
 @pytest.mark.parametrize("name, option, work", [("fuzz_inputs", "--out", ["run_files"]),
                                                  ("make_warehouse_map", "--out", ["warehouse", "write"]),
-                                                 ("noisy_map", "OUT_DIR", ["noisy_image", "write_map"])])
+                                                 ("noisy_map", "OUT_DIR", ["noisy_image", "write_map"]),
+                                                 ("make_figures", "--out", ["draw_figure"]),
+                                                 ("make_benchmarks_page", "--work", ["run_script", "run_planner_sweep",
+                                                                                     "machine_note"])])
 def test_an_output_folder_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, monkeypatch, name, option, work):
     mod = script(name)
     closed(monkeypatch, mod, work)
