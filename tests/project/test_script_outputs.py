@@ -1,7 +1,9 @@
-"""Every bench script's output files are checked before any work and written atomically
+"""Every script's output files (the benches', and those of the scripts that make figures, maps,
+screenshots and the benchmarks page) are checked before any work and written atomically
 (scripts/benchutil.py: ``check_out``, ``check_json``, ``write_json``), as the CLI's are: an output
-option pointed at a folder, or at one of the run's inputs (a bundled scenario), is one line naming
-the option, exit 2, the input unchanged; a run stopped half-way through writing leaves the old file.
+option pointed at a folder (an output folder at a file), or at one of the run's inputs (a bundled
+scenario), is one line naming the option, exit 2, the input unchanged; a run stopped half-way
+through writing leaves the old file. (Here, beside the other checks across scripts/.)
 
 Found by reading the scripts: they wrote with a plain ``open(path, "w")`` after the whole run, so
 ``--json scenarios/se2/bar_door.toml`` replaced a bundled scene and a folder was a traceback after
