@@ -189,17 +189,23 @@ def test_the_figures_are_written_atomically(tmp_path, capsys, monkeypatch, name,
                                                  ("noisy_map", "OUT_DIR", ["noisy_image", "write_map"]),
                                                  ("make_figures", "--out", ["draw_figure"]),
                                                  ("make_benchmarks_page", "--work", ["run_script", "run_planner_sweep",
-                                                                                     "machine_note"])])
+                                                                                     "machine_note"]),
+                                                 ("bench_benchmr", "--figures", ["polygon_problems", "figures"])])
 def test_an_output_folder_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, monkeypatch, name, option, work):
     mod = script(name)
     closed(monkeypatch, mod, work)
     f = tmp_path / "summary.json"
     f.write_bytes(b"kept")
+    args = [str(f)] if option == "OUT_DIR" else [option, str(f)]
+    if name == "bench_benchmr":  # an (empty) checkout, or it runs nothing
+        (tmp_path / "bm" / "bin" / "polygon_mazes").mkdir(parents=True)
+        args += ["--bench-mr", str(tmp_path / "bm")]
     with pytest.raises(SystemExit) as exc:
-        mod.main([str(f)] if option == "OUT_DIR" else [option, str(f)])
+        mod.main(args)
     err = capsys.readouterr().err.strip().splitlines()
     assert exc.value.code == 2 and len(err) == 1 and option in err[0] and "not a folder" in err[0], err
-    assert f.read_bytes() == b"kept" and os.listdir(tmp_path) == ["summary.json"]
+    assert f.read_bytes() == b"kept"
+    assert set(os.listdir(tmp_path)) == ({"summary.json", "bm"} if name == "bench_benchmr" else {"summary.json"})
 
 
 @pytest.mark.parametrize("name, shoot, work", [
