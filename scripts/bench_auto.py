@@ -15,6 +15,7 @@
 Side by side with OMPL + coal: ``python scripts/bench_se2.py --parts P --planners auto``.
 
 Usage: python scripts/bench_auto.py [--parts SC] [--seeds N | --quick] [--limit S] [--json FILE]
+(--json is checked before any work, never over a bundled scene, and written atomically.)
 
 >>> ratio(0.3, 0.15, 0.5)
 2.0
@@ -25,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import glob
-import json
 import math
 import os
 import statistics
@@ -113,6 +113,9 @@ def main(argv=None) -> int:
     ap.add_argument("--limit", type=float, default=10.0, help="seconds per plan")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args(argv)
+    from benchutil import check_json, write_json
+
+    check_json(a.json, [os.path.join(ROOT, "scenarios", d) for d in ("se2", "car")])  # (never over a scene)
     if a.quick:
         a.seeds = 3
     out = {}
@@ -150,8 +153,7 @@ def main(argv=None) -> int:
                   f"{r['auto']['colliding'] + r['RRTConnect']['colliding']}")
         print(f"  the four manoeuvres: target {'met' if met else 'NOT met'}")
     if a.json:
-        with open(a.json, "w") as fh:
-            json.dump(out, fh, indent=1, default=lambda x: None if isinstance(x, float) and math.isnan(x) else x)
+        write_json(a.json, out, default=lambda x: None if isinstance(x, float) and math.isnan(x) else x)
     return 0
 
 

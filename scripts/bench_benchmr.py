@@ -503,10 +503,11 @@ def main(argv=None) -> int:
         return 0
     if args.quick:
         args.seeds, args.time, args.rows = 1, 3.0, 3
-    from benchutil import check_json, write_json
+    from benchutil import check_json, check_out, write_json
 
     check_json(args.json, [os.path.join(args.bench_mr, "bin", d) for d in ("polygon_mazes", "moving_ai_scenarios")
                            if os.path.isdir(os.path.join(args.bench_mr, "bin", d))])  # (never over the checkout's files)
+    check_out(args.figures, (), "--figures", folder=True)  # (created now, not after the runs)
     peer = not args.no_peer
     load = os.getloadavg()
     print(f"load average at start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f} ({os.cpu_count()} CPUs)")

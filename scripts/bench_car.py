@@ -20,12 +20,12 @@
     ``cspace plan``); solved count, median solve time and length, each path judged.
 
 Usage: python scripts/bench_car.py [--quick] [--parts MT] [--json FILE]
+(--json is checked before any work, never over a bundled scene, and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
 import glob
-import json
 import math
 import os
 import statistics
@@ -146,6 +146,9 @@ def main(argv=None) -> int:
     ap.add_argument("--parts", default="MT")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args(argv)
+    from benchutil import check_json, write_json
+
+    check_json(a.json, [CAR_DIR])  # (never over a scene)
     out = {}
     if "M" in a.parts:
         out["motions"] = part_m(m=60 if a.quick else 400)
@@ -174,8 +177,7 @@ def main(argv=None) -> int:
             print(f"  {r['scene']:14} {r['space']:12} solved {r['solved']}/{r['seeds']}  median first solution {ms}"
                   f"  median length {ml}  colliding paths {r['colliding_paths']}")
     if a.json:
-        with open(a.json, "w") as fh:
-            json.dump(out, fh, indent=1)
+        write_json(a.json, out)
     return 0
 
 

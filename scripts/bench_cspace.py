@@ -43,11 +43,11 @@
     after pruning.
 
 Usage: python scripts/bench_cspace.py [--quick] [--out-json rows.json] [--parts ABC]
+(--out-json is checked before any work, never over a bundled scenario, and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import pathlib
@@ -506,6 +506,9 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out-json", default=None, help="write all rows as JSON")
     args = ap.parse_args(argv)
+    from benchutil import check_json, write_json
+
+    check_json(args.out_json, [ROOT / "scenarios", ROOT / "scenarios" / "ompl"], "--out-json")  # (never over a scene)
     out = {}
     parts = args.parts.upper()
     if "A" in parts:
@@ -519,8 +522,7 @@ def main(argv=None) -> int:
         out["C"] = part_c(3 if args.quick else 9)
         print_c(out["C"])
     if args.out_json:
-        with open(args.out_json, "w") as f:
-            json.dump(out, f, indent=1, default=str)
+        write_json(args.out_json, out, "--out-json", default=str)
     sys.stdout.flush()
     return 0
 

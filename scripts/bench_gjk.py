@@ -5,6 +5,7 @@ and overlapping. Peers: coal (C++, via its Python bindings; 2-D polygons as pris
 imports, and shapely's distance. EPA depths are checked against the exact depth of the
 materialised difference, for ours and for coal. Medians over repetitions; ratios printed.
 Usage: python scripts/bench_gjk.py [--pairs N] [--plot FILE]
+(--plot: .png, .svg or .pdf, checked before any work and written atomically.)
 """
 import argparse
 import statistics
@@ -92,11 +93,19 @@ def exact_depth(A, B):
     return D.exterior.distance(shapely.Point(0, 0))
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--pairs", type=int, default=50)
     ap.add_argument("--plot", default=None, help="PNG: distance error against the iteration cap")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
+    import os
+    import sys
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from benchutil import check_out
+    from planners.output import PLOT_FORMATS, atomic_path
+
+    fmt = check_out(args.plot or None, (), "--plot", PLOT_FORMATS)  # (the pairs are made here: no input files)
     import shapely
 
     rng = np.random.default_rng(0)
@@ -163,7 +172,8 @@ def main():
         ax.set_title("GJK convergence (separated pairs)")
         ax.legend()
         fig.tight_layout()
-        fig.savefig(args.plot, dpi=120)
+        with atomic_path(args.plot, "--plot") as tmp:
+            fig.savefig(tmp, dpi=120, format=fmt)
         print(f"plot: {args.plot}")
 
 

@@ -47,12 +47,12 @@ checkers have at least one valid run; where the peer has none, the cell says so
 (e.g. ``coal: 0/10 valid (10 colliding)``) instead of a ratio (:func:`ratio_cell`).
 
 Usage: python scripts/bench_planning.py [--quick] [--seeds N] [--time S] [--scenes a,b] [--out-json FILE]
+(--out-json is checked before any work, never over a bundled scenario, and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
 import glob
-import json
 import math
 import os
 import statistics
@@ -430,6 +430,10 @@ def main(argv=None) -> int:
     ap.add_argument("--planners", default=None)
     ap.add_argument("--out-json", default=None)
     args = ap.parse_args(argv)
+    from benchutil import check_json, write_json
+
+    check_json(args.out_json, [os.path.join(ROOT, "scenarios"), os.path.join(ROOT, "scenarios", "ompl")],
+               "--out-json")  # (never over a scene)
     names = set(args.scenes.split(",")) if args.scenes else (set(QUICK_SCENES) if args.quick else None)
     seeds = args.seeds or (3 if args.quick else 10)
     tlim = args.time or (5.0 if args.quick else 10.0)
@@ -449,8 +453,7 @@ def main(argv=None) -> int:
     print()
     print("\n".join(report(rows, checkers)))
     if args.out_json:
-        with open(args.out_json, "w") as fh:
-            json.dump(rows, fh, indent=1)
+        write_json(args.out_json, rows, "--out-json")
     return 0
 
 

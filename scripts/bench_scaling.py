@@ -51,11 +51,11 @@ log-log) against the theory, with the full run's figures (2-core machine, shared
     10^6-vertex convex obstacle: load and build seconds per stage, slopes per stage.
 
 Usage: python scripts/bench_scaling.py [--quick] [--big | --no-big] [--plot scaling.png] [--out-json rows.json]
+(--plot: .png, .svg or .pdf; both outputs are checked before any work and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import statistics
 import sys
@@ -358,8 +358,8 @@ def print_fits(table: list[dict]) -> None:
         print(f"{f['sweep']:>10} {f['field']:>16} {f['fitted']:>9.2f} {f['theory']:>7.1f}  {f['why']}")
 
 
-def plot(rows: list[dict], path: str) -> None:
-    """One log-log panel per sweep."""
+def plot(rows: list[dict], path: str, fmt: str = "png") -> None:
+    """One log-log panel per sweep, written atomically to ``path`` in ``fmt``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -399,7 +399,10 @@ def plot(rows: list[dict], path: str) -> None:
     axes[1].set_title("(b) vertices per obstacle")
     axes[2].set_title("(c) non-convex pairs")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    from planners.output import atomic_path
+
+    with atomic_path(path, "--plot") as tmp:
+        fig.savefig(tmp, dpi=110, format=fmt)
     plt.close(fig)
 
 
@@ -427,6 +430,12 @@ def main(argv=None) -> int:
 
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import scaling_big
+    from benchutil import check_distinct, check_json, check_out, write_json
+    from planners.output import PLOT_FORMATS
+
+    fmt = check_out(args.plot or None, (), "--plot", PLOT_FORMATS)  # (the scenes are made here: no input files)
+    check_json(args.out_json, (), "--out-json")
+    check_distinct([(args.plot, "--plot"), (args.out_json, "--out-json")])
 
     rows = [] if args.big else run(args.quick, args.seed)
     big = [] if args.no_big else scaling_big.sweep(args.quick, log=lambda *a, **k: print(*a, file=sys.stderr, **k))
@@ -438,11 +447,11 @@ def main(argv=None) -> int:
         scaling_big.print_big(big, big_table)
     rows += big
     if args.plot:
-        plot(rows, args.plot)
+        plot(rows, args.plot, fmt)
         print(f"\nplot: {args.plot}")
     if args.out_json:
-        with open(args.out_json, "w") as f:
-            json.dump({"rows": rows, "fits": table, "big_fits": big_table, "quick": args.quick}, f, indent=1)
+        write_json(args.out_json, {"rows": rows, "fits": table, "big_fits": big_table, "quick": args.quick},
+                   "--out-json")
     print(f"total {time.perf_counter() - t0:.1f}s")
     return 0
 

@@ -36,12 +36,12 @@
 
 Usage: python scripts/bench_se2.py [--quick] [--parts VMTP] [--peers shapely,coal] [--scenes WORDS]
                                    [--peer-resolution STEP] [--json FILE]
+(--json is checked before any work, never over a bundled scene, and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
 import glob
-import json
 import math
 import os
 import statistics
@@ -382,6 +382,9 @@ def main(argv=None) -> int:
                          "(default: OMPL's, 0.01); finer steps make a peer tunnel less and cost more")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args(argv)
+    from benchutil import check_json, write_json
+
+    check_json(a.json, [SE2_DIR, os.path.join(ROOT, "scenarios", "car")])  # (never over a scene)
     out = {}
     if "V" in a.parts:
         out["validity"] = part_v(n=5000 if a.quick else 50000, reps=5 if a.quick else 11)
@@ -449,8 +452,7 @@ def main(argv=None) -> int:
                           f"{max(vals):.2f}x; colliding paths: ours {sum(r['colliding']['ours'] for r in mine)}, "
                           f"{m} {sum(r['colliding'][m] for r in mine)}")
     if a.json:
-        with open(a.json, "w") as fh:
-            json.dump(out, fh, indent=1)
+        write_json(a.json, out)
     return 0
 
 

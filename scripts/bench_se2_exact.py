@@ -47,12 +47,12 @@ start's own angle, doors 0.1 % wider): every scene solved. ``--family a,b`` runs
 
 Usage: python scripts/bench_se2_exact.py [--seeds N] [--time T] [--scenes a,b] [--json FILE]
        [--families N [--family NAME,...] [--peer-time T]]
+(--json is checked before any work, never over a bundled scene, and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
 import glob
-import json
 import math
 import os
 import statistics
@@ -207,11 +207,13 @@ def main(argv=None) -> int:
     ap.add_argument("--family", help="with --families: comma-separated family names (default: all)")
     ap.add_argument("--peer-time", type=float, help="with --families: RRTConnect's limit (default: --time; 0: not run)")
     args = ap.parse_args(argv)
+    from benchutil import check_json, write_json
+
+    check_json(args.json, [os.path.join(ROOT, "scenarios", "se2")])  # (never over a scene)
     if args.families:
         rows = families(args.families, args.time, args.peer_time, args.family)
         if args.json:
-            with open(args.json, "w") as fh:
-                json.dump(rows, fh, indent=1)
+            write_json(args.json, rows)
         return 0
     paths = sorted(glob.glob(os.path.join(ROOT, "scenarios", "se2", "*.toml")))
     if args.scenes:
@@ -257,8 +259,7 @@ def main(argv=None) -> int:
     print(f"  colliding paths: exact {sum(r['colliding']['exact'] for r in rows)}, "
           f"RRTConnect {sum(r['colliding']['rrt'] for r in rows)}")
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(rows, fh, indent=1)
+        write_json(args.json, rows)
     return 0
 
 

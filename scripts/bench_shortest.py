@@ -28,11 +28,11 @@ medians of 3; ``--old-limit 30``): the lengths agree on every scene both finish.
 The figure: docs/shortest_scaling.png (``--plot``).
 
 Usage: python scripts/bench_shortest.py [--quick] [--plot docs/shortest_scaling.png] [--out-json rows.json]
+(--plot: .png, .svg or .pdf; both outputs are checked before any work and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import statistics
 import sys
@@ -160,8 +160,9 @@ def print_rows(rows: list[dict], table: list[dict]) -> None:
         print(f"{f['family']:>9} {f['search']:>5} k = {f['k']:.2f} ({f['points']} sizes)")
 
 
-def plot(rows: list[dict], table: list[dict], path: str) -> None:
-    """Time against C-obstacle vertices, log-log, one line per family and search."""
+def plot(rows: list[dict], table: list[dict], path: str, fmt: str = "png") -> None:
+    """Time against C-obstacle vertices, log-log, one line per family and search, written
+    atomically to ``path`` in ``fmt``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -184,8 +185,8 @@ def plot(rows: list[dict], table: list[dict], path: str) -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    with atomic_path(path, "--plot") as tmp:
+        fig.savefig(tmp, dpi=110, format=fmt)
     plt.close(fig)
 
 
@@ -199,6 +200,15 @@ def main(argv=None) -> int:
     ap.add_argument("--out-json", default=None, help="write the rows and slopes as JSON")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
+    import os
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from benchutil import check_distinct, check_json, check_out, write_json
+    from planners.output import PLOT_FORMATS
+
+    fmt = check_out(args.plot or None, (), "--plot", PLOT_FORMATS)  # (the scenes are made here: no input files)
+    check_json(args.out_json, (), "--out-json")
+    check_distinct([(args.plot, "--plot"), (args.out_json, "--out-json")])
     sizes = [int(s) for s in args.sizes.split(",")] if args.sizes else (QUICK if args.quick else FULL)
     reps = args.reps or (1 if args.quick else 3)
     limit = args.old_limit if args.old_limit is not None else (20.0 if args.quick else 60.0)
@@ -214,11 +224,9 @@ def main(argv=None) -> int:
     print_rows(rows, table)
     print(f"\n{time.perf_counter() - t0:.0f} s wall")
     if args.plot:
-        plot(rows, table, args.plot)
+        plot(rows, table, args.plot, fmt)
     if args.out_json:
-        from planners.output import write_text
-
-        write_text(args.out_json, json.dumps({"rows": rows, "fits": table}, indent=1) + "\n")
+        write_json(args.out_json, {"rows": rows, "fits": table}, "--out-json")
     bad = [r for r in rows if r.get("agree") is False]
     return 1 if bad else 0
 

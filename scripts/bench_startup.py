@@ -14,6 +14,7 @@ its C sources are the same in both), so a change's start-up is compared side by 
 the commit before it, ``cspace plan scenarios/basic.toml`` included.
 
 Usage: python scripts/bench_startup.py [--quick] [--rounds N] [--against REV] [--out-json FILE]
+(--out-json is checked before any work, never over scenarios/basic.toml, and written atomically.)
 """
 from __future__ import annotations
 
@@ -21,7 +22,6 @@ import argparse
 import contextlib
 import filecmp
 import glob
-import json
 import os
 import shutil
 import statistics
@@ -129,6 +129,10 @@ def main(argv=None) -> int:
     ap.add_argument("--against", metavar="REV", help="also time the tree commands in a checkout of REV")
     ap.add_argument("--out-json", default=None)
     args = ap.parse_args(argv)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from benchutil import check_json, write_json
+
+    check_json(args.out_json, [BASIC], "--out-json")  # (never over the scenario it plans)
     rows = run(args.rounds or (5 if args.quick else 15), args.against)
     print(f"{'command':30s} {'median s':>9s} {'over peer s':>12s}  target")
     for r in rows:
@@ -140,8 +144,7 @@ def main(argv=None) -> int:
         for name in tree_commands():
             print(f"  {name:30s} {med[name] / med[f'{name} [{args.against}]']:.3f}x")
     if args.out_json:
-        with open(args.out_json, "w") as fh:
-            json.dump(rows, fh, indent=1)
+        write_json(args.out_json, rows, "--out-json")
     return 0
 
 

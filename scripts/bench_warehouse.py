@@ -38,11 +38,11 @@ mean <= 45 ms, p95 <= 100 ms, every query answered (a path or a proof), 0 collid
 
 Usage: python scripts/bench_warehouse.py [--pairs N] [--size CELLS] [--time S] [--planners A,B]
        [--spaces se2,reeds-shepp,dubins] [--radius R] [--no-peer] [--json FILE]
+(--json is checked before any work and written atomically.)
 """
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import statistics
@@ -126,8 +126,9 @@ def main(argv=None) -> int:
     spaces = [s for s in args.spaces.split(",") if s]
     if not spaces or set(spaces) - {"se2", "reeds-shepp", "dubins"}:
         ap.error(f"--spaces: se2, reeds-shepp and/or dubins, got {args.spaces!r}")
-    from benchutil import coal_peer
+    from benchutil import check_json, coal_peer, write_json
 
+    check_json(args.json)  # (the map is written to a temporary folder: no input of the run's to protect)
     peer = coal_peer(not args.no_peer)
     out = {}
     with tempfile.TemporaryDirectory(prefix="warehouse-") as folder:
@@ -151,8 +152,7 @@ def main(argv=None) -> int:
                   f"(target <= 2 s: {'met' if prep['cpu'] <= 2 else 'MISSED'})")
             out[space] = bench_nav2.run_space(space, sc, cs, prep, pairs, judge, peer, args.time)
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(out, fh, indent=1)
+        write_json(args.json, out)
     return 0
 
 

@@ -39,37 +39,70 @@ def coal_peer(wanted: bool) -> bool:
     return True
 
 
-def check_json(path: str | None, inputs=()) -> None:
-    """Before any work: refuse a ``--json`` path that names one of the run's ``inputs`` (files, or
-    folders standing for every file in them: another project's checkout), a folder or an unwritable
-    place, in one line, exit 2 (:func:`planners.output.check_output`, the CLI's own check).
+def check_out(path: str | None, inputs=(), option: str = "--json", suffixes: dict | None = None,
+              folder: bool = False) -> str:
+    """Before any work: refuse an output ``path`` given as ``option`` that names one of the run's
+    ``inputs`` (files, or folders standing for every file in them: the bundled scenarios' folder,
+    another project's checkout), a folder, an unwritable place, or (with ``suffixes``, e.g.
+    :data:`planners.output.PLOT_FORMATS`) an extension not among them, in one line, exit 2
+    (:func:`planners.output.check_output`, the CLI's own check); returns the format for plots.
+    With ``folder`` the output is a folder: created if missing, and writable
+    (:func:`planners.output.check_folder`). ``None`` is no output.
 
-    >>> check_json(None), check_json("out.json")
-    (None, None)
+    >>> check_out(None), check_out("out.json"), check_out("fig.svg", (), "--plot", {".svg": "svg"})
+    ('', '', 'svg')
     """
     if path is None:
-        return
-    from planners.errors import InputError
-    from planners.output import check_output
+        return ""
+    from planners.output import check_folder, check_output
 
     files = []
     for p in inputs:
         files += [os.path.join(p, f) for f in sorted(os.listdir(p))] if os.path.isdir(p) else [p]
+    if folder:
+        return _refused(check_folder, path, option) or ""
+    return _refused(check_output, path, option, suffixes, files)
+
+
+def check_distinct(outputs) -> None:
+    """Before any work: refuse two options naming one output file (``[(path, option), ...]``,
+    None and '' skipped; :func:`planners.output.check_distinct`), in one line, exit 2.
+
+    >>> check_distinct([("a.json", "--out-json"), ("a.png", "--plot"), ("", "--csv")])
+    """
+    from planners.output import check_distinct as check
+
+    _refused(check, outputs)
+
+
+def _refused(check, *args):
+    """``check(*args)``; its :class:`planners.errors.InputError` is one line on stderr, exit 2."""
+    from planners.errors import InputError
+
     try:
-        check_output(path, "--json", inputs=files)
+        return check(*args)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         raise SystemExit(2) from None
 
 
-def write_json(path: str, data) -> None:
+def check_json(path: str | None, inputs=(), option: str = "--json") -> None:
+    """:func:`check_out` for a bench's JSON figures (``--json``, ``--out-json``).
+
+    >>> check_json(None), check_json("out.json")
+    (None, None)
+    """
+    check_out(path, inputs, option)
+
+
+def write_json(path: str, data, option: str = "--json", default=None) -> None:
     """Write a bench's figures as JSON, atomically (:func:`planners.output.atomic_path`): a run
-    stopped half-way leaves the old file, never half a new one."""
+    stopped half-way leaves the old file, never half a new one (``default``: as ``json.dump``'s)."""
     from planners.output import atomic_path
 
-    with atomic_path(path, "--json") as tmp:
+    with atomic_path(path, option) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:
-            json.dump(data, fh, indent=1)
+            json.dump(data, fh, indent=1, default=default)
 
 
 def _clock(s: float) -> str:

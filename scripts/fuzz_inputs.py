@@ -14,6 +14,7 @@ that breaks the contract is kept (its files and the reason) under ``OUT/kept`` a
 run goes on.
 
 Usage: python scripts/fuzz_inputs.py [--scenario N] [--imports N] [--campaigns N] [--out DIR] [--jobs 1|2]
+(--out is checked before any work: created if missing, and writable; OUT/summary.json is written atomically.)
 
 The defaults (1000 and 2000 examples per test: 4 tests each) give about 12 000 cases and
 about 22 000 generated files; expect a few minutes per 1000 cases a core.
@@ -55,7 +56,10 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="fuzz_out", help="folder for the reports, logs and kept cases")
     ap.add_argument("--jobs", type=int, choices=(1, 2), default=2)
     args = ap.parse_args(argv)
-    os.makedirs(args.out, exist_ok=True)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from benchutil import check_out, write_json
+
+    check_out(args.out, (), "--out", folder=True)  # before any work: created, and writable
     out = os.path.abspath(args.out)
     t0 = time.time()
     plan = [(FILES[tag], n, tag) for n, tag in ((args.scenario, "scenario"), (args.imports, "imports"),
@@ -101,8 +105,7 @@ def main(argv=None) -> int:
             summary["files_by_kind"]["scenario"] = summary["files_by_kind"].get("scenario", 0) + scen
     summary["files"] = sum(summary["files_by_kind"].values())
     print(json.dumps(summary, indent=1))
-    with open(os.path.join(out, "summary.json"), "w") as fh:
-        json.dump(summary, fh, indent=1)
+    write_json(os.path.join(out, "summary.json"), summary, "--out")
     ok = summary["exit_3"] == 0 and summary["contract_broken"] == 0 and not any(codes.values())
     return 0 if ok else 1
 

@@ -89,7 +89,13 @@ PLOT_IMG = "document.querySelector('#performance-plot img')"
 
 def arena_screenshot(out: str = OUT, db: str | None = None) -> str:
     """Save Planner Arena's "Overall performance" page for a cspace database (made here unless
-    ``db`` is given) as ``out``; returns a one-line summary."""
+    ``db`` is given) as ``out``; returns a one-line summary. ``out`` is checked before any work (a
+    PNG, not a folder, not ``db`` nor the scenario the sweep reads, writable: one line, exit 2) and
+    written atomically."""
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from benchutil import check_out
+
+    check_out(out, [p for p in (db, os.path.join(ROOT, BENCH_ARGS[0])) if p], "--out", {".png": "png"})
     mod = _browser_module()
     work = tempfile.mkdtemp(prefix="cspace-arena-")
     log_path = os.path.join(work, "plannerarena.log")
@@ -132,8 +138,7 @@ def arena_screenshot(out: str = OUT, db: str | None = None) -> str:
                                f"document.getElementById('performance-attribute').value, "
                                f"[...document.querySelectorAll('#performance-planners input:checked')]"
                                f".map(e => e.value).join(', ')]")
-                b.screenshot(out + ".tmp")
-        os.replace(out + ".tmp", out)
+                b.screenshot(out)  # (written atomically)
         return f"Planner Arena: {shown[0]}, {shown[1]}, planners {shown[2]}"
     except Exception:
         if os.path.exists(log_path):
@@ -147,8 +152,6 @@ def arena_screenshot(out: str = OUT, db: str | None = None) -> str:
             except subprocess.TimeoutExpired:
                 server.kill()
                 server.wait()
-        if os.path.exists(out + ".tmp"):
-            os.remove(out + ".tmp")
         shutil.rmtree(work, ignore_errors=True)
 
 

@@ -123,9 +123,16 @@ def run_script(name: str, script: str, work: str, checkout: str | None = None) -
         shown = shown.replace(shlex.quote(checkout), "DIR")
     rec = {"name": name, "command": shown, "seconds": time.perf_counter() - t, "rc": rc, **started,
            "stdout": out, "stderr": err[-2000:], "json": json_path if wants_json and os.path.exists(json_path) else None}
-    with open(os.path.join(work, f"{name}.run.json"), "w") as fh:
-        json.dump(rec, fh, indent=1)
+    _write_json(os.path.join(work, f"{name}.run.json"), rec)
     return rec
+
+
+def _write_json(path: str, rec: dict) -> None:
+    """A run's record in the work folder, written atomically (scripts/benchutil.py)."""
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from benchutil import write_json
+
+    write_json(path, rec, "--work")
 
 
 def run_planner_sweep(work: str) -> dict:
@@ -143,8 +150,7 @@ def run_planner_sweep(work: str) -> dict:
     rec = {"name": "cspace_bench", "command": " ".join(cmd[:-2] + ["--out", "OUT"]),
            "seconds": time.perf_counter() - t, "rc": rc, "stdout": out, "stderr": err[-2000:],
            "json": res if os.path.exists(res) else None}
-    with open(os.path.join(work, "cspace_bench.run.json"), "w") as fh:
-        json.dump(rec, fh, indent=1)
+    _write_json(os.path.join(work, "cspace_bench.run.json"), rec)
     return rec
 
 
@@ -355,8 +361,10 @@ def machine_note(work: str) -> str:
              "platform": platform.platform(), "processor": platform.processor() or platform.machine(),
              "cpus": os.cpu_count(), "python": platform.python_version(), "numpy": numpy.__version__,
              "load": list(os.getloadavg()) if hasattr(os, "getloadavg") else None}
-        with open(path, "w") as fh:
-            json.dump(m, fh)
+        sys.path.insert(0, ROOT)
+        from planners.output import write_text
+
+        write_text(path, json.dumps(m), "--work")
     load = f"; load average at start {', '.join(f'{x:.2f}' for x in m['load'])}" if m.get("load") else ""
     return (f"Measured {m['date']} on {m['platform']} ({m['processor']}, {m['cpus']} logical CPUs{load}), "
             f"Python {m['python']}, numpy {m['numpy']}.")
@@ -513,6 +521,17 @@ def main(argv: list[str] | None = None) -> int:
                     help="an OMPL.app checkout (or its resources/2D) for scripts/bench_omplapp.py (default: $OMPLAPP; "
                          "without one its section says how to run it)")
     args = ap.parse_args(argv)
+    sys.path.insert(0, ROOT)
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from benchutil import check_out
+
+    # Before any work: the page never over a file the benches read (the bundled scenarios, a given
+    # checkout's top folder) nor one of the --from records; --work a folder that can be written.
+    scenes = [os.path.join(ROOT, "scenarios")] + [os.path.join(ROOT, "scenarios", d) for d in ("ompl", "se2", "car", "maps")]
+    check_out(args.out, [p for p in (*scenes, args.source, args.bench_mr, args.omplapp) if p and os.path.isdir(p)],
+              "--out")
+    if args.work and not args.source:
+        check_out(args.work, (), "--work", folder=True)
     found = {os.path.splitext(os.path.basename(p))[0]: p for p in sorted(glob.glob(os.path.join(ROOT, "scripts", "bench_*.py")))}
     order = [n for n in EXPECTED if n in found] + [n for n in found if n not in EXPECTED]
     missing = [n for n in EXPECTED if n not in found]

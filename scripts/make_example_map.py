@@ -6,6 +6,8 @@ speckles of sensor noise, and unknown (grey 205) outside the building. Grey leve
 map_server's: 0 occupied, 254 free, 205 unknown. Run from the repository root:
 
     python scripts/make_example_map.py [--out scenarios/maps/office.pgm]
+
+``--out`` (.pgm or .png) is checked before any work and written atomically.
 """
 from __future__ import annotations
 
@@ -53,7 +55,14 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     from PIL import Image
 
-    Image.fromarray(office()).save(args.out)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from benchutil import check_out
+    from planners.output import atomic_path
+
+    fmt = check_out(args.out, (), "--out", {".pgm": "PPM", ".png": "PNG"})  # (Pillow's PPM writes a PGM)
+    img = office()
+    with atomic_path(args.out, "--out") as tmp:
+        Image.fromarray(img).save(tmp, format=fmt)
     print(f"wrote {args.out}")
     return 0
 

@@ -449,7 +449,10 @@ def main(argv: list[str] | None = None) -> int:
         for f in figs if args.only else figures():
             print(f"{f.name:<24} {f.group:<10} {f.what}" + (" (only when named)" if f.group in LONG_GROUPS else ""))
         return 0
-    os.makedirs(args.out, exist_ok=True)
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from benchutil import check_out
+
+    check_out(args.out, (), "--out", folder=True)  # before any work: created if missing, and writable
     t_all = time.perf_counter()
     for f in figs:
         path = os.path.join(args.out, f"{f.name}.png")

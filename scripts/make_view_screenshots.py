@@ -144,8 +144,11 @@ class Browser:
         """A PNG of the viewport (also written to ``out`` if given)."""
         png = base64.b64decode(self.call("Page.captureScreenshot", {"format": "png"}, session=True)["data"])
         if out:
-            with open(out, "wb") as fh:
-                fh.write(png)
+            from planners.output import atomic_path
+
+            with atomic_path(out, "screenshot") as tmp:  # never half a picture
+                with open(tmp, "wb") as fh:
+                    fh.write(png)
         return png
 
     def click(self, x: float, y: float) -> None:
@@ -205,14 +208,21 @@ def slider_point(b: Browser, index: int, fraction: float) -> tuple[float, float]
 
 def bar_door_screenshot(out: str = os.path.join(ROOT, "docs", "figures", "view_bar_door.png")) -> str:
     """Plan scenarios/se2/bar_door.toml, write its page, and save the browser's screenshot of it
-    with the bar half way through the door and the angle slider at 0 degrees."""
+    with the bar half way through the door and the angle slider at 0 degrees. ``out`` is checked
+    before any work (never the scenario, a folder or an unwritable place: one line, exit 2) and
+    written atomically."""
     sys.path.insert(0, ROOT)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import planners
+    from benchutil import check_out
+    from planners.output import PLOT_FORMATS
     from planners.pictures.view import write_view
 
+    scene = os.path.join(ROOT, "scenarios", "se2", "bar_door.toml")
+    check_out(out, [scene], "out", {".png": PLOT_FORMATS[".png"]})
     with tempfile.TemporaryDirectory() as tmp:
         page = os.path.join(tmp, "view.html")
-        write_view(planners.plan(os.path.join(ROOT, "scenarios", "se2", "bar_door.toml")), page)
+        write_view(planners.plan(scene), page)
         with Browser(width=1200, height=900) as b:
             b.open("file://" + page + "#pose=55&angle=16")
             b.pump(0.3)

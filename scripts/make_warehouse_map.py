@@ -112,22 +112,24 @@ def pairs(img: np.ndarray, count: int, seed: int = 0) -> list[tuple]:
 
 
 def write(out: str, size: int, seed: int, count: int) -> tuple[str, str]:
-    """Write warehouse.png, warehouse.yaml and warehouse_queries.toml into ``out``."""
+    """Write warehouse.png, warehouse.yaml and warehouse_queries.toml into ``out``, each atomically."""
     from PIL import Image
+
+    from planners.output import atomic_path, write_text
 
     os.makedirs(out, exist_ok=True)
     img = warehouse(size, seed)
-    Image.fromarray(img).save(os.path.join(out, "warehouse.png"))
+    with atomic_path(os.path.join(out, "warehouse.png"), "--out") as tmp:
+        Image.fromarray(img).save(tmp, format="PNG")
     yaml = os.path.join(out, "warehouse.yaml")
-    with open(yaml, "w") as fh:
-        fh.write("image: warehouse.png\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
-                 "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n")
+    write_text(yaml, "image: warehouse.png\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
+                     "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n", "--out")
     queries = os.path.join(out, "warehouse_queries.toml")
-    with open(queries, "w") as fh:
-        fh.write(f"# {count} start/goal pairs for a {FOOTPRINT[0]} x {FOOTPRINT[1]} m footprint "
-                 f"(scripts/make_warehouse_map.py, seed {seed})\n")
-        for s, g in pairs(img, count, seed):
-            fh.write(f"\n[[queries]]\nstart = [{s[0]}, {s[1]}, {s[2]}]\ngoal = [{g[0]}, {g[1]}, {g[2]}]\n")
+    text = (f"# {count} start/goal pairs for a {FOOTPRINT[0]} x {FOOTPRINT[1]} m footprint "
+            f"(scripts/make_warehouse_map.py, seed {seed})\n")
+    for s, g in pairs(img, count, seed):
+        text += f"\n[[queries]]\nstart = [{s[0]}, {s[1]}, {s[2]}]\ngoal = [{g[0]}, {g[1]}, {g[2]}]\n"
+    write_text(queries, text, "--out")
     return yaml, queries
 
 
@@ -138,6 +140,10 @@ def main(argv=None) -> int:
     ap.add_argument("--pairs", type=int, default=100)
     ap.add_argument("--size", type=int, default=2000, help="cells per side (5 cm each)")
     args = ap.parse_args(argv)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from benchutil import check_out
+
+    check_out(args.out, (), "--out", folder=True)  # before any work: created if missing, and writable
     yaml, queries = write(args.out, args.size, args.seed, args.pairs)
     print(f"{yaml}: {args.size} x {args.size} cells of {RES} m; {queries}: {args.pairs} pairs")
     return 0

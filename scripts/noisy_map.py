@@ -34,15 +34,17 @@ def start_goal(size: int, res: float = 0.05) -> tuple[tuple[float, float], tuple
 
 
 def write_map(folder: str, img: np.ndarray, name: str = "noisy", png: bool = False, res: float = 0.05) -> str:
-    """Write ``img`` and its YAML into ``folder``; returns the YAML's path."""
+    """Write ``img`` and its YAML into ``folder``, each atomically; returns the YAML's path."""
     from PIL import Image
 
+    from planners.output import atomic_path, write_text
+
     image = f"{name}.{'png' if png else 'pgm'}"
-    Image.fromarray(img).save(os.path.join(folder, image))
+    with atomic_path(os.path.join(folder, image), "OUT_DIR") as tmp:
+        Image.fromarray(img).save(tmp, format="PNG" if png else "PPM")  # (Pillow's PPM writes a PGM)
     path = os.path.join(folder, f"{name}.yaml")
-    with open(path, "w") as fh:
-        fh.write(f"image: {image}\nresolution: {res}\norigin: [0.0, 0.0, 0.0]\n"
-                 "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n")
+    write_text(path, f"image: {image}\nresolution: {res}\norigin: [0.0, 0.0, 0.0]\n"
+                     "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n", "OUT_DIR")
     return path
 
 
@@ -55,7 +57,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--res", type=float, default=0.05)
     ap.add_argument("--png", action="store_true")
     args = ap.parse_args(argv)
-    os.makedirs(args.out_dir, exist_ok=True)
+    import sys
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from benchutil import check_out
+
+    check_out(args.out_dir, (), "OUT_DIR", folder=True)  # before any work: created if missing, and writable
     path = write_map(args.out_dir, noisy_image(args.size, args.noise, args.seed),
                      f"noisy{args.size}", args.png, args.res)
     print(f"wrote {path}")
