@@ -16,8 +16,8 @@ from .result import PlanResult
 
 REACH_SHARE = 0.2  # of the time limit, at most, for both ends together
 REACH_MAX = 3.0    # seconds, at most, whatever the limit (the cells' cap ends it first on the scenes we know)
-# C-space -> the (start, goal, backward) whose attempts ran to their end without a proof (each is
-# deterministic: the same regions and cap answer the same); an attempt cut by time is not kept.
+# C-space -> the (start, goal, backward, steps) whose attempts ran to their end without a proof (each
+# is deterministic: the same regions and cap answer the same); an attempt cut by time is not kept.
 _NO_REACH: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -38,9 +38,9 @@ def reach_result(sc, cspace, regions, query, budget: float, ends: tuple = ("star
     None otherwise (not a Dubins car, a point robot, the reach not confined within the cap, or
     ``budget`` seconds spent). ``regions``: the C-space's slab regions
     (:func:`planners.core.exact_se2.slab_regions_of`), whose POSSIBLE the reach reads; ``ends``:
-    the reaches tried ("start": forward from it, "goal": backward from it), an end already tried
-    on this query to its end is not tried again; ``steps``: the resolutions tried, coarse first
-    (default :data:`cspace.car.dubins_reach.STEPS`)."""
+    the reaches tried ("start": forward from it, "goal": backward from it); ``steps``: the
+    resolutions tried, coarse first (default :data:`cspace.car.dubins_reach.STEPS`). An end
+    already tried to its end on this query at these steps is not tried again."""
     from cspace.car.dubins_reach import MAX_CELLS, STEPS, reach_proof
 
     steps = STEPS if steps is None else tuple(steps)
@@ -48,7 +48,7 @@ def reach_result(sc, cspace, regions, query, budget: float, ends: tuple = ("star
         return None
     key = (tuple(map(float, query.start)), tuple(map(float, query.goal)))
     tried = _NO_REACH.setdefault(cspace, set())
-    sides = [e == "goal" for e in ("start", "goal") if e in ends and key + (e == "goal",) not in tried]
+    sides = [e == "goal" for e in ("start", "goal") if e in ends and key + (e == "goal", steps) not in tried]
     t0 = time.perf_counter()
     deadline = t0 + budget
     for frac, backward in ((f, b) for f in steps for b in sides):  # coarse first, either end
@@ -67,5 +67,5 @@ def reach_result(sc, cspace, regions, query, budget: float, ends: tuple = ("star
                                       f"slabs, is closed under the car's steps of {proof['step']:g} and keeps the "
                                       f"{other} out)")
     if time.perf_counter() <= deadline:
-        tried.update(key + (b,) for b in sides)
+        tried.update(key + (b, steps) for b in sides)
     return None

@@ -370,3 +370,20 @@ def test_displacement_hulls_hold_every_curvature_bounded_step(a, width, frac, at
     theirs = disp_hull(a, b, s, r, exact, sign)
     assert mine.buffer(1e-9).covers(point) and theirs.buffer(1e-9).covers(point), (x, y)
     assert abs(theta - (a + at * width)) <= length / r + 1e-12
+
+
+def test_an_end_tried_at_coarse_steps_is_tried_again_at_a_finer_one():
+    # A wall 1.52 ahead: only a radius 11 % tighter turns away. The default steps (0.07, 0.05) find
+    # no proof; 0.04 (auto's last try for a boxed-in end) does. The memo of failed attempts once
+    # kept the query alone, so the finer attempt after a coarse one was skipped.
+    from cspace.car.dubins_reach import FINE_STEP, STEPS
+    from planners.core.dubins_proof import reach_result
+
+    sc = wall_scene(1.52)
+    cs = build_cspace(sc)
+    q = sc.all_queries()[0]
+    args = (sc, cs, slab_regions_of(cs), q, 60.0)
+    assert reach_result(*args, ends=("start",)) is None
+    assert reach_result(*args, ends=("start",)) is None  # (remembered: not tried again)
+    res = reach_result(*args, ends=("start",), steps=STEPS + (FINE_STEP,))
+    assert res is not None and res.proof["step"] == FINE_STEP and check_dubins_proof(sc, res.proof).valid
