@@ -33,8 +33,9 @@ RESTART_RADII = 7.0     # a restart's range, in turning radii
 RESTART_FLOOR = 1 / 8   # ... never below this share of OMPL's own range (a tiny radius: OMPL's steps)
 FIRST_RESTART = 2000    # iterations of the first restart (about 20 ms where the trees stay small)
 RESTART_GROWTH = 2      # each restart counts this many times the last one's iterations
-# The proofs run after these restarts: the reach once sampling has spent about what it costs
-# (2 000 + 4 000 + 8 000 iterations, 0.1-0.2 s), the SE(2) proof (its map-wide regions) after one more.
+# The proofs run after these restarts: the reach of an end in a pocket (its lattice short of
+# LATE_CAP) once sampling has spent about what it costs (2 000 + 4 000 + 8 000 iterations, 0.1-0.2 s),
+# the SE(2) proof (its map-wide regions) after one more.
 REACH_AFTER, QUICK_AFTER = 3, 4
 BOXED_CAP = 300    # lattice poses: an end short of it gets its reach proof before the restarts
 LATE_CAP = 1500    # ... and short of this, after REACH_AFTER restarts (a larger lattice: a reach past the cells' cap)
