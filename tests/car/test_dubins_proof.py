@@ -283,10 +283,22 @@ def check_solvable(seed: int, forge: bool = False) -> bool:
     cs, proofs = prove(sc)
     assert proofs == [None, None], seed  # a path exists: never proven unsolvable
     if forge:
-        for hole, step in ((False, "other end"), (True, "closure")):
-            r = check_dubins_proof(sc, forged(sc, cs, hole))
+        for hole in (False, True):
+            proof = forged(sc, cs, hole)
+            # the hole around the goal is not closed ("closure"), unless it takes the start's own
+            # cell too (a drive that ended within 0.5 of the start): then the start is not held ("seed")
+            step = "other end" if not hole else "closure" if holds_start(proof, sc) else "seed"
+            r = check_dubins_proof(sc, proof)
             assert not r.valid and r.step == step, (seed, r)
     return True
+
+
+def holds_start(proof: dict, sc) -> bool:
+    """Whether every slab of the forged proof holds every cell whose closed box holds the start."""
+    (x, y, _), h = sc.all_queries()[0].start, proof["grid"]["cell"]
+    cells = {(i, j) for i in {math.floor(x / h - 1e-9), math.floor(x / h + 1e-9)}
+             for j in {math.floor(y / h - 1e-9), math.floor(y / h + 1e-9)}}
+    return all(any(i == a and lo <= j < hi for a, lo, hi in slab["cells"]) for slab in proof["slabs"] for i, j in cells)
 
 
 def test_solvable_scenes_are_never_proven_and_forged_proofs_refused():
